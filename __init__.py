@@ -1,0 +1,23 @@
+"""Tessera: generate geometry where artists need it (Blender extension entry point).
+
+Registration only: submodules are registered in the order below and unregistered in reverse.
+Nothing is computed or compiled at import or register time.
+"""
+
+import importlib
+
+_modules = (
+    "addon.preferences",
+    "operators.tessellate",
+    "addon.menus",
+)
+
+
+def register():
+    for name in _modules:
+        importlib.import_module(f".{name}", __package__).register()
+
+
+def unregister():
+    for name in reversed(_modules):
+        importlib.import_module(f".{name}", __package__).unregister()

@@ -1,0 +1,1 @@
+"""Blender glue: preferences, menus, the mesh<->numpy bridge and the GPU-context helper."""

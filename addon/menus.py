@@ -1,0 +1,30 @@
+"""Menu entries: Object > Tessera."""
+
+import bpy
+
+
+class TESSERA_MT_object(bpy.types.Menu):
+    bl_idname = "TESSERA_MT_object"
+    bl_label = "Tessera"
+
+    def draw(self, context):
+        self.layout.operator("tessera.tessellate", icon="MOD_SUBSURF")
+
+
+def _draw_object_menu(self, context):
+    self.layout.separator()
+    self.layout.menu(TESSERA_MT_object.bl_idname)
+
+
+classes = (TESSERA_MT_object,)
+_register, _unregister = bpy.utils.register_classes_factory(classes)
+
+
+def register():
+    _register()
+    bpy.types.VIEW3D_MT_object.append(_draw_object_menu)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_object.remove(_draw_object_menu)
+    _unregister()

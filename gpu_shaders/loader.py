@@ -1,0 +1,33 @@
+"""Read GLSL files and build shaders from `GPUShaderCreateInfo` descriptions, once per session.
+
+GLSL follows Blender's cross-compilation rules: no ``#version``, ``layout`` or resource declarations in
+the files; inputs, outputs and uniforms are declared in the create-info. Nothing is compiled at import:
+`shader` compiles on first use (which needs a GPU context, see `addon.gpu_context`).
+"""
+
+from pathlib import Path
+
+GLSL_DIR = Path(__file__).parent
+_sources = {}
+_shaders = {}
+
+
+def source(name):
+    """Text of ``gpu_shaders/<name>`` (cached)."""
+    if name not in _sources:
+        _sources[name] = (GLSL_DIR / name).read_text(encoding="utf-8")
+    return _sources[name]
+
+
+def shader(name, describe):
+    """Compiled shader ``name``; ``describe()`` returns its `gpu.types.GPUShaderCreateInfo` on first use."""
+    if name not in _shaders:
+        import gpu
+
+        _shaders[name] = gpu.shader.create_from_info(describe())
+    return _shaders[name]
+
+
+def clear():
+    """Forget compiled shaders (their GPU context is gone, e.g. after unregister)."""
+    _shaders.clear()

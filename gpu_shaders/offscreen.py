@@ -1,0 +1,69 @@
+"""Offscreen rendering of triangle arrays to RGBA images, for checks and pictures.
+
+`render_triangles` draws world-space triangles with a view-projection matrix into a new offscreen
+buffer and returns the pixels as numpy; with ``lit=False`` every pixel of the mesh gets exactly
+``color``, which makes silhouette and crack comparisons exact.
+"""
+
+import numpy as np
+
+from . import loader
+
+
+def _describe_flat_mesh():
+    import gpu
+
+    iface = gpu.types.GPUStageInterfaceInfo("tessera_flat_mesh_iface")
+    iface.smooth("FLOAT", "shade")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.push_constant("MAT4", "view_projection")
+    info.push_constant("VEC4", "color")
+    info.push_constant("VEC3", "light_dir")
+    info.push_constant("VEC2", "lit_range")
+    info.vertex_in(0, "VEC3", "pos")
+    info.vertex_in(1, "VEC3", "nor")
+    info.vertex_out(iface)
+    info.fragment_out(0, "VEC4", "frag_color")
+    info.vertex_source(loader.source("flat_mesh_vert.glsl"))
+    info.fragment_source(loader.source("flat_mesh_frag.glsl"))
+    return info
+
+
+def render_triangles(positions, triangles, view_projection, size=(256, 256), color=(0.8, 0.8, 0.8, 1.0),
+                     background=(0.0, 0.0, 0.0, 1.0), lit=True):
+    """Draw triangles offscreen and return the image.
+
+    positions: (V, 3) float32 world space; triangles: (T, 3) int32; view_projection: (4, 4) row-major
+    matrix; size: (width, height). Returns (height, width, 4) uint8, row 0 at the bottom. Needs a GPU context.
+    """
+    import gpu
+    from gpu_extras.batch import batch_for_shader
+
+    width, height = size
+    tris = np.ascontiguousarray(triangles, dtype=np.int32)
+    corners = np.ascontiguousarray(positions, dtype=np.float32)[tris]  # (T, 3, 3) unshared: flat normals
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    nor = np.repeat(normals, 3, axis=0).astype(np.float32)
+    shader = loader.shader("flat_mesh", _describe_flat_mesh)
+    batch = batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
+    offscreen = gpu.types.GPUOffScreen(width, height)
+    try:
+        with offscreen.bind():
+            fb = gpu.state.active_framebuffer_get()
+            fb.clear(color=background, depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            shader.bind()
+            shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
+            shader.uniform_float("color", tuple(color))
+            shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
+            shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
+            batch.draw(shader)
+            buf = fb.read_color(0, 0, width, height, 4, 0, "UBYTE")
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+    finally:
+        offscreen.free()
+    buf.dimensions = width * height * 4  # multi-dimensional Buffers export wrong strides
+    return np.asarray(memoryview(buf), dtype=np.uint8).reshape(height, width, 4).copy()

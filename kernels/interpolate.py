@@ -1,0 +1,119 @@
+"""Evaluating attributes on a `Refinement`: weighted gathers, in numpy and OpenCL.
+
+Point attributes (positions, vertex colours) are interpolated per output vertex, corner attributes
+(UVs, corner normals, corner colours) per output face corner, and face attributes are copied from the
+source face. Everything is linear interpolation, so an attribute that is an affine function of position
+is reproduced exactly (up to float32 rounding of the result).
+"""
+
+import numpy as np
+
+from .errors import TesseraError
+from .opencl_runtime import get_runtime
+
+#: Below this many output rows the numpy path is used even when OpenCL is available (launch overhead).
+OPENCL_MIN_ROWS = 1 << 15
+BACKENDS = ("auto", "numpy", "opencl")
+
+
+def gather_weighted_numpy(values, idx, weights):
+    """Reference weighted gather.
+
+    values: (K, C) float; idx: (n, q) int; weights: (n, q) float. Returns (n, C) float32, accumulated in
+    float64 and rounded once.
+    """
+    acc = np.zeros((len(idx), values.shape[1]), dtype=np.float64)
+    for tap in range(idx.shape[1]):
+        acc += weights[:, tap, None] * values[idx[:, tap]]
+    return acc.astype(np.float32)
+
+
+def gather_weighted_opencl(runtime, values, idx, weights):
+    """The same gather as `gather_weighted_numpy` on an OpenCL device (float32 accumulation)."""
+    cl = runtime.cl
+    n, taps = idx.shape
+    channels = values.shape[1]
+    out = np.empty((n, channels), dtype=np.float32)
+    if n == 0:
+        return out
+    mf = cl.mem_flags
+    ctx = runtime.context
+    vals = np.ascontiguousarray(values, dtype=np.float32)
+    ids = np.ascontiguousarray(idx, dtype=np.int32)
+    wts = np.ascontiguousarray(weights, dtype=np.float32)
+    d_vals = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=vals)
+    d_ids = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=ids)
+    d_wts = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=wts)
+    d_out = cl.Buffer(ctx, mf.WRITE_ONLY, out.nbytes)
+    kernel = runtime.kernel("gather_weighted", "gather_weighted")
+    kernel(runtime.queue, (n,), None, d_vals, np.int32(channels), d_ids, d_wts, np.int32(taps), d_out, np.int32(n))
+    cl.enqueue_copy(runtime.queue, out, d_out)
+    return out
+
+
+def gather_weighted(values, idx, weights, backend="auto"):
+    """Weighted gather on the chosen backend: (K, C), (n, q), (n, q) -> (n, C) float32.
+
+    backend: ``"auto"`` (OpenCL for large inputs when available, else numpy), ``"numpy"`` or ``"opencl"``.
+    """
+    if backend not in BACKENDS:
+        raise TesseraError(f"Unknown compute backend {backend!r}; expected one of {', '.join(BACKENDS)}")
+    if backend == "numpy" or len(idx) == 0:
+        return gather_weighted_numpy(values, idx, weights)
+    if backend == "auto" and len(idx) < OPENCL_MIN_ROWS:
+        return gather_weighted_numpy(values, idx, weights)
+    runtime = get_runtime()
+    if runtime is None:
+        if backend == "opencl":
+            raise TesseraError("The OpenCL backend was requested but OpenCL is disabled or unavailable")
+        return gather_weighted_numpy(values, idx, weights)
+    return gather_weighted_opencl(runtime, values, idx, weights)
+
+
+def point_values(ref, values, backend="auto"):
+    """Interpolate a point attribute: (V, ...) -> (n_vertices, ...) float32.
+
+    Input vertices are copied, edge points are ``(1 - t) a + t b`` in the edge's canonical direction,
+    interior points are barycentric combinations of their face's corners.
+    """
+    values = np.asarray(values)
+    if values.shape[0] != ref.n_corners:
+        raise TesseraError(f"Point attribute has {values.shape[0]} rows; the mesh has {ref.n_corners} vertices")
+    flat = values.reshape(ref.n_corners, -1)
+    n_edge = len(ref.edge_point_edge)
+    out = np.empty((ref.n_vertices, flat.shape[1]), dtype=np.float32)
+    out[: ref.n_corners] = flat
+    t = ref.edge_point_t
+    out[ref.n_corners : ref.n_corners + n_edge] = gather_weighted(
+        flat, ref.edges[ref.edge_point_edge], np.stack([1.0 - t, t], axis=1), backend
+    )
+    out[ref.n_corners + n_edge :] = gather_weighted(flat, ref.faces[ref.interior_face], ref.interior_bary, backend)
+    return out.reshape((ref.n_vertices,) + values.shape[1:])
+
+
+def corner_values(ref, values, backend="auto"):
+    """Interpolate a per-face-corner attribute: (T, 3, ...) -> (M, 3, ...) float32."""
+    values = np.asarray(values)
+    n_faces = len(ref.faces)
+    if values.shape[:2] != (n_faces, 3):
+        raise TesseraError(f"Corner attribute has shape {values.shape}; expected ({n_faces}, 3, ...)")
+    flat = values.reshape(n_faces * 3, -1)
+    source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)  # (M, 3) source corners
+    idx = np.repeat(source, 3, axis=0)  # one row per output corner
+    out = gather_weighted(flat, idx, ref.corner_bary.reshape(-1, 3), backend)
+    return out.reshape((len(ref.triangles), 3) + values.shape[2:])
+
+
+def face_values(ref, values):
+    """Copy a per-face attribute to the output triangles: (T, ...) -> (M, ...), dtype kept."""
+    values = np.asarray(values)
+    if values.shape[0] != len(ref.faces):
+        raise TesseraError(f"Face attribute has {values.shape[0]} rows; the mesh has {len(ref.faces)} triangles")
+    return values[ref.triangle_face]
+
+
+def normalized(vectors):
+    """Unit vectors along the last axis; zero vectors stay zero. (..., 3) -> (..., 3) float32."""
+    v = np.asarray(vectors, dtype=np.float64)
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.divide(v, length, out=np.zeros_like(v), where=length > 0).astype(np.float32)

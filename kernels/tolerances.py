@@ -1,0 +1,8 @@
+"""Numeric tolerances used across kernels and tests: one place, so they cannot drift apart."""
+
+#: Relative tolerance when a float32 path (OpenCL, GPU) is compared with the float64-accumulating numpy reference.
+FLOAT32_PATH_RTOL = 1e-6
+#: Absolute tolerance for the same comparison, for values near zero.
+FLOAT32_PATH_ATOL = 1e-6
+#: Tolerance for "exact" reproduction of linear attributes (float32 storage of the result).
+LINEAR_REPRODUCTION_ATOL = 2e-6

@@ -1,0 +1,1 @@
+"""Blender operators, one module per capability; thin wrappers over `kernels`."""

@@ -1,0 +1,124 @@
+"""Test tiers and isolation.
+
+Tiers: unmarked kernel tests need numpy only; ``blender`` needs the ``bpy`` module, ``gpu`` a GPU
+context (Mesa llvmpipe is enough), ``opencl`` pyopencl with a platform (PoCL). Outside CI a missing tier
+is skipped with its reason; with ``CI=true`` a missing tier fails and any skip fails the run.
+
+Blender's user folder and every cache go to a temporary folder, set before ``bpy`` is imported.
+The source tree is importable as the package ``tessera`` through a symlink, which is also the dev
+extension repository the ``blender`` tier enables the add-on from.
+"""
+
+import importlib
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CI = os.environ.get("CI", "").strip().lower() in ("1", "true", "yes")
+_TMP = Path(tempfile.mkdtemp(prefix="tessera-tests-"))
+REPO_DIR = _TMP / "repo"  # holds the symlink "tessera" -> source tree
+REPO_DIR.mkdir()
+(REPO_DIR / "tessera").symlink_to(ROOT, target_is_directory=True)
+sys.path.insert(0, str(REPO_DIR))
+os.environ["BLENDER_USER_RESOURCES"] = str(_TMP / "blender_user")
+os.environ["XDG_CACHE_HOME"] = str(_TMP / "cache")
+os.environ["TESSERA_CACHE_DIR"] = str(_TMP / "cache" / "tessera")
+DEV_REPO_MODULE = "tessera_dev"
+ADDON_MODULE = f"bl_ext.{DEV_REPO_MODULE}.tessera"
+
+
+def tier_unavailable(reason):
+    """Skip (locally) or fail (CI) a test whose tier cannot run here."""
+    if CI:
+        pytest.fail(f"CI=true and a test tier is unavailable: {reason}", pytrace=False)
+    pytest.skip(reason)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    if not CI:
+        return
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    skipped = reporter.stats.get("skipped", []) if reporter else []
+    if skipped and session.exitstatus == 0:
+        reporter.write_line(f"CI=true: {len(skipped)} test(s) were skipped; every tier must run in CI", red=True)
+        session.exitstatus = 1
+
+
+@pytest.fixture(scope="session")
+def tmp_root():
+    return _TMP
+
+
+@pytest.fixture(scope="session")
+def bpy_module():
+    try:
+        import bpy
+    except ImportError as err:
+        tier_unavailable(f"the bpy module is not installed ({err})")
+    return bpy
+
+
+@pytest.fixture(scope="session")
+def addon(bpy_module):
+    """The Tessera package as Blender loads it (dev extension repo on the source tree), enabled."""
+    import addon_utils
+
+    prefs = bpy_module.context.preferences
+    if DEV_REPO_MODULE not in {r.module for r in prefs.extensions.repos}:
+        prefs.extensions.repos.new(
+            name=DEV_REPO_MODULE, module=DEV_REPO_MODULE, custom_directory=str(REPO_DIR), source="USER"
+        )
+    mod = addon_utils.enable(ADDON_MODULE, default_set=True, handle_error=None)
+    assert mod is not None, "the add-on failed to enable"
+    yield mod
+    addon_utils.disable(ADDON_MODULE, default_set=True)
+
+
+@pytest.fixture(scope="session")
+def addon_module(addon):
+    """Import a submodule of the enabled add-on: ``addon_module("addon.bridge")``."""
+    return lambda name: importlib.import_module(f"{ADDON_MODULE}.{name}")
+
+
+@pytest.fixture
+def clean_scene(bpy_module, addon):
+    """An empty current scene; removes objects, meshes and materials the test left behind."""
+    bpy = bpy_module
+
+    def wipe():
+        for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.cameras):
+            for item in list(collection):
+                collection.remove(item)
+
+    wipe()
+    yield bpy.context.scene
+    wipe()
+
+
+@pytest.fixture(scope="session")
+def gpu_renderer(addon_module):
+    """Create a GPU context (background mode) and return the renderer string."""
+    errors = addon_module("kernels.errors")
+    try:
+        return addon_module("addon.gpu_context").ensure_gpu_context()
+    except errors.GPUContextError as err:
+        tier_unavailable(str(err))
+
+
+@pytest.fixture(scope="session")
+def opencl():
+    """The OpenCL runtime (PoCL in CI), required."""
+    from tessera.kernels import opencl_runtime
+    from tessera.kernels.errors import OpenCLUnavailableError
+
+    opencl_runtime.configure(mode="require")
+    try:
+        runtime = opencl_runtime.get_runtime()
+    except OpenCLUnavailableError as err:
+        tier_unavailable(str(err))
+    yield runtime
+    opencl_runtime.configure()

@@ -1,0 +1,101 @@
+"""Attribute interpolation and the whole-mesh pipeline (numpy reference)."""
+
+import numpy as np
+import pytest
+from meshes import random_closed, torus
+from tessera.kernels.errors import BudgetError, InvalidInputError
+from tessera.kernels.interpolate import corner_values, face_values, point_values
+from tessera.kernels.mesh_arrays import MeshArrays
+from tessera.kernels.refine import refine
+from tessera.kernels.tessellate import check_budget, estimate, tessellate, uniform_levels
+from tessera.kernels.tolerances import LINEAR_REPRODUCTION_ATOL
+from tessera.kernels.topology import triangle_edges
+
+
+def mesh_with_attributes(seed=0):
+    v, f = random_closed(seed, 6, 5)
+    rng = np.random.default_rng(seed)
+    # A per-face affine UV map: discontinuous across every edge, like UV islands with seams everywhere.
+    uv_maps = rng.normal(size=(len(f), 3, 2))
+    uv_offsets = rng.normal(size=(len(f), 2))
+    uv = np.einsum("tkd,tde->tke", v[f], uv_maps) + uv_offsets[:, None, :]
+    colour_map, colour_offset = rng.normal(size=(3, 4)), rng.normal(size=4)  # affine in position, 4 channels
+    colour = v @ colour_map + colour_offset
+    mesh = MeshArrays(
+        positions=v,
+        triangles=f,
+        corner_normals=np.tile(np.array([0.0, 0.0, 1.0], np.float32), (len(f), 3, 1)),
+        point_attributes={"colour": colour.astype(np.float32)},
+        corner_attributes={"uv": uv.astype(np.float32)},
+        face_attributes={"material_index": (np.arange(len(f)) % 3).astype(np.int32)},
+    )
+    return mesh, uv_maps, uv_offsets, (colour_map, colour_offset)
+
+
+@pytest.mark.parametrize("spacing", ["EQUAL", "FRACTIONAL_EVEN"])
+def test_linear_attributes_are_reproduced_exactly(spacing):
+    mesh, uv_maps, uv_offsets, (colour_map, colour_offset) = mesh_with_attributes()
+    levels = np.random.default_rng(1).uniform(1, 9, len(uv_maps) * 3 // 2)
+    out, ref = tessellate(mesh, levels, spacing=spacing, backend="numpy")
+    pos = out.positions.astype(np.float64)
+    # point attribute: the same affine function of the (float32) output position
+    expected_colour = pos @ colour_map + colour_offset
+    assert np.allclose(out.point_attributes["colour"], expected_colour, atol=LINEAR_REPRODUCTION_ATOL * 10)
+    # corner attribute: each output corner follows the affine map of its own source face
+    corner_pos = pos[out.triangles]
+    expected_uv = np.einsum("mkd,mde->mke", corner_pos, uv_maps[ref.triangle_face]) + uv_offsets[ref.triangle_face][:, None]
+    scale = max(1.0, np.abs(expected_uv).max())
+    assert np.allclose(out.corner_attributes["uv"], expected_uv, atol=LINEAR_REPRODUCTION_ATOL * 10 * scale)
+    # face attribute: copied from the source face
+    assert np.array_equal(out.face_attributes["material_index"], mesh.face_attributes["material_index"][ref.triangle_face])
+
+
+def test_linear_method_keeps_every_vertex_on_its_face():
+    mesh, *_ = mesh_with_attributes(3)
+    out, ref = tessellate(mesh, uniform_levels(mesh, 5), backend="numpy")
+    corners = mesh.positions[mesh.triangles].astype(np.float64)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    offset = np.einsum("mkd,md->mk", out.positions[out.triangles] - corners[ref.triangle_face][:, :1], normal[ref.triangle_face])
+    assert np.abs(offset).max() < 1e-6
+    area_in = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
+    p = out.positions[out.triangles].astype(np.float64)
+    area_out = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
+    assert abs(area_out / area_in - 1) < 1e-6
+
+
+def test_corner_normals_stay_unit():
+    mesh, *_ = mesh_with_attributes(4)
+    rng = np.random.default_rng(2)
+    n = rng.normal(size=(len(mesh.triangles), 3, 3))
+    mesh.corner_normals = (n / np.linalg.norm(n, axis=2, keepdims=True)).astype(np.float32)
+    out, _ = tessellate(mesh, uniform_levels(mesh, 4), backend="numpy")
+    assert np.allclose(np.linalg.norm(out.corner_normals, axis=2), 1.0, atol=1e-6)
+
+
+def test_estimate_matches_the_result():
+    mesh, *_ = mesh_with_attributes(5)
+    levels = uniform_levels(mesh, 6)
+    est = estimate(mesh, levels)
+    out, _ = tessellate(mesh, levels, backend="numpy")
+    assert (est.vertices, est.triangles) == (len(out.positions), len(out.triangles))
+    with pytest.raises(BudgetError, match="over the memory budget"):
+        check_budget(est, est.bytes - 1)
+    check_budget(est, est.bytes)  # at the budget: accepted
+    check_budget(est, 0)  # 0: no limit
+
+
+def test_shape_errors():
+    v, f = torus(5, 4)
+    ref = refine(f, len(v), np.ones(len(triangle_edges(f)[0])))
+    with pytest.raises(Exception, match="rows"):
+        point_values(ref, v[:-1])
+    with pytest.raises(Exception, match="expected"):
+        corner_values(ref, np.zeros((len(f), 2, 2)))
+    with pytest.raises(Exception, match="rows"):
+        face_values(ref, np.zeros(len(f) + 1))
+    bad = MeshArrays(positions=np.full((len(v), 3), np.nan, np.float32), triangles=f)
+    with pytest.raises(InvalidInputError, match="NaN"):
+        tessellate(bad, np.ones(len(triangle_edges(f)[0])))
+    with pytest.raises(InvalidInputError, match="method"):
+        tessellate(MeshArrays(positions=v, triangles=f), np.ones(len(triangle_edges(f)[0])), method="CUBIC")
