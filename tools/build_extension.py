@@ -1,0 +1,99 @@
+"""Build the Tessera extension zips with Blender's own builder, one per platform, wheels bundled.
+
+Steps: validate the source manifest (tags checked against Blender's list); download the wheels of
+pyopencl and its pure-Python needs for each platform, at the versions installed in this venv (the
+ones the tests ran with); stage a copy of the tree whose manifest lists them; build with
+``blender_ext.py build --split-platforms``; validate each zip. numpy is not bundled: Blender ships it.
+
+Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
+"""
+
+import argparse
+import shutil
+import subprocess
+import sys
+import tempfile
+import tomllib
+from importlib import metadata
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+# Blender platform -> pip platform tags for cp311 binary wheels.
+PLATFORMS = {
+    "linux-x64": ["manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux_2_17_x86_64", "manylinux2014_x86_64"],
+    "windows-x64": ["win_amd64"],
+    "macos-arm64": ["macosx_15_0_arm64"],
+    "macos-x64": ["macosx_15_0_x86_64"],
+}
+BINARY = ("pyopencl", "siphash24")
+PURE = ("pytools", "platformdirs", "typing_extensions")
+IGNORE = shutil.ignore_patterns(".git", ".venv", "out", "dist", "wheels", "__pycache__", ".pytest_cache",
+                                ".ruff_cache", ".hypothesis", "*.zip")
+
+
+def blender_ext(*args):
+    """Run Blender's extension CLI (bl_pkg) from the bpy module, so tags are validated too."""
+    code = ("import sys, bpy; from bl_pkg import bl_extension_cli as c; "
+            "sys.exit(c.cli_extension_handler(sys.argv[1:]))")
+    subprocess.run([sys.executable, "-c", code, *args], check=True)
+
+
+def pip_download(spec, dest, platforms=None):
+    cmd = [sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--only-binary=:all:", "-d", str(dest)]
+    if platforms:
+        cmd += ["--python-version", "3.11", "--implementation", "cp"]
+        for tag in platforms:
+            cmd += ["--platform", tag]
+    subprocess.run(cmd + [spec], check=True)
+
+
+def fetch_wheels(dest):
+    """Download every needed wheel into ``dest``; returns the file names, sorted."""
+    dest.mkdir(parents=True, exist_ok=True)
+    for name in PURE:
+        pip_download(f"{name}=={metadata.version(name)}", dest)
+    for platform, tags in PLATFORMS.items():
+        for name in BINARY:
+            try:
+                pip_download(f"{name}=={metadata.version(name)}", dest, tags)
+            except subprocess.CalledProcessError as err:
+                raise SystemExit(f"No {name} wheel for {platform} (cp311); the zip cannot be built") from err
+    return sorted(p.name for p in dest.glob("*.whl"))
+
+
+def stage(wheel_dir, wheels, staging):
+    shutil.copytree(ROOT, staging, ignore=IGNORE, symlinks=False)
+    (staging / "wheels").mkdir()
+    for name in wheels:
+        shutil.copy2(wheel_dir / name, staging / "wheels" / name)
+    manifest = (staging / "blender_manifest.toml").read_text(encoding="utf-8")
+    listing = ",\n".join(f'  "./wheels/{name}"' for name in wheels)
+    platforms = ", ".join(f'"{p}"' for p in PLATFORMS)
+    head, sep, tail = manifest.partition("\n[permissions]")
+    manifest = f"{head}\nplatforms = [{platforms}]\nwheels = [\n{listing},\n]\n{sep}{tail}"
+    (staging / "blender_manifest.toml").write_text(manifest, encoding="utf-8")
+    tomllib.loads(manifest)  # fail here, not in Blender, if the edit broke the TOML
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=ROOT / "dist")
+    parser.add_argument("--wheels", type=Path, default=ROOT / "wheels")
+    args = parser.parse_args(argv)
+    blender_ext("validate", str(ROOT))
+    wheels = fetch_wheels(args.wheels)
+    args.out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="tessera-build-") as tmp:
+        staging = Path(tmp) / "tessera"
+        stage(args.wheels, wheels, staging)
+        blender_ext("build", "--source-dir", str(staging), "--output-dir", str(args.out), "--split-platforms")
+    version = tomllib.loads((ROOT / "blender_manifest.toml").read_text(encoding="utf-8"))["version"]
+    zips = sorted(args.out.glob(f"tessera-{version}-*.zip"))
+    for z in zips:
+        blender_ext("validate", str(z))
+    print("\n".join(str(z) for z in zips))
+    return zips
+
+
+if __name__ == "__main__":
+    main()
