@@ -99,7 +99,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
         for collection in ob.users_collection:
             collection.objects.link(new)
         new.matrix_world = ob.matrix_world.copy()
-        for src_slot, dst_slot in zip(ob.material_slots, new.material_slots):
+        for src_slot, dst_slot in zip(ob.material_slots, new.material_slots, strict=False):
             if src_slot.link == "OBJECT":
                 dst_slot.link = "OBJECT"
                 dst_slot.material = src_slot.material

@@ -17,7 +17,8 @@ import json, sys, bpy, addon_utils
 zip_path = sys.argv[1]
 prefs = bpy.context.preferences
 repo_index = next(i for i, r in enumerate(prefs.extensions.repos) if r.module == "user_default")
-assert bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True) == {"FINISHED"}
+installed = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
+assert installed == {"FINISHED"}
 module = "bl_ext.user_default.tessera"
 enabled = module in prefs.addons
 bpy.ops.mesh.primitive_cube_add()

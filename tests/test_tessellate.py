@@ -43,11 +43,12 @@ def test_linear_attributes_are_reproduced_exactly(spacing):
     assert np.allclose(out.point_attributes["colour"], expected_colour, atol=LINEAR_REPRODUCTION_ATOL * 10)
     # corner attribute: each output corner follows the affine map of its own source face
     corner_pos = pos[out.triangles]
-    expected_uv = np.einsum("mkd,mde->mke", corner_pos, uv_maps[ref.triangle_face]) + uv_offsets[ref.triangle_face][:, None]
+    face = ref.triangle_face
+    expected_uv = np.einsum("mkd,mde->mke", corner_pos, uv_maps[face]) + uv_offsets[face][:, None]
     scale = max(1.0, np.abs(expected_uv).max())
     assert np.allclose(out.corner_attributes["uv"], expected_uv, atol=LINEAR_REPRODUCTION_ATOL * 10 * scale)
     # face attribute: copied from the source face
-    assert np.array_equal(out.face_attributes["material_index"], mesh.face_attributes["material_index"][ref.triangle_face])
+    assert np.array_equal(out.face_attributes["material_index"], mesh.face_attributes["material_index"][face])
 
 
 def test_linear_method_keeps_every_vertex_on_its_face():
@@ -56,7 +57,8 @@ def test_linear_method_keeps_every_vertex_on_its_face():
     corners = mesh.positions[mesh.triangles].astype(np.float64)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    offset = np.einsum("mkd,md->mk", out.positions[out.triangles] - corners[ref.triangle_face][:, :1], normal[ref.triangle_face])
+    face = ref.triangle_face
+    offset = np.einsum("mkd,md->mk", out.positions[out.triangles] - corners[face][:, :1], normal[face])
     assert np.abs(offset).max() < 1e-6
     area_in = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
     p = out.positions[out.triangles].astype(np.float64)
