@@ -52,6 +52,10 @@ class Refinement:
     triangle_face: (M,) int32 source face of each output triangle.
     corner_bary: (M, 3, 3) float64 barycentric coordinates of each output corner in its source face
         (for per-corner attributes such as UVs, which may differ between the faces of a shared vertex).
+    spacing: the spacing used.
+    edge_level, edge_segments: (E,) float64 clamped level and int64 segment count of each edge.
+    inner_level, inner_segments: (T,) float64 and int64, the same for each face's interior.
+    interior_counts: (T,) int64 interior points of each face (they are stored contiguously, face by face).
     """
 
     n_corners: int
@@ -64,6 +68,12 @@ class Refinement:
     triangles: np.ndarray
     triangle_face: np.ndarray
     corner_bary: np.ndarray
+    spacing: str
+    edge_level: np.ndarray
+    edge_segments: np.ndarray
+    inner_level: np.ndarray
+    inner_segments: np.ndarray
+    interior_counts: np.ndarray
 
     @property
     def n_vertices(self):
@@ -178,6 +188,12 @@ def refine(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL
         triangles=vertex_id[tri_rv].astype(np.int32),
         triangle_face=vertex_face[tri_rv[:, 0]].astype(np.int32),
         corner_bary=vertex_bary[tri_rv],
+        spacing=spacing,
+        edge_level=edge_f,
+        edge_segments=edge_n,
+        inner_level=inner_f,
+        inner_segments=inner_n,
+        interior_counts=_interior_counts(inner_n),
     )
 
 

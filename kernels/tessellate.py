@@ -1,21 +1,61 @@
-"""Whole-mesh tessellation: levels -> refinement -> evaluated positions and attributes.
+"""Whole-mesh tessellation: levels -> refinement -> evaluated positions, normals and attributes.
 
-The refinement pattern is shared by every method; a method only decides where the new vertices go.
-``LINEAR`` keeps them on the flat input triangles (the geometry is unchanged; useful as a base for
-displacement, and as the oracle for the GPU path). PN and Phong plug in here as further methods.
+The refinement pattern is shared by every method; a method only decides where the new vertices go:
+
+``LINEAR``
+    On the flat input triangles (the geometry is unchanged; a base for displacement, and an oracle).
+``PHONG``
+    Phong tessellation with shape factor alpha (a constant, or per vertex from a point attribute).
+``PN``
+    PN triangles: cubic Bézier geometry, quadratic (or linear) normals.
+
+Curved methods need one normal per vertex for the geometry; `kernels.normals` explains the two
+hard-edge policies. Attributes (UVs, colours) are interpolated linearly, as in the seeds.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import patches
 from .errors import BudgetError, InvalidInputError
 from .interpolate import corner_values, face_values, normalized, point_values
 from .mesh_arrays import MeshArrays
+from .normals import NORMAL_MODES, shared_vertex_normals, split_by_normals, split_corners
 from .refine import refine, refinement_counts
+from .surface_eval import evaluate_corners, evaluate_surface
 from .topology import triangle_edges, validate_triangles
 
-METHODS = ("LINEAR",)
+METHODS = ("LINEAR", "PHONG", "PN")
+NORMAL_FIELDS = ("QUADRATIC", "LINEAR")
+
+
+@dataclass(frozen=True)
+class SurfaceOptions:
+    """How the curved methods shape the surface.
+
+    alpha: Phong shape factor (0 flat, 1 the seed, 0.75 the paper's default); alpha_attribute: name of a
+    float point attribute holding a per-vertex factor instead (or None); normal_mode: one of
+    `kernels.normals.NORMAL_MODES`; pn_normals: ``QUADRATIC`` (Vlachos's normal patch) or ``LINEAR``.
+    """
+
+    alpha: float = 0.75
+    alpha_attribute: str | None = None
+    normal_mode: str = "WATERTIGHT"
+    pn_normals: str = "QUADRATIC"
+
+
+@dataclass
+class Tessellation:
+    """What `tessellate` returns: the mesh, its refinement, and notes for the user.
+
+    opened_edges: input edges the ``SPLIT`` normal mode cut open (0 in ``WATERTIGHT``).
+    """
+
+    mesh: MeshArrays
+    refinement: object
+    opened_edges: int = 0
+    notes: list = field(default_factory=list)
 
 #: Bytes per output triangle and per output vertex at peak, measured loosely from the arrays the
 #: refinement, the interpolation and Blender's mesh hold at once (documented in README "Memory guard").
@@ -62,32 +102,159 @@ def check_budget(est, budget_bytes):
         )
 
 
+def _check_options(method, options):
+    if method not in METHODS:
+        raise InvalidInputError(f"Unknown tessellation method {method!r}; expected one of {', '.join(METHODS)}")
+    if options.normal_mode not in NORMAL_MODES:
+        raise InvalidInputError(f"Unknown normal mode {options.normal_mode!r}; expected {', '.join(NORMAL_MODES)}")
+    if options.pn_normals not in NORMAL_FIELDS:
+        raise InvalidInputError(f"Unknown PN normal field {options.pn_normals!r}; expected {', '.join(NORMAL_FIELDS)}")
+    if not np.isfinite(options.alpha):
+        raise InvalidInputError("The Phong shape factor must be a finite number")
+
+
+def _split_mesh(mesh, edge_levels):
+    """SPLIT mode: one vertex per distinct corner normal. Returns (mesh', vertex normals, levels', opened)."""
+    tris, source, normals = split_by_normals(mesh.triangles, mesh.corner_normals, len(mesh.positions))
+    old_edges, _, _ = triangle_edges(mesh.triangles)
+    new_edges, _, _ = triangle_edges(tris)
+    n = len(mesh.positions)
+    old_keys = old_edges[:, 0].astype(np.int64) * n + old_edges[:, 1]
+    a, b = source[new_edges[:, 0]], source[new_edges[:, 1]]
+    keys = np.minimum(a, b) * n + np.maximum(a, b)
+    levels = np.asarray(edge_levels, np.float64)[np.searchsorted(old_keys, keys)]
+    split = MeshArrays(
+        positions=mesh.positions[source], triangles=tris, corner_normals=mesh.corner_normals,
+        point_attributes={k: v[source] for k, v in mesh.point_attributes.items()},
+        corner_attributes=mesh.corner_attributes, face_attributes=mesh.face_attributes,
+        attribute_types=mesh.attribute_types,
+    )
+    return split, normals, levels, len(new_edges) - len(old_edges)
+
+
+def _alpha_values(mesh, options):
+    """Per-vertex shape factors (V,) float64, or None for a constant factor."""
+    name = options.alpha_attribute
+    if not name:
+        return None
+    values = mesh.point_attributes.get(name)
+    if values is None or values.ndim != 1:
+        raise InvalidInputError(f"The shape-factor attribute {name!r} must be a float attribute on points")
+    values = np.asarray(values, np.float64)
+    if not np.all(np.isfinite(values)):
+        raise InvalidInputError(f"The shape-factor attribute {name!r} has NaN or infinite values")
+    return values
+
+
+def _edge_data(ref, positions, normals):
+    lo, hi = ref.edges[:, 0], ref.edges[:, 1]
+    return positions[lo], positions[hi], normals[lo], normals[hi]
+
+
+def _phong_positions(ref, positions, normals, alpha):
+    pa, pb, na, nb = _edge_data(ref, positions, normals)
+    p, n = positions[ref.faces], normals[ref.faces]
+    if alpha is None or np.ndim(alpha) == 0:
+        a = 0.75 if alpha is None else float(alpha)
+        return evaluate_surface(ref, positions, patches.phong_edge_control(pa, pb, na, nb, a, a),
+                                patches.quadratic_edge_basis, patches.phong_control(p, n, a), patches.quadratic_basis)
+    linear = point_values(ref, positions, "numpy").astype(np.float64)
+    offset = evaluate_surface(ref, np.zeros_like(positions), patches.phong_edge_offset_control(pa, pb, na, nb),
+                              patches.quadratic_edge_basis, patches.phong_offset_control(p, n), patches.quadratic_basis)
+    factor = point_values(ref, alpha, "numpy").astype(np.float64)
+    out = linear + factor[:, None] * offset
+    out[: ref.n_corners] = positions
+    return out.astype(np.float32)
+
+
+def _pn_positions(ref, positions, normals):
+    pa, pb, na, nb = _edge_data(ref, positions, normals)
+    p, n = positions[ref.faces], normals[ref.faces]
+    return evaluate_surface(ref, positions, patches.pn_edge_control(pa, pb, na, nb), patches.cubic_edge_basis,
+                            patches.pn_control(p, n), patches.cubic_basis)
+
+
+def _normal_field(method, options):
+    """(edge control fn, edge basis, face control fn, face basis) of the shading-normal field."""
+    if method == "PN" and options.pn_normals == "QUADRATIC":
+        return (patches.pn_edge_normal_control, patches.quadratic_edge_basis,
+                patches.pn_normal_control, patches.quadratic_basis)
+    return (lambda pa, pb, na, nb: np.stack([na, nb], axis=1), patches.linear_edge_basis,
+            lambda p, n: np.asarray(n, np.float64), patches.linear_basis)
+
+
+def _shading_normals(ref, method, options, positions, vertex_normals, corner_normals, split):
+    """Unit shading normals: (point normals (n_vertices, 3), corner normals (M, 3, 3) or None)."""
+    edge_fn, edge_basis, face_fn, face_basis = _normal_field(method, options)
+    pa, pb, na, nb = _edge_data(ref, positions, vertex_normals)
+    points = evaluate_surface(ref, vertex_normals, edge_fn(pa, pb, na, nb), edge_basis,
+                              face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis)
+    points = normalized(points)
+    if split is None or not split.any():
+        return points, None
+    corners = points[ref.triangles]
+    faces = np.flatnonzero(split.any(axis=1))
+    own = face_fn(positions[ref.faces[faces]], corner_normals[faces])  # the split faces' own normal fields
+    control = np.zeros((len(ref.faces),) + own.shape[1:])
+    control[faces] = own
+    out_tris = np.flatnonzero(np.isin(ref.triangle_face, faces))
+    corners[out_tris] = normalized(evaluate_corners(ref, out_tris, control, face_basis))
+    return points, corners
+
+
 def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LINEAR", backend="auto",
-               progress=None):
-    """Tessellate a `MeshArrays` and return a new `MeshArrays` (plus the `Refinement`).
+               progress=None, options=None):
+    """Tessellate a `MeshArrays` and return a `Tessellation`.
 
     edge_levels: (E,) float, one per edge of `kernels.topology.triangle_edges`; inner_levels: (T,) float or
     None; spacing: see `kernels.partition`; method: one of `METHODS`; backend: see
-    `kernels.interpolate.gather_weighted`; progress: optional callable ``(fraction)`` for long jobs.
-    Returns ``(MeshArrays, Refinement)``; face attributes of the output are per output triangle.
+    `kernels.interpolate.gather_weighted`; progress: optional callable ``(fraction)``; options:
+    `SurfaceOptions` for PHONG and PN. Face attributes of the output are per output triangle. Curved
+    methods write unit ``point_normals`` (and ``corner_normals`` where the input has split normals).
     """
-    if method not in METHODS:
-        raise InvalidInputError(f"Unknown tessellation method {method!r}; expected one of {', '.join(METHODS)}")
+    options = options or SurfaceOptions()
+    _check_options(method, options)
     mesh.validate()
     report = progress or (lambda fraction: None)
-    ref = refine(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
-    report(0.4)
-    out = MeshArrays(
-        positions=point_values(ref, mesh.positions, backend),
-        triangles=ref.triangles,
-        attribute_types=dict(mesh.attribute_types),
-    )
-    report(0.6)
-    if mesh.corner_normals is not None:
-        out.corner_normals = normalized(corner_values(ref, mesh.corner_normals, backend))
+    result = Tessellation(mesh=None, refinement=None)
+    if method == "LINEAR":
+        ref = refine(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
+        report(0.4)
+        out = MeshArrays(positions=point_values(ref, mesh.positions, backend), triangles=ref.triangles,
+                         attribute_types=dict(mesh.attribute_types))
+        if mesh.corner_normals is not None:
+            out.corner_normals = normalized(corner_values(ref, mesh.corner_normals, backend))
+    else:
+        source, split = mesh, None
+        positions = np.asarray(mesh.positions, np.float64)
+        if options.normal_mode == "SPLIT" and mesh.corner_normals is not None:
+            source, vertex_normals, edge_levels, result.opened_edges = _split_mesh(mesh, edge_levels)
+            positions = np.asarray(source.positions, np.float64)
+            if result.opened_edges:
+                result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
+        else:
+            vertex_normals = shared_vertex_normals(positions, mesh.triangles, mesh.corner_normals)
+            if mesh.corner_normals is not None:
+                split = split_corners(mesh.triangles, mesh.corner_normals, vertex_normals)
+        alpha = _alpha_values(source, options) if method == "PHONG" else None
+        ref = refine(source.triangles, len(source.positions), edge_levels, inner_levels, spacing)
+        report(0.4)
+        if method == "PN":
+            out_positions = _pn_positions(ref, positions, vertex_normals)
+        else:
+            out_positions = _phong_positions(ref, positions, vertex_normals,
+                                             options.alpha if alpha is None else alpha)
+        report(0.6)
+        out = MeshArrays(positions=out_positions, triangles=ref.triangles, attribute_types=dict(mesh.attribute_types))
+        corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
+        out.point_normals, out.corner_normals = _shading_normals(
+            ref, method, options, positions, vertex_normals, corner_normals, split)
+        mesh = source
+    report(0.7)
     out.point_attributes = {k: point_values(ref, v, backend) for k, v in mesh.point_attributes.items()}
-    report(0.8)
+    report(0.85)
     out.corner_attributes = {k: corner_values(ref, v, backend) for k, v in mesh.corner_attributes.items()}
     out.face_attributes = {k: face_values(ref, v) for k, v in mesh.face_attributes.items()}
     report(1.0)
-    return out, ref
+    result.mesh, result.refinement = out, ref
+    return result

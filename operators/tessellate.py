@@ -77,7 +77,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
         progress(0.1)
         levels = uniform_levels(arrays, self.level)
         check_budget(estimate(arrays, levels, spacing=self.spacing), get_preferences(context).memory_budget_bytes)
-        result, _ = tessellate(
+        result = tessellate(
             arrays, levels, spacing=self.spacing, method=self.method, progress=lambda f: progress(0.1 + 0.7 * f)
         )
         mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result, info)

@@ -20,7 +20,7 @@ def test_linear_tessellation_renders_like_the_original(gpu_renderer, addon_modul
     render = addon_module("gpu_shaders.offscreen").render_triangles
     bpy.ops.mesh.primitive_monkey_add()
     arrays, _ = bridge.read_mesh(bpy.context.active_object.data)
-    out, _ = tess.tessellate(arrays, tess.uniform_levels(arrays, 5), backend="numpy")
+    out = tess.tessellate(arrays, tess.uniform_levels(arrays, 5), backend="numpy").mesh
     rng = np.random.default_rng(5)
     for _ in range(3):
         direction = rng.normal(size=3)

@@ -36,7 +36,8 @@ def mesh_with_attributes(seed=0):
 def test_linear_attributes_are_reproduced_exactly(spacing):
     mesh, uv_maps, uv_offsets, (colour_map, colour_offset) = mesh_with_attributes()
     levels = np.random.default_rng(1).uniform(1, 9, len(uv_maps) * 3 // 2)
-    out, ref = tessellate(mesh, levels, spacing=spacing, backend="numpy")
+    result = tessellate(mesh, levels, spacing=spacing, backend="numpy")
+    out, ref = result.mesh, result.refinement
     pos = out.positions.astype(np.float64)
     # point attribute: the same affine function of the (float32) output position
     expected_colour = pos @ colour_map + colour_offset
@@ -53,7 +54,8 @@ def test_linear_attributes_are_reproduced_exactly(spacing):
 
 def test_linear_method_keeps_every_vertex_on_its_face():
     mesh, *_ = mesh_with_attributes(3)
-    out, ref = tessellate(mesh, uniform_levels(mesh, 5), backend="numpy")
+    result = tessellate(mesh, uniform_levels(mesh, 5), backend="numpy")
+    out, ref = result.mesh, result.refinement
     corners = mesh.positions[mesh.triangles].astype(np.float64)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
@@ -71,7 +73,7 @@ def test_corner_normals_stay_unit():
     rng = np.random.default_rng(2)
     n = rng.normal(size=(len(mesh.triangles), 3, 3))
     mesh.corner_normals = (n / np.linalg.norm(n, axis=2, keepdims=True)).astype(np.float32)
-    out, _ = tessellate(mesh, uniform_levels(mesh, 4), backend="numpy")
+    out = tessellate(mesh, uniform_levels(mesh, 4), backend="numpy").mesh
     assert np.allclose(np.linalg.norm(out.corner_normals, axis=2), 1.0, atol=1e-6)
 
 
@@ -79,7 +81,7 @@ def test_estimate_matches_the_result():
     mesh, *_ = mesh_with_attributes(5)
     levels = uniform_levels(mesh, 6)
     est = estimate(mesh, levels)
-    out, _ = tessellate(mesh, levels, backend="numpy")
+    out = tessellate(mesh, levels, backend="numpy").mesh
     assert (est.vertices, est.triangles) == (len(out.positions), len(out.triangles))
     with pytest.raises(BudgetError, match="over the memory budget"):
         check_budget(est, est.bytes - 1)

@@ -1,0 +1,99 @@
+"""Evaluate a patch surface (any polynomial basis) at every vertex of a `Refinement`.
+
+Output vertices come in three groups (see `kernels.refine`): input corners (copied), edge points
+(evaluated once per mesh edge from that edge's own control, in the canonical direction, so shared
+edges are bit-identical from both sides) and interior points (evaluated from their face's control).
+
+Points of the same *class* (edges with the same segment count and level, faces with the same inner
+level) sit at the same parameters, so a class is evaluated as one matrix product
+``basis (P, K) @ control (K, owners * C)``. When there are too many classes for that to pay (random
+adaptive levels), points are evaluated one by one in chunks. Both give the same values up to the
+summation order of float64 products (checked in the tests).
+"""
+
+import numpy as np
+
+from .topology import ragged
+
+#: Use per-class matrix products when there are at most this many classes, or few per owner.
+MAX_CLASSES = 256
+#: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
+CHUNK = 1 << 16
+
+
+def _class_path(n_classes, n_owners):
+    return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
+
+
+def _evaluate_group(out, first, counts, keys, params, control, basis):
+    """Evaluate points owned by rows of ``control``; writes ``out[first + ...]``.
+
+    counts: (K,) points per owner, stored contiguously in owner order from ``first``; keys: (K,) class
+    of each owner (same key -> same parameters); params: (N, ...) parameter of each point;
+    control: (K, k, C); basis: callable ``params (P, ...) -> (P, k)``.
+    """
+    n = int(counts.sum())
+    if n == 0:
+        return
+    starts = np.cumsum(counts) - counts
+    uniq, inverse = np.unique(keys, return_inverse=True)
+    channels = control.shape[2]
+    if _class_path(len(uniq), len(counts)):
+        for c in range(len(uniq)):
+            owners = np.flatnonzero(inverse == c)
+            p = int(counts[owners[0]])
+            if p == 0:
+                continue
+            s = int(starts[owners[0]])
+            b = basis(params[s : s + p])  # (p, k)
+            ctrl = np.ascontiguousarray(control[owners].transpose(1, 0, 2)).reshape(b.shape[1], -1)
+            vals = (b @ ctrl).reshape(p, len(owners), channels).transpose(1, 0, 2)  # (owners, p, C)
+            if owners[-1] - owners[0] + 1 == len(owners):  # consecutive owners: one contiguous block
+                lo = first + int(starts[owners[0]])
+                out[lo : lo + len(owners) * p] = vals.reshape(-1, channels)
+            else:
+                rows = first + starts[owners][:, None] + np.arange(p)
+                out[rows.ravel()] = vals.reshape(-1, channels)
+        return
+    owner, _, _ = ragged(counts)
+    for lo in range(0, n, CHUNK):
+        hi = min(n, lo + CHUNK)
+        b = basis(params[lo:hi])
+        out[first + lo : first + hi] = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
+
+
+def _edge_keys(ref):
+    return ref.edge_level if ref.spacing != "EQUAL" else ref.edge_segments.astype(np.float64)
+
+
+def _inner_keys(ref):
+    return ref.inner_level if ref.spacing != "EQUAL" else ref.inner_segments.astype(np.float64)
+
+
+def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control, face_basis):
+    """Values of a patch surface at every output vertex.
+
+    corner_values: (V, C) values at the input vertices (the patches interpolate them);
+    edge_control: (E, ke, C) per mesh edge, for the direction ``edges[e, 0] -> edges[e, 1]``;
+    edge_basis: ``t (P,) -> (P, ke)``; face_control: (T, kf, C); face_basis: ``bary (P, 3) -> (P, kf)``.
+    Returns (n_vertices, C) float32 (evaluated in float64, rounded once).
+    """
+    channels = face_control.shape[2]
+    out = np.empty((ref.n_vertices, channels), dtype=np.float32)
+    out[: ref.n_corners] = corner_values
+    _evaluate_group(out, ref.n_corners, np.maximum(ref.edge_segments - 1, 0), _edge_keys(ref),
+                    ref.edge_point_t, edge_control, edge_basis)
+    _evaluate_group(out, ref.n_corners + len(ref.edge_point_edge), ref.interior_counts, _inner_keys(ref),
+                    ref.interior_bary, face_control, face_basis)
+    return out
+
+
+def evaluate_corners(ref, triangles, face_control, face_basis):
+    """A face field at the corners of some output triangles: (m,) ids -> (m, 3, C) float64.
+
+    Uses ``ref.corner_bary``; for fields that differ between the faces of a shared vertex (split normals).
+    """
+    faces = ref.triangle_face[triangles]
+    bary = ref.corner_bary[triangles].reshape(-1, 3)
+    b = face_basis(bary).reshape(len(triangles), 3, -1)
+    return np.einsum("mck,mkd->mcd", b, face_control[faces])
