@@ -8,8 +8,10 @@ import importlib
 
 _modules = (
     "addon.preferences",
+    "addon.settings",
     "operators.tessellate",
     "addon.menus",
+    "addon.panels",
 )
 
 

@@ -107,21 +107,24 @@ def _new_attribute(mesh, name, dtype, domain):
     return attr
 
 
-def _set_custom_normals(mesh, normals):
-    """Corner normals (L, 3) float32 as custom normals, with the fastest API this Blender has."""
+def _set_custom_normals(mesh, normals, domain="CORNER"):
+    """Corner (L, 3) or point (V, 3) float32 normals as custom normals, with the fastest API this Blender has."""
+    normals = np.ascontiguousarray(normals, dtype=np.float32)
     if bpy.app.version >= (5, 0, 0):
-        attr = _new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", "CORNER")
-        attr.data.foreach_set("vector", np.ascontiguousarray(normals, dtype=np.float32).ravel())
+        attr = _new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", domain)
+        attr.data.foreach_set("vector", normals.ravel())
+    elif domain == "POINT":
+        mesh.normals_split_custom_set_from_vertices(normals)
     else:
-        mesh.normals_split_custom_set(np.ascontiguousarray(normals, dtype=np.float32))
+        mesh.normals_split_custom_set(normals)
 
 
 def write_mesh(name, arrays, info=None):
     """Create a new `bpy.types.Mesh` from triangle `MeshArrays` and return it.
 
     Writes positions, triangles, point / corner / face attributes with the data types recorded in
-    ``arrays.attribute_types``, and corner normals as custom normals. If anything fails the half-built
-    mesh is removed before the error propagates.
+    ``arrays.attribute_types``, and corner (or else point) normals as custom normals. If anything fails the
+    half-built mesh is removed before the error propagates.
     """
     positions = np.ascontiguousarray(arrays.positions, dtype=np.float32)
     tris = np.ascontiguousarray(arrays.triangles, dtype=np.int32)
@@ -149,6 +152,8 @@ def write_mesh(name, arrays, info=None):
                 attr.data.foreach_set(prop, np.ascontiguousarray(values, dtype=np_type).ravel())
         if arrays.corner_normals is not None:
             _set_custom_normals(mesh, arrays.corner_normals.reshape(-1, 3))
+        elif arrays.point_normals is not None:
+            _set_custom_normals(mesh, arrays.point_normals, "POINT")
         if info is not None:
             _restore_active(mesh, info)
         mesh.update()

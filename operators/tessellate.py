@@ -1,39 +1,42 @@
-"""``tessera.tessellate``: tessellate the active mesh object into a new object or in place."""
+"""``tessera.tessellate``: PN, Phong or linear tessellation of the active mesh, uniform or adaptive levels."""
 
 import bpy
+import numpy as np
 
 from ..addon import bridge
+from ..addon.cameras import camera_for
 from ..addon.preferences import get_preferences
+from ..addon.settings import (
+    adaptive_settings,
+    copy_settings,
+    draw_settings,
+    needs_camera,
+    setting_annotations,
+    surface_options,
+)
+from ..kernels.adaptive import adaptive_levels
 from ..kernels.errors import TesseraError
-from ..kernels.partition import MAX_LEVEL
 from ..kernels.tessellate import check_budget, estimate, tessellate, uniform_levels
 
-_METHODS = (("LINEAR", "Linear", "New vertices on the flat triangles: same shape, more vertices"),)
-_SPACINGS = (
-    ("EQUAL", "Equal", "Level rounded up to a whole number of equal segments"),
-    ("FRACTIONAL_EVEN", "Fractional Even", "Even segment counts; vertices slide continuously as the level changes"),
-)
-_OUTPUTS = (
-    ("NEW_OBJECT", "New Object", "Create a new object beside the source (from the evaluated mesh, with modifiers)"),
-    ("REPLACE", "Replace Mesh", "Replace the object's own mesh data (modifiers stay and apply on top)"),
-)
+
+def _world_positions(positions, matrix):
+    m = np.array(matrix, dtype=np.float64)
+    return positions @ m[:3, :3].T + m[:3, 3]
 
 
 class TESSERA_OT_tessellate(bpy.types.Operator):
-    """Tessellate the active mesh with the hardware tessellator's refinement pattern"""
+    """Tessellate the active mesh: PN triangles, Phong or linear, with uniform or adaptive crack-free levels"""
 
     bl_idname = "tessera.tessellate"
     bl_label = "Tessellate"
     bl_options = {"REGISTER", "UNDO"}
 
-    method: bpy.props.EnumProperty(name="Method", items=_METHODS, default="LINEAR")
-    level: bpy.props.FloatProperty(
-        name="Level",
-        description="Segments per edge (and inner level) for every triangle",
-        default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2,
-    )
-    spacing: bpy.props.EnumProperty(name="Spacing", items=_SPACINGS, default="EQUAL")
-    output: bpy.props.EnumProperty(name="Output", items=_OUTPUTS, default="NEW_OBJECT")
+    __annotations__ = {
+        **setting_annotations(),
+        "use_object_settings": bpy.props.BoolProperty(
+            name="Use Object Settings", description="Take every setting from the object (Object > Tessera panel)",
+            default=False, options={"SKIP_SAVE"}),
+    }
 
     @classmethod
     def poll(cls, context):
@@ -46,12 +49,23 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             return False
         return True
 
+    def invoke(self, context, event):
+        stored = context.active_object.tessera.tessellate
+        if stored.stored and not self.use_object_settings:
+            copy_settings(stored, self)  # start from what was used last time on this object
+        return self.execute(context)
+
+    def draw(self, context):
+        draw_settings(self.layout, self)
+
     def execute(self, context):
         ob = context.active_object
+        if self.use_object_settings:
+            copy_settings(ob.tessera.tessellate, self)
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            new_mesh, skipped = self._build_mesh(context, ob, lambda f: wm.progress_update(int(100 * f)))
+            new_mesh, skipped, notes = self._build_mesh(context, ob, lambda f: wm.progress_update(int(100 * f)))
         except TesseraError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
@@ -59,11 +73,23 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             wm.progress_end()
         if skipped:
             self.report({"INFO"}, f"Not carried over (no interpolation for these types): {', '.join(skipped)}")
-        self._place(context, ob, new_mesh)
+        for note in notes:
+            self.report({"WARNING"}, note)
+        target = self._place(context, ob, new_mesh)
+        for holder in {ob, target}:
+            copy_settings(self, holder.tessera.tessellate)
+            holder.tessera.tessellate.stored = True
         return {"FINISHED"}
 
+    def _levels(self, context, ob, arrays):
+        if self.level_mode == "UNIFORM":
+            return uniform_levels(arrays, self.level), None
+        camera = camera_for(context, self.camera_source) if needs_camera(self) else None
+        world = _world_positions(arrays.positions.astype(np.float64), ob.matrix_world)
+        return adaptive_levels(world, arrays.triangles, adaptive_settings(self), camera, arrays.corner_normals)
+
     def _build_mesh(self, context, ob, progress):
-        """Read, tessellate and write; returns ``(mesh, skipped)``. Creates nothing on failure."""
+        """Read, tessellate and write; returns ``(mesh, skipped, notes)``. Creates nothing on failure."""
         if self.output == "NEW_OBJECT":
             evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
             source = evaluated.to_mesh()
@@ -75,18 +101,21 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             if evaluated is not None:
                 evaluated.to_mesh_clear()
         progress(0.1)
-        levels = uniform_levels(arrays, self.level)
-        check_budget(estimate(arrays, levels, spacing=self.spacing), get_preferences(context).memory_budget_bytes)
+        edge_levels, inner_levels = self._levels(context, ob, arrays)
+        budget = get_preferences(context).memory_budget_bytes
+        check_budget(estimate(arrays, edge_levels, inner_levels, spacing=self.spacing), budget)
         result = tessellate(
-            arrays, levels, spacing=self.spacing, method=self.method, progress=lambda f: progress(0.1 + 0.7 * f)
+            arrays, edge_levels, inner_levels, spacing=self.spacing, method=self.method,
+            options=surface_options(self), progress=lambda f: progress(0.1 + 0.7 * f),
         )
-        mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result, info)
+        mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result.mesh, info)
         for material in ob.data.materials:
             mesh.materials.append(material)
         progress(1.0)
-        return mesh, info.skipped
+        return mesh, info.skipped, result.notes
 
     def _place(self, context, ob, mesh):
+        """Put the new mesh in the scene; returns the object that holds it."""
         if self.output == "REPLACE":
             old = ob.data
             ob.data = mesh
@@ -94,7 +123,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
                 old_name = old.name
                 bpy.data.meshes.remove(old)
                 mesh.name = old_name
-            return
+            return ob
         new = bpy.data.objects.new(f"{ob.name}.tessellated", mesh)
         for collection in ob.users_collection:
             collection.objects.link(new)
@@ -107,6 +136,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             other.select_set(False)
         new.select_set(True)
         context.view_layer.objects.active = new
+        return new
 
 
 classes = (TESSERA_OT_tessellate,)

@@ -54,7 +54,7 @@ def test_linear_tessellation_keeps_shape_and_shading(clean_scene, bpy_module):
     bpy = bpy_module
     ob = add_suzanne(bpy)
     bpy.ops.object.shade_smooth()
-    bpy.ops.tessera.tessellate(level=3)
+    bpy.ops.tessera.tessellate(method="LINEAR", level=3)
     new = bpy.context.active_object
     src, dst = ob.data, new.data
     src_pos = np.array([v.co for v in src.vertices])
