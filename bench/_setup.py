@@ -1,13 +1,35 @@
-"""Make the source tree importable as the package ``tessera`` (a symlink in a temporary folder)."""
+"""Make the source tree importable as the package ``tessera`` (a symlink in a temporary folder), and
+enable it in Blender the way an installed extension is (a local extension repository on that folder)."""
 
+import os
 import sys
 import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+_FOLDER = None
 
 
 def import_path():
-    folder = Path(tempfile.mkdtemp(prefix="tessera-bench-"))
-    (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(folder))
+    global _FOLDER
+    if _FOLDER is None:
+        _FOLDER = Path(tempfile.mkdtemp(prefix="tessera-bench-"))
+        (_FOLDER / "tessera").symlink_to(ROOT, target_is_directory=True)
+        sys.path.insert(0, str(_FOLDER))
+        os.environ.setdefault("BLENDER_USER_RESOURCES", str(_FOLDER / "blender_user"))
+    return _FOLDER
+
+
+def enable_extension():
+    """Enable Tessera in the bpy module; returns the add-on's package name (``bl_ext.tessera_bench.tessera``)."""
+    folder = import_path()
+    import addon_utils
+    import bpy
+
+    repos = bpy.context.preferences.extensions.repos
+    if "tessera_bench" not in {r.module for r in repos}:
+        repos.new(name="tessera_bench", module="tessera_bench", custom_directory=str(folder), source="USER")
+    name = "bl_ext.tessera_bench.tessera"
+    if addon_utils.enable(name, default_set=True, handle_error=None) is None:
+        raise RuntimeError("Tessera failed to enable")
+    return name

@@ -97,10 +97,37 @@ def corner_values(ref, values, backend="auto"):
     n_faces = len(ref.faces)
     if values.shape[:2] != (n_faces, 3):
         raise TesseraError(f"Corner attribute has shape {values.shape}; expected ({n_faces}, 3, ...)")
+    if ref.face_class is not None and backend != "opencl":
+        return _corner_values_by_class(ref, values)
     flat = values.reshape(n_faces * 3, -1)
     source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)  # (M, 3) source corners
     idx = np.repeat(source, 3, axis=0)  # one row per output corner
     out = gather_weighted(flat, idx, ref.corner_bary.reshape(-1, 3), backend)
+    return out.reshape((len(ref.triangles), 3) + values.shape[2:])
+
+
+def _corner_values_by_class(ref, values):
+    """`corner_values` for a refinement built per pattern class: one matrix product per class."""
+    n_faces = len(ref.faces)
+    flat = values.reshape(n_faces, 3, -1).astype(np.float64)
+    channels = flat.shape[2]
+    counts = np.bincount(ref.triangle_face, minlength=n_faces)
+    starts = np.cumsum(counts) - counts
+    out = np.empty((len(ref.triangles) * 3, channels), dtype=np.float32)
+    order = np.argsort(ref.face_class, kind="stable")
+    groups = np.split(order, np.cumsum(np.bincount(ref.face_class, minlength=len(ref.class_corner_bary)))[:-1])
+    for template, faces in zip(ref.class_corner_bary, groups, strict=True):
+        if len(faces) == 0:
+            continue
+        weights = template.reshape(-1, 3)  # (Mt * 3, 3)
+        k = len(weights)
+        vals = (weights @ flat[faces].transpose(1, 0, 2).reshape(3, -1)).reshape(k, len(faces), channels)
+        rows = (3 * starts[faces][:, None] + np.arange(k)).ravel()
+        if faces[-1] - faces[0] + 1 == len(faces):
+            lo = int(rows[0])
+            out[lo : lo + len(rows)].reshape(len(faces), k, channels)[...] = vals.transpose(1, 0, 2)
+        else:
+            out[rows] = vals.transpose(1, 0, 2).reshape(-1, channels)
     return out.reshape((len(ref.triangles), 3) + values.shape[2:])
 
 
@@ -113,7 +140,12 @@ def face_values(ref, values):
 
 
 def normalized(vectors):
-    """Unit vectors along the last axis; zero vectors stay zero. (..., 3) -> (..., 3) float32."""
-    v = np.asarray(vectors, dtype=np.float64)
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.divide(v, length, out=np.zeros_like(v), where=length > 0).astype(np.float32)
+    """Unit vectors along the last axis; zero vectors stay zero. (..., 3) -> (..., 3) float32.
+
+    float32 input is normalised in float32 (within 2 ulp of unit length); anything else in float64.
+    """
+    v = np.asarray(vectors)
+    if v.dtype != np.float32:
+        v = v.astype(np.float64)
+    length = np.sqrt(np.einsum("...i,...i->...", v, v))[..., None]
+    return np.divide(v, length, out=np.zeros_like(v), where=length > 0).astype(np.float32, copy=False)

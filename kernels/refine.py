@@ -26,10 +26,11 @@ OpenGL terms, local edge 0 (v0-v1) is ``gl_TessLevelOuter[2]``, edge 1 (v1-v2) i
 (v2-v0) is ``[1]``.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import refine_templates
 from .errors import InvalidInputError
 from .partition import clamp_levels, point_params, segment_counts
 from .topology import ragged, triangle_edges, validate_triangles
@@ -63,21 +64,48 @@ class Refinement:
     edges: np.ndarray
     edge_point_edge: np.ndarray
     edge_point_t: np.ndarray
-    interior_face: np.ndarray
-    interior_bary: np.ndarray
     triangles: np.ndarray
     triangle_face: np.ndarray
-    corner_bary: np.ndarray
     spacing: str
     edge_level: np.ndarray
     edge_segments: np.ndarray
     inner_level: np.ndarray
     inner_segments: np.ndarray
     interior_counts: np.ndarray
+    #: ``interior_face``, ``interior_bary``, ``corner_bary``: arrays, or callables that build them on first use.
+    lazy: dict = field(default_factory=dict, repr=False, compare=False)
+    #: Class of each face, and the interior and corner barycentrics of each class (set when built per class).
+    face_class: np.ndarray | None = None
+    class_interior_bary: tuple = ()
+    class_corner_bary: tuple = ()
+
+    def _get(self, name):
+        value = self.lazy[name]
+        if callable(value):
+            value = self.lazy[name] = value()
+        return value
+
+    @property
+    def interior_face(self):
+        return self._get("interior_face")
+
+    @property
+    def interior_bary(self):
+        return self._get("interior_bary")
+
+    @property
+    def corner_bary(self):
+        return self._get("corner_bary")
 
     @property
     def n_vertices(self):
-        return self.n_corners + len(self.edge_point_edge) + len(self.interior_face)
+        return self.n_corners + len(self.edge_point_edge) + int(self.interior_counts.sum())
+
+    def interior_template(self, face, start):
+        """Barycentrics (P, 3) of the interior points of ``face``, stored from offset ``start``."""
+        if self.face_class is not None:
+            return self.class_interior_bary[self.face_class[face]]
+        return self.interior_bary[start : start + int(self.interior_counts[face])]
 
 
 def _interior_counts(m):
@@ -155,6 +183,16 @@ def refine(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL
     tris = validate_triangles(triangles, n_vertices)
     edges, face_edges, flipped = triangle_edges(tris)
     edge_f, edge_n, inner_f, inner_n = _face_levels(face_edges, len(edges), edge_levels, inner_levels, spacing)
+    levels = (edge_f, edge_n, inner_f, inner_n)
+    classes = refine_templates.pattern_classes(edge_f[face_edges], edge_n[face_edges], inner_f, inner_n, spacing)
+    if refine_templates.worth_it(classes, len(tris)):
+        return refine_templates.refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing)
+    return _refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacing)
+
+
+def _refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
+    """The vectorised construction for any mix of levels (every face's rings and zipper at once)."""
+    edge_f, edge_n, inner_f, inner_n = levels
     outer_n = edge_n[face_edges]  # (T, 3) segments of each local edge
 
     # Edge points, once per edge, in canonical direction: edge e owns ids [edge_first[e], + n_e - 1).
@@ -183,17 +221,16 @@ def refine(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL
         edges=edges,
         edge_point_edge=point_edge.astype(np.int32),
         edge_point_t=edge_point_t,
-        interior_face=vertex_face[interior].astype(np.int32),
-        interior_bary=vertex_bary[interior],
         triangles=vertex_id[tri_rv].astype(np.int32),
         triangle_face=vertex_face[tri_rv[:, 0]].astype(np.int32),
-        corner_bary=vertex_bary[tri_rv],
         spacing=spacing,
         edge_level=edge_f,
         edge_segments=edge_n,
         inner_level=inner_f,
         inner_segments=inner_n,
         interior_counts=_interior_counts(inner_n),
+        lazy={"interior_face": vertex_face[interior].astype(np.int32), "interior_bary": vertex_bary[interior],
+              "corner_bary": vertex_bary[tri_rv]},
     )
 
 

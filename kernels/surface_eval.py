@@ -25,37 +25,42 @@ def _class_path(n_classes, n_owners):
     return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
 
 
-def _evaluate_group(out, first, counts, keys, params, control, basis):
+def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis):
     """Evaluate points owned by rows of ``control``; writes ``out[first + ...]``.
 
     counts: (K,) points per owner, stored contiguously in owner order from ``first``; keys: (K,) class
-    of each owner (same key -> same parameters); params: (N, ...) parameter of each point;
+    of each owner (same key -> same parameters); template_of: ``(owner, start) -> (P, ...)`` parameters
+    of one owner's points; all_params: ``() -> (N, ...)`` every point's parameters (the point path);
     control: (K, k, C); basis: callable ``params (P, ...) -> (P, k)``.
     """
     n = int(counts.sum())
     if n == 0:
         return
     starts = np.cumsum(counts) - counts
-    uniq, inverse = np.unique(keys, return_inverse=True)
+    if keys.min() == keys.max():
+        uniq, inverse = keys[:1], np.zeros(len(keys), np.int64)
+    else:
+        uniq, inverse = np.unique(keys, return_inverse=True)
     channels = control.shape[2]
     if _class_path(len(uniq), len(counts)):
-        for c in range(len(uniq)):
-            owners = np.flatnonzero(inverse == c)
+        order = np.argsort(inverse, kind="stable")
+        groups = np.split(order, np.cumsum(np.bincount(inverse, minlength=len(uniq)))[:-1])
+        for owners in groups:
             p = int(counts[owners[0]])
             if p == 0:
                 continue
-            s = int(starts[owners[0]])
-            b = basis(params[s : s + p])  # (p, k)
+            b = basis(template_of(owners[0], int(starts[owners[0]])))  # (p, k)
             ctrl = np.ascontiguousarray(control[owners].transpose(1, 0, 2)).reshape(b.shape[1], -1)
-            vals = (b @ ctrl).reshape(p, len(owners), channels).transpose(1, 0, 2)  # (owners, p, C)
+            vals = (b @ ctrl).reshape(p, len(owners), channels).transpose(1, 0, 2)  # (owners, p, C) view
             if owners[-1] - owners[0] + 1 == len(owners):  # consecutive owners: one contiguous block
                 lo = first + int(starts[owners[0]])
-                out[lo : lo + len(owners) * p] = vals.reshape(-1, channels)
+                out[lo : lo + len(owners) * p].reshape(len(owners), p, channels)[...] = vals
             else:
                 rows = first + starts[owners][:, None] + np.arange(p)
                 out[rows.ravel()] = vals.reshape(-1, channels)
         return
     owner, _, _ = ragged(counts)
+    params = all_params()
     for lo in range(0, n, CHUNK):
         hi = min(n, lo + CHUNK)
         b = basis(params[lo:hi])
@@ -81,10 +86,12 @@ def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control,
     channels = face_control.shape[2]
     out = np.empty((ref.n_vertices, channels), dtype=np.float32)
     out[: ref.n_corners] = corner_values
-    _evaluate_group(out, ref.n_corners, np.maximum(ref.edge_segments - 1, 0), _edge_keys(ref),
-                    ref.edge_point_t, edge_control, edge_basis)
+    edge_counts = np.maximum(ref.edge_segments - 1, 0)
+    _evaluate_group(out, ref.n_corners, edge_counts, _edge_keys(ref),
+                    lambda e, start: ref.edge_point_t[start : start + int(edge_counts[e])],
+                    lambda: ref.edge_point_t, edge_control, edge_basis)
     _evaluate_group(out, ref.n_corners + len(ref.edge_point_edge), ref.interior_counts, _inner_keys(ref),
-                    ref.interior_bary, face_control, face_basis)
+                    ref.interior_template, lambda: ref.interior_bary, face_control, face_basis)
     return out
 
 

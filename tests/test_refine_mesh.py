@@ -119,3 +119,25 @@ def test_deterministic_bytes():
 def test_bad_input_is_a_clear_error(tris, n_vertices, levels, match):
     with pytest.raises(InvalidInputError, match=match):
         refine(tris, n_vertices, levels)
+
+
+@pytest.mark.parametrize("spacing", ["EQUAL", "FRACTIONAL_EVEN"])
+@pytest.mark.parametrize("levels", ["uniform", "pow2", "random"])
+def test_class_path_equals_general_path(spacing, levels, monkeypatch):
+    from tessera.kernels import refine_templates
+
+    v, f = random_closed(7, 6, 5)
+    edges, _, _ = triangle_edges(f)
+    rng = np.random.default_rng(2)
+    lv = {"uniform": np.full(len(edges), 5.5), "pow2": 2.0 ** rng.integers(0, 4, len(edges)),
+          "random": rng.uniform(1, 9, len(edges))}[levels]
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: True)
+    by_class = refine(f, len(v), lv, spacing=spacing)
+    assert by_class.face_class is not None
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
+    general = refine(f, len(v), lv, spacing=spacing)
+    assert general.face_class is None
+    for name in ("triangles", "triangle_face", "edge_point_t", "interior_face", "interior_counts"):
+        assert np.array_equal(getattr(by_class, name), getattr(general, name)), name
+    np.testing.assert_allclose(by_class.interior_bary, general.interior_bary, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(by_class.corner_bary, general.corner_bary, rtol=0, atol=1e-15)

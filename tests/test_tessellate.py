@@ -103,3 +103,20 @@ def test_shape_errors():
         tessellate(bad, np.ones(len(triangle_edges(f)[0])))
     with pytest.raises(InvalidInputError, match="method"):
         tessellate(MeshArrays(positions=v, triangles=f), np.ones(len(triangle_edges(f)[0])), method="CUBIC")
+
+
+def test_corner_values_by_class_equal_the_gather(monkeypatch):
+    from tessera.kernels import refine_templates
+
+    mesh, *_ = mesh_with_attributes(2)
+    levels = np.full(len(triangle_edges(mesh.triangles)[0]), 4.0)
+    levels[::3] = 2.0  # a few classes, faces of a class not consecutive
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: True)
+    ref = refine(mesh.triangles, len(mesh.positions), levels)
+    assert ref.face_class is not None and len(ref.class_corner_bary) > 1
+    by_class = corner_values(ref, mesh.corner_attributes["uv"], backend="numpy")
+    flat = mesh.corner_attributes["uv"].reshape(-1, 2)
+    source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)
+    from tessera.kernels.interpolate import gather_weighted_numpy
+    gathered = gather_weighted_numpy(flat, np.repeat(source, 3, axis=0), ref.corner_bary.reshape(-1, 3))
+    np.testing.assert_allclose(by_class.reshape(-1, 2), gathered, rtol=1e-6, atol=1e-6)

@@ -1,0 +1,138 @@
+"""Refinement by pattern class: build each distinct triangle pattern once, then stamp it onto its faces.
+
+A face's refined topology depends only on its three local segment counts and its inner segment count
+(plus, with fractional spacing, the levels themselves, which move the points). Uniform levels, and
+adaptive levels rounded to powers of two, leave few such classes. For each class the general
+construction of `kernels.refine` runs on one lone triangle; its output triangles, written in "slots"
+(corner, point ``j`` of local edge ``e``, interior point ``i``), are mapped to each face's real vertex
+ids with one gather. Vertex numbering, triangle order and barycentrics are those of the general path
+(the tests compare both bit for bit for the topology).
+"""
+
+import numpy as np
+
+from . import refine as core
+from .partition import point_params
+from .topology import ragged
+
+#: Use the class path when there are at most this many classes, or at least this many faces per class.
+MAX_CLASSES = 64
+FACES_PER_CLASS = 64
+
+
+def pattern_classes(outer_f, outer_n, inner_f, inner_n, spacing):
+    """Group faces by refinement pattern.
+
+    outer_f, outer_n: (T, 3) level and segment count of each local edge; inner_f, inner_n: (T,).
+    Returns ``(first (C,) int64 a face of each class, inverse (T,) int64 class of each face)``.
+    """
+    counts = outer_n.astype(np.int64)
+    key = ((counts[:, 0] * 65 + counts[:, 1]) * 65 + counts[:, 2]) * 65 + inner_n.astype(np.int64)
+    if spacing == "EQUAL":
+        if key.min() == key.max():
+            return np.zeros(1, np.int64), np.zeros(len(key), np.int64)
+        _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+        return first, inverse.reshape(-1)
+    rows = np.column_stack([key.astype(np.float64), outer_f, inner_f])
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    return first, inverse.reshape(-1)
+
+
+def worth_it(classes, n_faces):
+    n = len(classes[0])
+    return n <= MAX_CLASSES or n * FACES_PER_CLASS <= n_faces
+
+
+def _lone_pattern(outer_f, outer_n, inner_f, inner_n, spacing):
+    """The general construction on the triangle (0, 1, 2) with these local levels.
+
+    Returns ``(refinement, slot_edge, slot_j)``: for each edge-point id of the lone refinement (offset 3),
+    its local edge and its index along that edge from the edge's first corner.
+    """
+    tris = np.array([[0, 1, 2]], np.int32)
+    edges = np.array([[0, 1], [0, 2], [1, 2]], np.int32)  # local edges 0, 2 (reversed), 1
+    face_edges = np.array([[0, 2, 1]], np.int32)
+    flipped = np.array([[False, False, True]])
+    order = [0, 2, 1]
+    levels = (np.asarray(outer_f, np.float64)[order], np.asarray(outer_n, np.int64)[order],
+              np.array([inner_f], np.float64), np.array([inner_n], np.int64))
+    ref = core._refine_general(tris, 3, edges, face_edges, flipped, levels, spacing)
+    n0, n1, n2 = (int(x) for x in outer_n)
+    k0, k2, k1 = np.arange(n0 - 1), np.arange(n2 - 1), np.arange(n1 - 1)
+    slot_edge = np.concatenate([np.zeros(n0 - 1, np.int64), np.full(n2 - 1, 2), np.ones(n1 - 1, np.int64)])
+    slot_j = np.concatenate([k0 + 1, n2 - (k2 + 1), k1 + 1])
+    return ref, slot_edge, slot_j
+
+
+def _faces_by_class(inverse, n_classes):
+    order = np.argsort(inverse, kind="stable")
+    counts = np.bincount(inverse, minlength=n_classes)
+    return np.split(order, np.cumsum(counts)[:-1])
+
+
+def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing):
+    """Same contract as `kernels.refine.refine`, built per pattern class. Returns a `Refinement`."""
+    edge_f, edge_n, inner_f, inner_n = levels
+    first, inverse = classes
+    outer_n = edge_n[face_edges]
+    outer_f = edge_f[face_edges]
+    point_edge, point_local, point_start = ragged(edge_n - 1)
+    edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
+    edge_first = n_vertices + point_start
+    interior_counts = core._interior_counts(inner_n)
+    interior_start = np.cumsum(interior_counts) - interior_counts
+    interior_first = n_vertices + len(point_edge)
+    tri_counts = outer_n.sum(axis=1) + 2 * interior_counts - 2
+    tri_start = np.cumsum(tri_counts) - tri_counts
+    triangles = np.empty((int(tri_counts.sum()), 3), np.int32)
+
+    patterns, groups = [], _faces_by_class(inverse, len(first))
+    for f0, faces in zip(first, groups, strict=True):
+        pat, slot_edge, slot_j = _lone_pattern(outer_f[f0], outer_n[f0], inner_f[f0], inner_n[f0], spacing)
+        patterns.append(pat)
+        n_edge_slots = len(slot_edge)
+        table = np.empty((len(faces), 3 + n_edge_slots + int(interior_counts[f0])), np.int64)
+        table[:, :3] = tris[faces]
+        if n_edge_slots:
+            e = face_edges[faces][:, slot_edge]  # (F, slots) mesh edge of each slot
+            n_e = outer_n[f0][slot_edge]
+            canonical = np.where(flipped[faces][:, slot_edge], n_e - slot_j, slot_j)
+            table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
+        table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(
+            int(interior_counts[f0]))
+        stamped = table[:, pat.triangles]  # (F, Mt, 3)
+        mt = len(pat.triangles)
+        if faces[-1] - faces[0] + 1 == len(faces):
+            lo = int(tri_start[faces[0]])
+            triangles[lo : lo + len(faces) * mt] = stamped.reshape(-1, 3)
+        else:
+            triangles[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = stamped.reshape(-1, 3)
+
+    def interior_bary():
+        out = np.empty((int(interior_counts.sum()), 3))
+        for pat, faces in zip(patterns, groups, strict=True):
+            p = len(pat.interior_bary)
+            if p:
+                rows = (interior_start[faces][:, None] + np.arange(p)).ravel()
+                out[rows] = np.tile(pat.interior_bary, (len(faces), 1))
+        return out
+
+    def corner_bary():
+        out = np.empty((len(triangles), 3, 3))
+        for pat, faces in zip(patterns, groups, strict=True):
+            mt = len(pat.triangles)
+            out[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = np.tile(pat.corner_bary, (len(faces), 1, 1))
+        return out
+
+    n_faces = len(tris)
+    return core.Refinement(
+        n_corners=int(n_vertices), faces=tris, edges=edges,
+        edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t,
+        triangles=triangles, triangle_face=np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts),
+        spacing=spacing, edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
+        interior_counts=interior_counts,
+        lazy={"interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
+              "interior_bary": interior_bary, "corner_bary": corner_bary},
+        face_class=inverse, class_interior_bary=tuple(p.interior_bary for p in patterns),
+        class_corner_bary=tuple(p.corner_bary for p in patterns),
+    )
