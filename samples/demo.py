@@ -1,9 +1,12 @@
-"""Tessera demo, headless: tessellate Suzanne, export it with Blender's exporters, render a picture.
+"""Tessera demo, headless: PN and Phong on Suzanne, adaptive levels for a camera, export, pictures.
 
 Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make setup``; also works as
-``blender --background --python samples/demo.py``). Writes ``out/demo.glb``, ``out/demo.obj`` (+ .mtl)
-and ``out/demo.png``: the original Suzanne on the left, the tessellated one on the right, each with its
-wireframe drawn over it.
+``blender --background --python samples/demo.py``). Writes:
+
+- ``out/demo.png``: original / Phong / PN Suzanne (uniform level 4), each with its wireframe;
+- ``out/demo_adaptive.png``: four Suzannes receding from the camera, PN with adaptive levels for that
+  camera (projected edge length, 18 px): the far ones get fewer triangles;
+- ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
 import os
@@ -16,7 +19,7 @@ import bpy
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"
-LEVEL = 3
+LEVEL = 4
 
 
 def enable_addon():
@@ -52,33 +55,72 @@ def wire_overlay(ob, mat):
     return wire
 
 
-def build_scene():
+def clear_scene():
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
-    scene = bpy.context.scene
-    bpy.ops.mesh.primitive_monkey_add(location=(-1.3, 0.0, 0.0), rotation=(0.0, 0.0, 0.35))
-    source = bpy.context.active_object
-    source.name = "Suzanne"
+
+
+def add_suzanne(location, mat):
+    bpy.ops.mesh.primitive_monkey_add(location=location)
+    ob = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    source.data.materials.append(material("Clay", (0.8, 0.55, 0.35, 1.0)))
+    ob.data.materials.append(mat)
+    return ob
+
+
+def add_camera(location, rotation, lens=50):
+    scene = bpy.context.scene
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(cam)
+    cam.location, cam.rotation_euler = location, rotation
+    cam.data.lens = lens
+    scene.camera = cam
+    return cam
+
+
+def tessellate(source, **settings):
+    bpy.context.view_layer.objects.active = source
     t0 = time.perf_counter()
-    result = bpy.ops.tessera.tessellate(method="LINEAR", level=LEVEL, output="NEW_OBJECT")
+    result = bpy.ops.tessera.tessellate(output="NEW_OBJECT", **settings)
     elapsed = time.perf_counter() - t0
     if result != {"FINISHED"}:
         sys.exit(f"demo: tessellate returned {result}")
-    tess = bpy.context.active_object
-    tess.location.x = 1.3
-    wire_mat = material("Wire", (0.05, 0.05, 0.08, 1.0))
-    for ob in (source, tess):
-        wire_overlay(ob, wire_mat)
+    return bpy.context.active_object, elapsed
 
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(cam)
-    cam.location = (0.0, -8.6, 0.55)
-    cam.rotation_euler = (1.5, 0.0, 0.0)
-    cam.data.lens = 50
-    scene.camera = cam
-    return source, tess, elapsed
+
+def build_methods_scene():
+    """Original, Phong and PN side by side; returns (source, {method: (object, seconds)})."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    source = add_suzanne((-2.6, 0.0, 0.0), clay)
+    source.name = "Suzanne"
+    results = {}
+    for method, x in (("PHONG", 0.0), ("PN", 2.6)):
+        ob, elapsed = tessellate(source, method=method, level=LEVEL)
+        ob.location.x = x
+        results[method] = (ob, elapsed)
+    for ob in (source, *(o for o, _ in results.values())):
+        wire_overlay(ob, wire_mat)
+    add_camera((0.0, -10.5, 0.55), (1.5, 0.0, 0.0), lens=42)
+    return source, results
+
+
+def build_adaptive_scene():
+    """Four Suzannes receding from the camera, PN with adaptive levels for it; returns the triangle counts."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    add_camera((0.0, -4.2, 0.5), (1.5, 0.0, 0.0), lens=35)
+    bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 1280, 620
+    counts = []
+    for k in range(4):
+        source = add_suzanne((-2.1 + 1.9 * k, 4.0 * k, 0.0), clay)
+        ob, _ = tessellate(source, method="PN", level_mode="ADAPTIVE", metrics={"PROJECTED"},
+                           max_level=10, edge_pixels=18)
+        ob.location = source.location
+        bpy.data.objects.remove(source)
+        wire_overlay(ob, wire_mat)
+        counts.append(len(ob.data.polygons))
+    return counts
 
 
 def export(tess):
@@ -89,7 +131,7 @@ def export(tess):
     bpy.ops.wm.obj_export(filepath=str(OUT / "demo.obj"), export_selected_objects=True)
 
 
-def render():
+def render(name):
     scene = bpy.context.scene
     scene.render.engine = "BLENDER_WORKBENCH"
     scene.display.shading.light = "STUDIO"
@@ -99,7 +141,7 @@ def render():
     scene.render.film_transparent = False
     scene.world = scene.world or bpy.data.worlds.new("World")
     scene.world.color = (0.9, 0.9, 0.92)
-    scene.render.filepath = str(OUT / "demo.png")
+    scene.render.filepath = str(OUT / name)
     bpy.ops.render.render(write_still=True)
 
 
@@ -107,13 +149,17 @@ def main():
     OUT.mkdir(exist_ok=True)
     os.environ.setdefault("TESSERA_OPENCL", "1")
     enable_addon()
-    source, tess, elapsed = build_scene()
-    export(tess)
-    render()
+    source, results = build_methods_scene()
+    export(results["PN"][0])
+    render("demo.png")
     n_in = len(source.data.polygons)
-    n_out = len(tess.data.polygons)
-    print(f"demo: Suzanne {n_in} faces -> {n_out} triangles at level {LEVEL} in {elapsed:.2f} s")
-    for name in ("demo.glb", "demo.obj", "demo.png"):
+    for method, (ob, elapsed) in results.items():
+        print(f"demo: {method} Suzanne {n_in} faces -> {len(ob.data.polygons)} triangles at level {LEVEL} "
+              f"in {elapsed:.2f} s")
+    counts = build_adaptive_scene()
+    render("demo_adaptive.png")
+    print(f"demo: adaptive PN for the camera, near to far: {counts} triangles")
+    for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
