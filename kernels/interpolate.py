@@ -10,6 +10,7 @@ import numpy as np
 
 from .errors import TesseraError
 from .opencl_runtime import get_runtime
+from .topology import group_by_class
 
 #: Below this many output rows the numpy path is used even when OpenCL is available (launch overhead).
 OPENCL_MIN_ROWS = 1 << 15
@@ -114,8 +115,7 @@ def _corner_values_by_class(ref, values):
     counts = np.bincount(ref.triangle_face, minlength=n_faces)
     starts = np.cumsum(counts) - counts
     out = np.empty((len(ref.triangles) * 3, channels), dtype=np.float32)
-    order = np.argsort(ref.face_class, kind="stable")
-    groups = np.split(order, np.cumsum(np.bincount(ref.face_class, minlength=len(ref.class_corner_bary)))[:-1])
+    groups = group_by_class(ref.face_class, len(ref.class_corner_bary))
     for template, faces in zip(ref.class_corner_bary, groups, strict=True):
         if len(faces) == 0:
             continue

@@ -13,7 +13,7 @@ import numpy as np
 
 from . import refine as core
 from .partition import point_params
-from .topology import ragged
+from .topology import group_by_class, ragged
 
 #: Use the class path when there are at most this many classes, or at least this many faces per class.
 MAX_CLASSES = 64
@@ -64,12 +64,6 @@ def _lone_pattern(outer_f, outer_n, inner_f, inner_n, spacing):
     return ref, slot_edge, slot_j
 
 
-def _faces_by_class(inverse, n_classes):
-    order = np.argsort(inverse, kind="stable")
-    counts = np.bincount(inverse, minlength=n_classes)
-    return np.split(order, np.cumsum(counts)[:-1])
-
-
 def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing):
     """Same contract as `kernels.refine.refine`, built per pattern class. Returns a `Refinement`."""
     edge_f, edge_n, inner_f, inner_n = levels
@@ -86,7 +80,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     tri_start = np.cumsum(tri_counts) - tri_counts
     triangles = np.empty((int(tri_counts.sum()), 3), np.int32)
 
-    patterns, groups = [], _faces_by_class(inverse, len(first))
+    patterns, groups = [], group_by_class(inverse, len(first))
     for f0, faces in zip(first, groups, strict=True):
         pat, slot_edge, slot_j = _lone_pattern(outer_f[f0], outer_n[f0], inner_f[f0], inner_n[f0], spacing)
         patterns.append(pat)

@@ -13,7 +13,7 @@ summation order of float64 products (checked in the tests).
 
 import numpy as np
 
-from .topology import ragged
+from .topology import group_by_class, ragged
 
 #: Use per-class matrix products when there are at most this many classes, or few per owner.
 MAX_CLASSES = 256
@@ -43,9 +43,7 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         uniq, inverse = np.unique(keys, return_inverse=True)
     channels = control.shape[2]
     if _class_path(len(uniq), len(counts)):
-        order = np.argsort(inverse, kind="stable")
-        groups = np.split(order, np.cumsum(np.bincount(inverse, minlength=len(uniq)))[:-1])
-        for owners in groups:
+        for owners in group_by_class(inverse, len(uniq)):
             p = int(counts[owners[0]])
             if p == 0:
                 continue

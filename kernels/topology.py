@@ -66,3 +66,9 @@ def ragged(counts):
     owner = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
     local = np.arange(int(counts.sum()), dtype=np.int64) - starts[owner]
     return owner, local, starts
+
+
+def group_by_class(inverse, n_classes):
+    """Owners of each class, in owner order: (K,) int class per owner -> list of n_classes (k_c,) int64 arrays."""
+    order = np.argsort(inverse, kind="stable")
+    return np.split(order, np.cumsum(np.bincount(inverse, minlength=n_classes))[:-1])
