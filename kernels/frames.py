@@ -104,8 +104,9 @@ def prefix_rotations(steps, offsets):
     longest = int(local.max()) + 1 if n else 0
     d = 1
     while d < longest:
-        idx = np.nonzero(local >= d)[0]
-        acc[idx] = _quat_mul(acc[idx], acc[idx - d])
+        # slices instead of index arrays: combine everything d apart, keep only pairs inside one curve
+        inside = (local[d:] >= d)[:, None]
+        acc[d:] = np.where(inside, _quat_mul(acc[d:], acc[:-d]), acc[d:])
         d *= 2
     # keep unit length against rounding drift of long products
     acc /= np.linalg.norm(acc, axis=1, keepdims=True)

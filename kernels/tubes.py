@@ -18,7 +18,8 @@ import numpy as np
 from .curve_refine import catmull_rom, select_points
 from .errors import InvalidInputError
 from .frames import rotation_minimizing_frames
-from .polylines import arc_lengths, chunks, drop_duplicates, next_index, take_curves
+from .polylines import arc_lengths, chunks, drop_duplicates, take_curves
+from .tube_caps import cap_pieces, cap_sizes
 
 CAPS = ("NONE", "FLAT", "ROUND")
 SIDES_MODES = ("FIXED", "CAMERA")
@@ -139,128 +140,220 @@ def prepare_lines(lines, settings):
 def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None):
     """Tube mesh around every curve of ``lines`` (`polylines.Polylines`). Returns a `PolygonMesh`.
 
-    Works in chunks of whole curves, grouped by side count, so memory stays proportional to the output.
+    Layout: tubes sorted by side count (stable, so FIXED keeps the curve order), bodies first, then caps.
+    Output arrays are allocated once at their final size and written in chunks of curves, so memory stays
+    close to the output itself.
     """
     settings.validate(camera)
     lines = prepare_lines(lines, settings)
-    notes = list(lines.notes)
-    parts = []
-    chunk_list = list(chunks(lines, 1 << 18))
-    for i, (c0, c1) in enumerate(chunk_list):
-        parts.extend(_build_chunk(take_curves(lines, c0, c1), settings, camera))
-        if progress is not None:
-            progress((i + 1) / len(chunk_list))
-    mesh = _concatenate(parts, settings)
-    mesh.notes = notes
+    report = progress or (lambda f: None)
+    frames = _frames(lines, settings, camera)
+    report(0.3)
+    layout = _Layout(lines, frames["sides"], settings)
+    mesh = layout.allocate(settings)
+    mesh.notes = list(lines.notes)
+    caps = []
+    cursor = {"v": 0, "f": 0, "c": 0, "e": 0, "cap_v": layout.body_v, "cap_e": layout.body_e}
+    units = list(layout.units())
+    for i, (n, curves) in enumerate(units):
+        _write_body(mesh, lines, frames, n, curves, cursor, settings, caps)
+        report(0.3 + 0.65 * (i + 1) / len(units))
+    _write_caps(mesh, caps, layout, settings)
+    if settings.caps == "FLAT":
+        mesh.corner_normals[: layout.body_c] = mesh.point_normals[mesh.corner_verts[: layout.body_c]]
+        mesh.point_normals = None
+    report(1.0)
     return mesh
 
 
-def _build_chunk(lines, settings, camera):
-    pixel = pixel_world_size(lines.points, camera) if camera is not None else np.full(len(lines.points), np.inf)
-    sides = tube_sides(lines, settings, pixel)
-    t, nrm, bin_ = rotation_minimizing_frames(lines)
-    arc, total = arc_lengths(lines)
-    curve = lines.curve_of_point()
-    radius = lines.radius
-    if settings.aa_clamp:
-        radius = effective_radius(radius, pixel, sides[curve], settings.max_radius)
-    for n in np.unique(sides):
-        keep = sides == n
-        sub = lines.select_curves(keep)
-        pick = np.repeat(keep, lines.counts)
-        yield _tube_group(sub, int(n), t[pick], nrm[pick], bin_[pick], radius[pick], arc[pick], total[keep],
-                          settings)
+def _frames(lines, settings, camera):
+    """Per point: unit T, N, B (float32), effective radius; per curve: sides. Chunked for memory."""
+    n_pts = len(lines.points)
+    out = {k: np.empty((n_pts, 3), np.float32) for k in ("t", "n", "b")}
+    out["radius"] = np.empty(n_pts, np.float32)
+    out["sides"] = np.empty(lines.n_curves, np.int64)
+    for c0, c1 in chunks(lines, 1 << 20):
+        sub = take_curves(lines, c0, c1)
+        p0, p1 = lines.offsets[c0], lines.offsets[c1]
+        pixel = pixel_world_size(sub.points, camera) if camera is not None else np.full(len(sub.points), np.inf)
+        sides = tube_sides(sub, settings, pixel)
+        out["sides"][c0:c1] = sides
+        radius = sub.radius
+        if settings.aa_clamp:
+            radius = effective_radius(radius, pixel, np.repeat(sides, sub.counts), settings.max_radius)
+        out["radius"][p0:p1] = radius
+        t, nrm, bin_ = rotation_minimizing_frames(sub)
+        out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = t, nrm, bin_
+    out["arc"], out["total"] = arc_lengths(lines)
+    return out
+
+
+class _Layout:
+    """Sizes of the output and the order in which tubes are written."""
+
+    def __init__(self, lines, sides, settings):
+        self.lines, self.sides = lines, sides
+        self.order = np.argsort(sides, kind="stable")
+        counts = lines.counts
+        segs = counts - 1 + lines.cyclic
+        self.body_v = int(np.sum(counts * sides))
+        self.body_f = int(np.sum(segs * sides))
+        self.body_c = 4 * self.body_f
+        self.body_e = self.body_v + self.body_f
+        open_ = ~lines.cyclic
+        cap_v = cap_e = cap_f = cap_c = 0
+        if settings.caps != "NONE":
+            for n in np.unique(sides[open_]):
+                ends = 2 * int(np.sum(open_ & (sides == n)))
+                dv, de, df, dc = cap_sizes(settings.caps, int(n))
+                cap_v, cap_e, cap_f, cap_c = cap_v + ends * dv, cap_e + ends * de, cap_f + ends * df, cap_c + ends * dc
+        self.totals = (self.body_v + cap_v, self.body_f + cap_f, self.body_c + cap_c, self.body_e + cap_e)
+
+    def allocate(self, settings):
+        v, f, c, e = self.totals
+        mesh = PolygonMesh(
+            positions=np.empty((v, 3), np.float32), face_sizes=np.empty(f, np.int32),
+            corner_verts=np.empty(c, np.int32), edges=np.empty((e, 2), np.int32), corner_edges=np.empty(c, np.int32),
+            point_normals=np.empty((v, 3), np.float32), face_material=np.empty(f, np.int32),
+        )
+        if settings.caps == "FLAT":
+            mesh.corner_normals = np.empty((c, 3), np.float32)
+        if settings.uvs:
+            mesh.corner_uvs = np.empty((c, 2), np.float32)
+        return mesh
+
+    def units(self, max_points=1 << 19):
+        """``(sides, curve ids)`` runs of equal side count with about ``max_points`` points each."""
+        sorted_sides = self.sides[self.order]
+        counts = self.lines.counts[self.order]
+        bounds = np.concatenate(([0], np.nonzero(np.diff(sorted_sides))[0] + 1, [len(self.order)]))
+        for g0, g1 in zip(bounds[:-1], bounds[1:], strict=True):
+            csum = np.cumsum(counts[g0:g1])
+            start = 0
+            while start < g1 - g0:
+                base = csum[start - 1] if start else 0
+                stop = int(np.searchsorted(csum, base + max_points, side="right"))
+                stop = min(max(stop, start + 1), g1 - g0)
+                yield int(sorted_sides[g0]), self.order[g0 + start:g0 + stop]
+                start = stop
+
+
+def _unit_points(lines, curves):
+    """Point ids of ``curves`` in order: a slice when they are consecutive, else an index array."""
+    counts = lines.counts[curves]
+    if len(curves) and np.all(np.diff(curves) == 1):
+        return slice(int(lines.offsets[curves[0]]), int(lines.offsets[curves[-1] + 1])), counts
+    starts = lines.offsets[curves]
+    local = np.concatenate(([0], np.cumsum(counts)))
+    idx = np.arange(local[-1]) - np.repeat(local[:-1] - starts, counts)
+    return idx, counts
+
+
+def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps):
+    """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
+    pick, counts = _unit_points(lines, curves)
+    cyclic = lines.cyclic[curves]
+    n_pts = int(counts.sum())
+    local = np.concatenate(([0], np.cumsum(counts)))
+    last = local[1:] - 1
+    v0, f0, c0, e0 = cursor["v"], cursor["f"], cursor["c"], cursor["e"]
+
+    # vertices: radial directions (the normals), then centre + radius * radial
+    cos_t, sin_t = (x.astype(np.float32) for x in _ring(n))
+    nrm_out = mesh.point_normals[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
+    pos_out = mesh.positions[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
+    np.multiply(cos_t[None, :, None], frames["n"][pick][:, None, :], out=nrm_out)
+    np.multiply(sin_t[None, :, None], frames["b"][pick][:, None, :], out=pos_out)
+    nrm_out += pos_out
+    np.multiply(nrm_out, frames["radius"][pick][:, None, None], out=pos_out)
+    pos_out += lines.points[pick].astype(np.float32)[:, None, :]
+
+    # segments: every point but the last of an open curve; the last of a cyclic curve closes it
+    has_seg = np.ones(n_pts, bool)
+    has_seg[last[~cyclic]] = False
+    seg = np.nonzero(has_seg)[0]
+    nxt = seg + 1
+    closing = np.isin(seg, last[cyclic])
+    nxt[closing] = local[:-1][cyclic]
+    n_seg = len(seg)
+    j = np.arange(n, dtype=np.int64)
+    j1 = (j + 1) % n
+    ring = (v0 + seg * n)[:, None]
+    ring_next = (v0 + nxt * n)[:, None]
+    cv = mesh.corner_verts[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4)
+    cv[..., 0], cv[..., 1], cv[..., 2], cv[..., 3] = ring + j, ring + j1, ring_next + j1, ring_next + j
+    # edges: ring edges of every point (p*n + j: side j to j+1), then the edges along every segment
+    ring_e = mesh.edges[e0:e0 + n_pts * n].reshape(n_pts, n, 2)
+    first = (v0 + np.arange(n_pts) * n)[:, None]
+    ring_e[..., 0], ring_e[..., 1] = first + j, first + j1
+    long_e = mesh.edges[e0 + n_pts * n:e0 + (n_pts + n_seg) * n].reshape(n_seg, n, 2)
+    long_e[..., 0], long_e[..., 1] = ring + j, ring_next + j
+    ce = mesh.corner_edges[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4)
+    along = (e0 + (n_pts + np.arange(n_seg)) * n)[:, None]
+    ce[..., 0], ce[..., 1] = (e0 + seg * n)[:, None] + j, along + j1
+    ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
+    mesh.face_sizes[f0:f0 + n_seg * n] = 4
+    curve_of_point = np.repeat(np.arange(len(curves)), counts)
+    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][curve_of_point[seg]], n)
+    if settings.uvs:
+        arc, total = frames["arc"][pick], frames["total"][curves][curve_of_point]
+        u = arc / np.maximum(total, 1e-300)
+        u0 = u[seg].astype(np.float32)
+        u1 = np.where(closing, 1.0, u[nxt]).astype(np.float32)
+        v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
+        uv = mesh.corner_uvs[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4, 2)
+        uv[:, :, 0, 0] = uv[:, :, 1, 0] = u0[:, None]
+        uv[:, :, 2, 0] = uv[:, :, 3, 0] = u1[:, None]
+        uv[:, :, 0, 1] = uv[:, :, 3, 1] = v_lo
+        uv[:, :, 1, 1] = uv[:, :, 2, 1] = v_hi
+    if settings.caps != "NONE":
+        _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps)
+    cursor["v"] += n_pts * n
+    cursor["f"] += n_seg * n
+    cursor["c"] += 4 * n_seg * n
+    cursor["e"] += (n_pts + n_seg) * n
+
+
+def _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps):
+    open_ = ~cyclic
+    if not np.any(open_):
+        return
+    mat = lines.material_index[curves][open_]
+    for side, ends in ((-1.0, local[:-1][open_]), (1.0, local[1:][open_] - 1)):
+        p = pick.start + ends if isinstance(pick, slice) else pick[ends]
+        piece = cap_pieces(settings.caps, n, side, lines.points[p], frames["t"][p].astype(np.float64),
+                           frames["n"][p].astype(np.float64), frames["b"][p].astype(np.float64),
+                           frames["radius"][p].astype(np.float64), v0 + ends * n, e0 + ends * n, mat,
+                           cursor["cap_v"], cursor["cap_e"], settings.uvs)
+        cursor["cap_v"] += len(piece["positions"])
+        cursor["cap_e"] += len(piece["edges"])
+        caps.append(piece)
+
+
+def _write_caps(mesh, caps, layout, settings):
+    if not caps:
+        return
+    v, e = layout.body_v, layout.body_e
+    f, c = layout.body_f, layout.body_c
+    for piece in caps:
+        nv, ne = len(piece["positions"]), len(piece["edges"])
+        mesh.positions[v:v + nv] = piece["positions"]
+        mesh.point_normals[v:v + nv] = piece["normals"]
+        mesh.edges[e:e + ne] = piece["edges"]
+        v, e = v + nv, e + ne
+        for k, faces in enumerate(piece["faces"]):
+            nf, width = faces.shape
+            mesh.face_sizes[f:f + nf] = width
+            mesh.face_material[f:f + nf] = piece["materials"][k]
+            mesh.corner_verts[c:c + nf * width] = faces.ravel()
+            mesh.corner_edges[c:c + nf * width] = piece["corner_edges"][k].ravel()
+            if settings.uvs:
+                mesh.corner_uvs[c:c + nf * width] = piece["uvs"][k]
+            if settings.caps == "FLAT":
+                mesh.corner_normals[c:c + nf * width] = piece["corner_normals"][k]
+            f, c = f + nf, c + nf * width
 
 
 def _ring(n):
     theta = 2.0 * np.pi * np.arange(n) / n
     return np.cos(theta), np.sin(theta)
-
-
-def _tube_group(lines, n, t, nrm, bin_, radius, arc, total, settings):
-    """Body (and caps) of tubes that all have ``n`` sides; vertex ids local to the group."""
-    P = len(lines.points)
-    cos_t, sin_t = _ring(n)
-    radial = (cos_t[None, :, None] * nrm[:, None, :] + sin_t[None, :, None] * bin_[:, None, :]).astype(np.float32)
-    pos = lines.points.astype(np.float32)[:, None, :] + radius.astype(np.float32)[:, None, None] * radial
-    nxt = next_index(lines)
-    seg = np.nonzero(nxt >= 0)[0]
-    j = np.arange(n)
-    j1 = (j + 1) % n
-    a = seg[:, None] * n
-    b = nxt[seg][:, None] * n
-    quads = np.stack((a + j, a + j1, b + j1, b + j), axis=-1).reshape(-1, 4)  # (S * n, 4)
-    # edges: around each ring (k, j)-(k, j+1) for all points, along each segment (k, j)-(k+1, j)
-    ring_edges = np.stack((np.arange(P)[:, None] * n + j, np.arange(P)[:, None] * n + j1), axis=-1).reshape(-1, 2)
-    long_edges = np.stack((a + j, b + j), axis=-1).reshape(-1, 2)
-    n_ring = len(ring_edges)
-    # corner edges of quad (a+j, a+j1, b+j1, b+j): ring edge of k at j, long edge at j1, ring edge of k+1 at j,
-    # long edge at j
-    ring_id = lambda k: (k[:, None] * n + j)  # noqa: E731 - tiny local index helper
-    long_id = n_ring + np.arange(len(seg))[:, None] * n
-    corner_edges = np.stack((ring_id(seg), long_id + j1, ring_id(nxt[seg]), long_id + j), axis=-1).reshape(-1, 4)
-
-    curve = lines.curve_of_point()
-    mat = lines.material_index[curve[seg]]
-    group = {
-        "positions": pos.reshape(-1, 3), "normals": radial.reshape(-1, 3),
-        "faces": [quads], "corner_edges": [corner_edges], "edges": [ring_edges, long_edges],
-        "face_material": [np.repeat(mat, n)], "uvs": [], "corner_normals": [],
-    }
-    if settings.uvs:
-        length = np.maximum(total[curve], 1e-300)
-        u0 = (arc / length)[seg]
-        closing = nxt[seg] <= seg  # the segment that closes a cyclic curve ends at u = 1
-        u1 = np.where(closing, 1.0, (arc / length)[nxt[seg]])
-        v0, v1 = j / n, (j + 1) / n
-        uv = np.empty((len(seg), n, 4, 2), np.float32)
-        uv[..., 0] = np.stack((u0, u0, u1, u1), axis=-1)[:, None, :]
-        uv[..., 1] = np.stack((v0, v1, v1, v0), axis=-1)[None, :, :]
-        group["uvs"].append(uv.reshape(-1, 2))
-    if settings.caps == "FLAT":
-        group["corner_normals"].append(group["normals"][quads.ravel()])
-    if settings.caps != "NONE":
-        from .tube_caps import add_caps
-
-        add_caps(group, lines, n, t, nrm, bin_, radius, settings)
-    return group
-
-
-def _concatenate(groups, settings):
-    """One `PolygonMesh` from per-group pieces, offsetting vertex and edge ids."""
-    positions, normals, faces, sizes, cverts, cedges, edges, mats, uvs, cnormals = ([] for _ in range(10))
-    v_base = e_base = 0
-    for g in groups:
-        for f, ce in zip(g["faces"], g["corner_edges"], strict=True):
-            sizes.append(np.full(len(f), f.shape[1], np.int32))
-            cverts.append((f + v_base).ravel())
-            cedges.append((ce + e_base).ravel())
-        e_count = 0
-        for e in g["edges"]:
-            edges.append(e + v_base)
-            e_count += len(e)
-        positions.append(g["positions"])
-        normals.append(g["normals"])
-        mats.extend(g["face_material"])
-        uvs.extend(g["uvs"])
-        cnormals.extend(g["corner_normals"])
-        v_base += len(g["positions"])
-        e_base += e_count
-
-    def cat(items, dtype, width=None):
-        if items:
-            return np.ascontiguousarray(np.concatenate(items), dtype=dtype)
-        return np.zeros((0, width) if width else 0, dtype)
-
-    mesh = PolygonMesh(
-        positions=cat(positions, np.float32, 3), face_sizes=cat(sizes, np.int32),
-        corner_verts=cat(cverts, np.int32), edges=cat(edges, np.int32, 2), corner_edges=cat(cedges, np.int32),
-        face_material=cat(mats, np.int32),
-    )
-    if settings.caps == "FLAT":
-        mesh.corner_normals = cat(cnormals, np.float32, 3)
-    else:
-        mesh.point_normals = cat(normals, np.float32, 3)
-    if settings.uvs:
-        mesh.corner_uvs = cat(uvs, np.float32, 2)
-    return mesh
