@@ -133,7 +133,9 @@ def segment_lengths(lines):
 
 
 def arc_lengths(lines):
-    """Arc length from the curve start to each point (P,) and each curve's total length (C,), closing segment included."""
+    """Arc length from the curve start to each point (P,) and each curve's total length (C,).
+
+    A cyclic curve's total includes its closing segment."""
     seg = segment_lengths(lines)
     csum = np.cumsum(seg)
     start_sum = np.concatenate(([0.0], csum))[lines.offsets[:-1]]

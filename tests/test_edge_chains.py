@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tessera.kernels.edge_chains import chains_from_edges
 from tessera.kernels.errors import InvalidInputError
 

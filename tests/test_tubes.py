@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tessera.kernels.camera import Camera
 from tessera.kernels.curve_refine import catmull_rom, select_points
 from tessera.kernels.errors import InvalidInputError
