@@ -10,6 +10,7 @@ _modules = (
     "addon.preferences",
     "addon.settings",
     "operators.tessellate",
+    "operators.tubes",
     "addon.menus",
     "addon.panels",
 )

@@ -173,3 +173,162 @@ def _restore_active(mesh, info):
         mesh.uv_layers.active = mesh.uv_layers[info.active_uv]
     if info.render_uv and info.render_uv in mesh.uv_layers:
         mesh.uv_layers[info.render_uv].active_render = True
+
+
+# ---- polygon meshes (tubes) and curve-like inputs -------------------------------------------------------------
+
+
+def write_polygons(name, poly):
+    """Create a `bpy.types.Mesh` from a `kernels.tubes.PolygonMesh` and return it.
+
+    Writes edges and corner edges directly when the kernel knows them (no edge computation). Faces are
+    smooth except where corner normals differ from the point normal field (FLAT caps: those faces are
+    marked sharp, so Blender's own normals keep the rim crisp). UVs go to the map "UVMap", materials to
+    ``material_index``. Removes the half-built mesh if anything fails.
+    """
+    n_v, n_f, n_c = len(poly.positions), len(poly.face_sizes), len(poly.corner_verts)
+    mesh = bpy.data.meshes.new(name)
+    try:
+        mesh.vertices.add(n_v)
+        mesh.loops.add(n_c)
+        mesh.polygons.add(n_f)
+        mesh.attributes["position"].data.foreach_set("vector", np.ascontiguousarray(poly.positions).ravel())
+        mesh.attributes[".corner_vert"].data.foreach_set("value", poly.corner_verts)
+        mesh.polygons.foreach_set("loop_start", poly.face_offsets[:-1].astype(np.int32))
+        if poly.edges is not None:
+            mesh.edges.add(len(poly.edges))
+            mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(poly.edges).ravel())
+            mesh.attributes[".corner_edge"].data.foreach_set("value", poly.corner_edges)
+            mesh.update()
+        else:
+            mesh.update(calc_edges=True)
+        if poly.corner_normals is not None:
+            corner_face = np.repeat(np.arange(n_f), poly.face_sizes)
+            first = poly.corner_normals[poly.face_offsets[:-1]]
+            flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < 1e-6, axis=1)
+            sharp = np.logical_and.reduceat(flat, poly.face_offsets[:-1])
+            _new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", sharp)
+        if poly.corner_uvs is not None:
+            uv = _new_attribute(mesh, "UVMap", "FLOAT2", "CORNER")
+            uv.data.foreach_set("vector", np.ascontiguousarray(poly.corner_uvs).ravel())
+        if poly.face_material is not None and np.any(poly.face_material):
+            mat = _new_attribute(mesh, "material_index", "INT", "FACE")
+            mat.data.foreach_set("value", np.ascontiguousarray(poly.face_material))
+        mesh.update()
+    except Exception:
+        bpy.data.meshes.remove(mesh)
+        raise
+    return mesh
+
+
+def _split_wire(n_verts, edges):
+    """Point counts and cyclic flags of the consecutive-vertex runs of a curve's wire mesh (edges (E, 2))."""
+    a, b = edges[:, 0].astype(np.int64), edges[:, 1].astype(np.int64)
+    linked = np.zeros(n_verts, bool)  # linked[i]: an edge joins i and i + 1
+    step = np.abs(a - b) == 1
+    linked[np.minimum(a, b)[step]] = True
+    breaks = np.nonzero(~linked[:-1])[0] + 1
+    starts = np.concatenate(([0], breaks))
+    stops = np.concatenate((breaks, [n_verts]))
+    closing = {(int(min(x, y)), int(max(x, y))) for x, y in zip(a[~step], b[~step], strict=True)}
+    cyclic = np.array([(int(s), int(e - 1)) in closing for s, e in zip(starts, stops, strict=True)], bool)
+    return stops - starts, cyclic
+
+
+def _control_values(spline, name):
+    points = spline.bezier_points if spline.type == "BEZIER" else spline.points
+    values = np.empty(len(points), np.float32)
+    points.foreach_get(name, values)
+    return values.astype(np.float64)
+
+
+def _resample(values, count, cyclic):
+    """Control-point values spread linearly over ``count`` evaluated points (exact for poly and Bézier)."""
+    n = len(values)
+    if n == 1 or count == 1:
+        return np.full(count, values[0])
+    if cyclic:
+        u = np.arange(count) * n / count
+        return np.interp(u, np.arange(n + 1), np.append(values, values[0]))
+    return np.interp(np.arange(count) * (n - 1) / (count - 1), np.arange(n), values)
+
+
+def read_curve_object(ob, radius_scale=1.0):
+    """Evaluated centre lines of a legacy Curve object (poly, Bézier, NURBS) as `Polylines` in object space.
+
+    Points come from Blender's own evaluation (resolution, handles, NURBS order) of a bevel-free copy;
+    radius (x ``radius_scale``) and tilt are the control points' values spread over the evaluated points.
+    Returns ``(lines, notes)``.
+    """
+    from ..kernels.polylines import Polylines
+
+    data = ob.data.copy()
+    probe = bpy.data.objects.new("__tessera_curve_probe", data)
+    notes = []
+    try:
+        data.bevel_depth, data.extrude, data.bevel_object, data.taper_object = 0.0, 0.0, None, None
+        wire = probe.to_mesh()
+        n_v = len(wire.vertices)
+        if n_v == 0:
+            raise InvalidInputError(f"Curve {ob.name!r} has no points")
+        positions = _get(wire.attributes["position"].data, "vector", n_v, np.float32, 3)
+        edges = _get(wire.edges, "vertices", len(wire.edges), np.int32, 2)
+        counts, cyclic = _split_wire(n_v, edges)
+        splines = [s for s in data.splines if len(s.bezier_points if s.type == "BEZIER" else s.points) > 0]
+        radius = np.full(n_v, radius_scale)
+        tilt = np.zeros(n_v)
+        materials = np.zeros(len(counts), np.int32)
+        if len(splines) == len(counts):
+            off = np.concatenate(([0], np.cumsum(counts)))
+            for i, s in enumerate(splines):
+                radius[off[i]:off[i + 1]] = radius_scale * _resample(_control_values(s, "radius"), counts[i], cyclic[i])
+                tilt[off[i]:off[i + 1]] = _resample(_control_values(s, "tilt"), counts[i], cyclic[i])
+                materials[i] = s.material_index
+        else:
+            notes.append(f"Curve {ob.name!r}: the evaluated splines do not match the control splines; "
+                         "point radius and tilt were not carried over")
+        lines = Polylines.build(positions, np.concatenate(([0], np.cumsum(counts))), radius, tilt, cyclic,
+                                materials)
+    finally:
+        probe.to_mesh_clear()
+        bpy.data.objects.remove(probe)
+        bpy.data.curves.remove(data)
+    return lines, notes
+
+
+def read_hair_curves(curves, default_radius):
+    """Points of a hair `Curves` data-block as `Polylines` in object space.
+
+    Radius from the ``radius`` point attribute, or ``default_radius`` where the curves have none.
+    """
+    from ..kernels.polylines import Polylines
+
+    n_p, n_c = len(curves.points), len(curves.curves)
+    if n_p == 0:
+        raise InvalidInputError(f"Curves {curves.name!r} has no points")
+    positions = _get(curves.attributes["position"].data, "vector", n_p, np.float32, 3)
+    offsets = _get(curves.curve_offset_data, "value", n_c + 1, np.int32)
+    attr = curves.attributes.get("radius")
+    has_radius = attr is not None and attr.domain == "POINT" and attr.data_type == "FLOAT"
+    radius = _get(attr.data, "value", n_p, np.float32) if has_radius else default_radius
+    cyc = curves.attributes.get("cyclic")
+    cyclic = _get(cyc.data, "value", n_c, bool) if cyc is not None and cyc.domain == "CURVE" else False
+    mat = curves.attributes.get("material_index")
+    materials = _get(mat.data, "value", n_c, np.int32) if mat is not None and mat.domain == "CURVE" else None
+    return Polylines.build(positions, offsets, radius, None, cyclic, materials)
+
+
+def point_float_attribute(data, name, count):
+    """A float POINT attribute of a mesh or curves data-block as (count,) float64, or a clear error."""
+    attr = data.attributes.get(name)
+    if attr is None or attr.domain != "POINT" or attr.data_type != "FLOAT":
+        raise InvalidInputError(f"{data.name!r} has no float point attribute named {name!r}")
+    return _get(attr.data, "value", count, np.float32).astype(np.float64)
+
+
+def read_wire_mesh(mesh):
+    """Vertex positions (V, 3) float32 and edges (E, 2) int32 of a mesh (its wire, faces ignored)."""
+    n_v = len(mesh.vertices)
+    positions = _get(mesh.attributes["position"].data, "vector", n_v, np.float32, 3)
+    edges = _get(mesh.edges, "vertices", len(mesh.edges), np.int32, 2)
+    return positions, edges

@@ -9,6 +9,7 @@ class TESSERA_MT_object(bpy.types.Menu):
 
     def draw(self, context):
         self.layout.operator("tessera.tessellate", icon="MOD_SUBSURF")
+        self.layout.operator("tessera.tubes", icon="MESH_CYLINDER")
 
 
 def _draw_object_menu(self, context):
