@@ -36,10 +36,8 @@ def render_triangles(positions, triangles, view_projection, size=(256, 256), col
     positions: (V, 3) float32 world space; triangles: (T, 3) int32; view_projection: (4, 4) row-major
     matrix; size: (width, height). Returns (height, width, 4) uint8, row 0 at the bottom. Needs a GPU context.
     """
-    import gpu
     from gpu_extras.batch import batch_for_shader
 
-    width, height = size
     tris = np.ascontiguousarray(triangles, dtype=np.int32)
     corners = np.ascontiguousarray(positions, dtype=np.float32)[tris]  # (T, 3, 3) unshared: flat normals
     normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
@@ -47,6 +45,24 @@ def render_triangles(positions, triangles, view_projection, size=(256, 256), col
     nor = np.repeat(normals, 3, axis=0).astype(np.float32)
     shader = loader.shader("flat_mesh", _describe_flat_mesh)
     batch = batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
+
+    def draw():
+        shader.bind()
+        shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
+        shader.uniform_float("color", tuple(color))
+        shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
+        shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
+        batch.draw(shader)
+
+    return render(draw, size, background)
+
+
+def render(draw, size=(256, 256), background=(0.0, 0.0, 0.0, 1.0)):
+    """Call ``draw()`` into a new offscreen buffer with depth test; return (height, width, 4) uint8, row 0 at
+    the bottom. Needs a GPU context."""
+    import gpu
+
+    width, height = size
     offscreen = gpu.types.GPUOffScreen(width, height)
     try:
         with offscreen.bind():
@@ -54,12 +70,7 @@ def render_triangles(positions, triangles, view_projection, size=(256, 256), col
             fb.clear(color=background, depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
-            shader.bind()
-            shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
-            shader.uniform_float("color", tuple(color))
-            shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
-            shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
-            batch.draw(shader)
+            draw()
             buf = fb.read_color(0, 0, width, height, 4, 0, "UBYTE")
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)

@@ -11,7 +11,7 @@ Here the clamp is applied to the polygon's inscribed radius (s_pix / cos(π/n)),
 not only the ideal cylinder, covers two pixels; an optional maximum caps the inflation.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -164,6 +164,20 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None):
         mesh.point_normals = None
     report(1.0)
     return mesh
+
+
+def tube_sections(lines, settings, camera=None):
+    """What a GPU draw of the tubes needs: the prepared `Polylines` and per point unit N, B (float32 (P, 3))
+    and the radius before the anti-aliasing clamp (which the shader applies per frame); sides per curve."""
+    lines = prepare_lines(lines, settings)
+    frames = _frames(lines, replace(settings, aa_clamp=False), camera)
+    return lines, frames
+
+
+def lod_sides(lines, settings, camera):
+    """Sides per curve (C,) for ``camera`` (prepared lines): what a preview recomputes when the view moves."""
+    pixel = pixel_world_size(lines.points, camera) if camera is not None else np.full(len(lines.points), np.inf)
+    return tube_sides(lines, settings, pixel)
 
 
 def _frames(lines, settings, camera):

@@ -1,0 +1,178 @@
+"""Tubes against geometry nodes Curve to Mesh (circle profile) at the same output size, in one run.
+
+Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M vertices, 24.8 M quads.
+- ``kernel``: `kernels.tubes.build_tubes` (frames, rings, normals, quads, edges) against evaluating a
+  Curve to Mesh modifier on a poly hair-curves object with the same points (Blender builds the mesh with
+  its own minimum-twist normals, multithreaded). Ratio > 1: Tessera is faster.
+- ``operator``: ``tessera.tubes`` end to end (read the hair, build, write a new mesh object) against the
+  same modifier evaluation plus copying its mesh into a new object (``bpy.data.meshes.new_from_object``).
+- ``memory``: peak resident memory of a fresh process building 1 M strands x 32 points with 3 sides,
+  against the size of the output arrays.
+Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tubes.py
+"""
+
+import json
+import subprocess
+import sys
+import time
+
+import numpy as np
+from _setup import enable_extension, import_path
+
+STRANDS, POINTS, SIDES, RADIUS = 100_000, 32, 8, 0.005
+REPEAT = 3
+
+
+def strands(count, points, seed=0):
+    rng = np.random.default_rng(seed)
+    roots = rng.uniform(-1, 1, (count, 1, 3))
+    steps = rng.normal(scale=0.02, size=(count, points, 3))
+    steps[:, :, 2] += 0.05
+    return (roots + np.cumsum(steps, axis=1)).reshape(-1, 3)
+
+
+def best_of(fn, repeat=REPEAT):
+    best, result = float("inf"), None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        result = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, result
+
+
+def hair_object(bpy, pts):
+    hair = bpy.data.hair_curves.new("bench_strands")
+    hair.add_curves([POINTS] * STRANDS)
+    hair.set_types(type="POLY")
+    hair.attributes["position"].data.foreach_set("vector", pts.astype(np.float32).ravel())
+    ob = bpy.data.objects.new("bench_strands", hair)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def curve_to_mesh_group(bpy):
+    ng = bpy.data.node_groups.new("bench_curve_to_mesh", "GeometryNodeTree")
+    ng.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    ng.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    gin, gout = ng.nodes.new("NodeGroupInput"), ng.nodes.new("NodeGroupOutput")
+    to_mesh = ng.nodes.new("GeometryNodeCurveToMesh")
+    circle = ng.nodes.new("GeometryNodeCurvePrimitiveCircle")
+    circle.inputs["Resolution"].default_value = SIDES
+    circle.inputs["Radius"].default_value = RADIUS
+    ng.links.new(gin.outputs[0], to_mesh.inputs["Curve"])
+    ng.links.new(circle.outputs["Curve"], to_mesh.inputs["Profile Curve"])
+    ng.links.new(to_mesh.outputs["Mesh"], gout.inputs[0])
+    return ng
+
+
+def geometry_nodes(bpy, ob, copy_mesh):
+    """Best seconds to evaluate Curve to Mesh (and optionally copy the result into a mesh), and vertex count."""
+    mod = ob.modifiers.new("CurveToMesh", "NODES")
+    mod.node_group = curve_to_mesh_group(bpy)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+
+    def run():
+        mod.show_viewport = False
+        depsgraph.update()
+        t = time.perf_counter()
+        mod.show_viewport = True
+        depsgraph.update()
+        evaluated = ob.evaluated_get(depsgraph)
+        geometry = bpy.types.GeometrySet.from_evaluated_object(evaluated)
+        n = len(geometry.mesh.vertices)
+        if copy_mesh:
+            me = bpy.data.meshes.new_from_object(evaluated)
+            copy = bpy.data.objects.new("bench_copy", me)
+            bpy.context.scene.collection.objects.link(copy)
+            n = len(me.vertices)
+        seconds = time.perf_counter() - t
+        if copy_mesh:
+            bpy.data.objects.remove(copy)
+            bpy.data.meshes.remove(me)
+        return seconds, n
+
+    runs = [run() for _ in range(REPEAT)]
+    ob.modifiers.remove(mod)
+    return min(r[0] for r in runs), runs[0][1]
+
+
+def kernel_case(pts):
+    from tessera.kernels.polylines import Polylines
+    from tessera.kernels.tubes import TubeSettings, build_tubes
+
+    lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
+    settings = TubeSettings(sides=SIDES, caps="NONE", uvs=False)
+    seconds, mesh = best_of(lambda: len(build_tubes(lines, settings).positions))
+    return seconds, mesh
+
+
+def operator_case(bpy, ob):
+    def run():
+        for other in bpy.context.selected_objects:
+            other.select_set(False)
+        ob.select_set(True)
+        bpy.context.view_layer.objects.active = ob
+        bpy.ops.tessera.tubes(radius_source="CONSTANT", radius=RADIUS, sides=SIDES, caps="NONE", uvs=False)
+        out = bpy.context.active_object
+        n = len(out.data.vertices)
+        me = out.data
+        bpy.data.objects.remove(out)
+        bpy.data.meshes.remove(me)
+        return n
+
+    return best_of(run)
+
+
+MEMORY_CHILD = """
+import resource, sys
+sys.path.insert(0, sys.argv[1])
+import numpy as np
+from tessera.kernels.polylines import Polylines
+from tessera.kernels.tubes import TubeSettings, build_tubes
+count, points = 1_000_000, 32
+rng = np.random.default_rng(1)
+pts = rng.normal(scale=0.02, size=(count, points, 3)).cumsum(axis=1).reshape(-1, 3)
+lines = Polylines.build(pts, np.arange(0, count * points + 1, points), radius=0.005)
+del pts
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+mesh = build_tubes(lines, TubeSettings(sides=3, caps="NONE", uvs=False))
+out = sum(a.nbytes for a in (mesh.positions, mesh.point_normals, mesh.corner_verts, mesh.corner_edges, mesh.edges,
+                             mesh.face_sizes, mesh.face_material))
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(before * 1024, peak * 1024, out, len(mesh.positions))
+"""
+
+
+def memory_case():
+    folder = import_path()
+    proc = subprocess.run([sys.executable, "-c", MEMORY_CHILD, str(folder)], capture_output=True, text=True,
+                          check=True)
+    before, peak, out, verts = (int(x) for x in proc.stdout.split())
+    return {"case": "memory", "strands": 1_000_000, "points": 32, "sides": 3, "vertices": verts,
+            "peak_rss_mib": round(peak / 2**20), "input_rss_mib": round(before / 2**20),
+            "output_mib": round(out / 2**20), "peak_over_input_plus_output": round(peak / (before + out), 2)}
+
+
+def main():
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    enable_extension()
+    pts = strands(STRANDS, POINTS)
+    ob = hair_object(bpy, pts)
+    gn_eval, gn_verts = geometry_nodes(bpy, ob, copy_mesh=False)
+    ours, verts = kernel_case(pts)
+    print(json.dumps({"case": "kernel", "strands": STRANDS, "points": POINTS, "sides": SIDES, "vertices": verts,
+                      "baseline": "geometry nodes Curve to Mesh (evaluation)", "baseline_vertices": gn_verts,
+                      "seconds": round(ours, 3), "baseline_seconds": round(gn_eval, 3),
+                      "speed_ratio": round(gn_eval / ours, 2)}))
+    gn_copy, _ = geometry_nodes(bpy, ob, copy_mesh=True)
+    op, op_verts = operator_case(bpy, ob)
+    print(json.dumps({"case": "operator", "vertices": op_verts,
+                      "baseline": "Curve to Mesh evaluation + new_from_object", "seconds": round(op, 3),
+                      "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / op, 2)}))
+    print(json.dumps(memory_case()))
+
+
+if __name__ == "__main__":
+    main()
