@@ -8,11 +8,13 @@ import importlib
 
 _modules = (
     "addon.preferences",
+    "addon.tube_settings",
     "addon.settings",
     "operators.tessellate",
     "operators.tubes",
     "addon.menus",
     "addon.panels",
+    "addon.tube_preview",
 )
 
 

@@ -31,3 +31,9 @@ def viewport_camera(context):
 def camera_for(context, source):
     """``source``: ``"SCENE"`` or ``"VIEWPORT"``."""
     return viewport_camera(context) if source == "VIEWPORT" else scene_camera(context)
+
+
+def object_camera(camera, matrix_world):
+    """``camera`` seen from an object's local space (for work done in object coordinates)."""
+    m = np.array(matrix_world, np.float64)
+    return Camera(np.asarray(camera.view) @ m, camera.projection, camera.width, camera.height)

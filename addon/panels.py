@@ -3,6 +3,8 @@
 import bpy
 
 from .settings import draw_settings
+from .tube_settings import copy_tube_settings, draw_tube_settings
+from .tube_sources import SOURCE_TYPES
 
 
 class TESSERA_PT_tessellate(bpy.types.Panel):
@@ -26,5 +28,29 @@ class TESSERA_PT_tessellate(bpy.types.Panel):
         op.use_object_settings = True
 
 
-classes = (TESSERA_PT_tessellate,)
+class TESSERA_PT_tubes(bpy.types.Panel):
+    bl_idname = "TESSERA_PT_tubes"
+    bl_label = "Tubes"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Tessera"
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.type in SOURCE_TYPES
+
+    def draw_header(self, context):
+        self.layout.prop(context.active_object.tessera.tubes, "preview", text="")
+
+    def draw(self, context):
+        settings = context.active_object.tessera.tubes
+        draw_tube_settings(self.layout, settings)
+        row = self.layout.row()
+        row.scale_y = 1.4
+        op = row.operator("tessera.tubes", icon="MESH_CYLINDER", text="Make Tube Mesh")
+        copy_tube_settings(settings, op)
+
+
+classes = (TESSERA_PT_tessellate, TESSERA_PT_tubes)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -11,6 +11,7 @@ import bpy
 from ..kernels.adaptive import AdaptiveSettings
 from ..kernels.partition import MAX_LEVEL
 from ..kernels.tessellate import SurfaceOptions
+from .tube_settings import TESSERA_PG_tubes
 
 METHOD_ITEMS = (
     ("PN", "PN Triangles", "Cubic Bézier patches from positions and normals (smoothest; Vlachos et al.)"),
@@ -108,6 +109,7 @@ class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
     tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
+    tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
 
 
 def copy_settings(source, target):

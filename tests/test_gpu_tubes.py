@@ -78,3 +78,26 @@ def test_preview_clamp_keeps_far_tubes_visible_like_the_mesh(gpu_renderer, addon
     assert np.mean(a == b) >= 0.995
     thin = offscreen.render(lambda: data.draw(vp, 160, color=(1, 1, 1, 1), lit=False, clamp=False), size=(160, 160))
     assert (thin[..., 0] > 127).sum() < a.sum() / 4  # without the clamp the lines break up
+
+
+def test_preview_cache_refreshes_only_on_change(gpu_renderer, addon_module, clean_scene, bpy_module):
+    bpy = bpy_module
+    preview = addon_module("addon.tube_preview")
+    bpy.ops.curve.primitive_bezier_curve_add()
+    ob = bpy.context.active_object
+    ob.tessera.tubes.preview = True
+    bpy.context.view_layer.update()  # settle the updates of adding the curve
+    entry = preview._entry(ob)
+    assert entry is not None and preview._entry(ob) is entry  # built once, reused
+    assert entry["draw"].section_bytes == 48 * (ob.data.resolution_u + 1)
+    bpy.context.view_layer.update()
+    assert preview._entry(ob) is entry  # nothing changed: nothing rebuilt
+    ob.data.splines[0].bezier_points[0].co.x += 1.0
+    bpy.context.view_layer.update()
+    assert ob.name not in preview._state["cache"]  # an edit drops the uploaded sections
+    entry = preview._entry(ob)
+    ob.tessera.tubes.sides = 5
+    assert ob.name not in preview._state["cache"]  # so does a settings change
+    ob.tessera.tubes.preview = False
+    bpy.data.curves.remove(ob.data)
+    preview._state["cache"].clear()
