@@ -6,6 +6,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
 - ``out/demo.png``: original / Phong / PN Suzanne (uniform level 4), each with its wireframe;
 - ``out/demo_adaptive.png``: four Suzannes receding from the camera, PN with adaptive levels for that
   camera (projected edge length, 18 px): the far ones get fewer triangles;
+- ``out/demo_tubes.png``: streamlines of an ABC flow (a wire mesh) turned into tubes with sides per tube
+  from the camera (level of detail: near tubes round, far ones triangular) and the pixel clamp;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
@@ -16,6 +18,7 @@ import time
 from pathlib import Path
 
 import bpy
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"
@@ -40,13 +43,13 @@ def material(name, rgba):
     return mat
 
 
-def wire_overlay(ob, mat):
+def wire_overlay(ob, mat, thickness=0.006):
     """A copy of ``ob`` drawn as thin wires (Wireframe modifier) so the triangles show in a render."""
     wire = bpy.data.objects.new(f"{ob.name}.wire", ob.data)
     bpy.context.scene.collection.objects.link(wire)
     wire.matrix_basis = ob.matrix_basis.copy()  # matrix_world is stale until the depsgraph updates
     mod = wire.modifiers.new("Wire", "WIREFRAME")
-    mod.thickness = 0.006
+    mod.thickness = thickness
     mod.use_replace = True
     mod.use_even_offset = False
     mod.material_offset = 0
@@ -123,6 +126,69 @@ def build_adaptive_scene():
     return counts
 
 
+def abc_streamlines(lines=220, steps=260, dt=0.05, seed=4):
+    """Streamlines of the Arnold-Beltrami-Childress flow (RK4) as (lines * steps, 3) points, in a 2π box."""
+    a, b, c = 1.0, np.sqrt(2 / 3), np.sqrt(1 / 3)
+
+    def field(p):
+        x, y, z = p[:, 0], p[:, 1], p[:, 2]
+        return np.stack((a * np.sin(z) + c * np.cos(y), b * np.sin(x) + a * np.cos(z), c * np.sin(y) + b * np.cos(x)),
+                        axis=1)
+
+    p = np.random.default_rng(seed).uniform(0, 2 * np.pi, (lines, 3))
+    out = np.empty((steps, lines, 3))
+    for k in range(steps):
+        out[k] = p
+        k1 = field(p)
+        k2 = field(p + 0.5 * dt * k1)
+        k3 = field(p + 0.5 * dt * k2)
+        k4 = field(p + dt * k3)
+        p = p + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    inside = np.all((out >= 0) & (out <= 2 * np.pi), axis=2)
+    inside = np.cumprod(inside, axis=0).astype(bool)  # cut each line where it first leaves the box
+    return out.transpose(1, 0, 2), inside.T
+
+
+def build_tubes_scene():
+    """Streamlines as a wire mesh, then tubes with camera LOD; returns (faces, sides range, seconds)."""
+    clear_scene()
+    points, inside = abc_streamlines()
+    verts, edges, base = [], [], 0
+    for line, keep in zip(points, inside, strict=True):
+        line = line[keep]
+        if len(line) < 2:
+            continue
+        verts.append(line)
+        edges.append(np.stack((np.arange(len(line) - 1), np.arange(1, len(line))), axis=1) + base)
+        base += len(line)
+    verts, edges = np.concatenate(verts).astype(np.float32), np.concatenate(edges).astype(np.int32)
+    me = bpy.data.meshes.new("ABC streamlines")
+    me.vertices.add(len(verts))
+    me.edges.add(len(edges))
+    me.vertices.foreach_set("co", verts.ravel())
+    me.edges.foreach_set("vertices", edges.ravel())
+    me.update()
+    lines = bpy.data.objects.new("ABC streamlines", me)
+    bpy.context.scene.collection.objects.link(lines)
+    lines.location = (-np.pi, -np.pi, -np.pi)
+    lines.data.materials.append(material("Tube", (0.25, 0.5, 0.85, 1.0)))
+    add_camera((0.0, -5.2, 0.9), (1.42, 0.0, 0.0), lens=18)
+    bpy.context.view_layer.update()
+    for ob in bpy.context.scene.objects:
+        ob.select_set(ob is lines)
+    bpy.context.view_layer.objects.active = lines
+    t0 = time.perf_counter()
+    result = bpy.ops.tessera.tubes(radius=0.045, sides_mode="CAMERA", min_sides=3, max_sides=16, edge_pixels=9,
+                                   aa_clamp=True, caps="ROUND", camera_source="SCENE", select_angle=np.radians(6))
+    elapsed = time.perf_counter() - t0
+    if result != {"FINISHED"}:
+        sys.exit(f"demo: tubes returned {result}")
+    tubes = bpy.context.active_object
+    bpy.data.objects.remove(lines)
+    wire_overlay(tubes, material("Wire", (0.02, 0.03, 0.08, 1.0)))
+    return len(tubes.data.polygons), elapsed
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -159,7 +225,10 @@ def main():
     counts = build_adaptive_scene()
     render("demo_adaptive.png")
     print(f"demo: adaptive PN for the camera, near to far: {counts} triangles")
-    for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png"):
+    faces, elapsed = build_tubes_scene()
+    render("demo_tubes.png")
+    print(f"demo: tubes around ABC-flow streamlines: {faces:,} faces in {elapsed:.2f} s")
+    for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
