@@ -1,11 +1,12 @@
 """Tubes against geometry nodes Curve to Mesh (circle profile) at the same output size, in one run.
 
 Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M vertices, 24.8 M quads.
-- ``kernel``: `kernels.tubes.build_tubes` (frames, rings, normals, quads, edges) against evaluating a
+- ``kernel_opencl`` / ``kernel_numpy``: `kernels.tubes.build_tubes` (frames, rings, normals, quads, edges;
+  OpenCL on PoCL, or the numpy reference) against evaluating a
   Curve to Mesh modifier on a poly hair-curves object with the same points (Blender builds the mesh with
   its own minimum-twist normals, multithreaded). Ratio > 1: Tessera is faster.
 - ``operator``: ``tessera.tubes`` end to end (read the hair, build, write a new mesh object) against the
-  same modifier evaluation plus copying its mesh into a new object (``bpy.data.meshes.new_from_object``).
+  same modifier evaluation plus copying its mesh into a new object (what applying the modifier costs).
 - ``memory``: peak resident memory of a fresh process building 1 M strands x 32 points with 3 sides,
   against the size of the output arrays.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tubes.py
@@ -81,7 +82,7 @@ def geometry_nodes(bpy, ob, copy_mesh):
         geometry = bpy.types.GeometrySet.from_evaluated_object(evaluated)
         n = len(geometry.mesh.vertices)
         if copy_mesh:
-            me = bpy.data.meshes.new_from_object(evaluated)
+            me = geometry.mesh.copy()  # the evaluated mesh into bpy.data, as applying the modifier would
             copy = bpy.data.objects.new("bench_copy", me)
             bpy.context.scene.collection.objects.link(copy)
             n = len(me.vertices)
@@ -96,13 +97,13 @@ def geometry_nodes(bpy, ob, copy_mesh):
     return min(r[0] for r in runs), runs[0][1]
 
 
-def kernel_case(pts):
+def kernel_case(pts, backend):
     from tessera.kernels.polylines import Polylines
     from tessera.kernels.tubes import TubeSettings, build_tubes
 
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
     settings = TubeSettings(sides=SIDES, caps="NONE", uvs=False)
-    seconds, mesh = best_of(lambda: len(build_tubes(lines, settings).positions))
+    seconds, mesh = best_of(lambda: len(build_tubes(lines, settings, backend=backend).positions))
     return seconds, mesh
 
 
@@ -161,15 +162,16 @@ def main():
     pts = strands(STRANDS, POINTS)
     ob = hair_object(bpy, pts)
     gn_eval, gn_verts = geometry_nodes(bpy, ob, copy_mesh=False)
-    ours, verts = kernel_case(pts)
-    print(json.dumps({"case": "kernel", "strands": STRANDS, "points": POINTS, "sides": SIDES, "vertices": verts,
-                      "baseline": "geometry nodes Curve to Mesh (evaluation)", "baseline_vertices": gn_verts,
-                      "seconds": round(ours, 3), "baseline_seconds": round(gn_eval, 3),
-                      "speed_ratio": round(gn_eval / ours, 2)}))
+    for backend in ("opencl", "numpy"):
+        ours, verts = kernel_case(pts, backend)
+        print(json.dumps({"case": f"kernel_{backend}", "strands": STRANDS, "points": POINTS, "sides": SIDES,
+                          "vertices": verts, "baseline": "geometry nodes Curve to Mesh (evaluation)",
+                          "baseline_vertices": gn_verts, "seconds": round(ours, 3),
+                          "baseline_seconds": round(gn_eval, 3), "speed_ratio": round(gn_eval / ours, 2)}))
     gn_copy, _ = geometry_nodes(bpy, ob, copy_mesh=True)
     op, op_verts = operator_case(bpy, ob)
     print(json.dumps({"case": "operator", "vertices": op_verts,
-                      "baseline": "Curve to Mesh evaluation + new_from_object", "seconds": round(op, 3),
+                      "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object", "seconds": round(op, 3),
                       "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / op, 2)}))
     print(json.dumps(memory_case()))
 

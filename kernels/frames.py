@@ -168,3 +168,34 @@ def _seam_correction(lines, t, r, q):
     per_curve = np.zeros(lines.n_curves)
     per_curve[cyc] = phi / np.maximum(total[cyc], _TINY)
     return per_curve[curve] * arc
+
+
+def rotation_minimizing_frames_opencl(runtime, lines, arc, total):
+    """The same frames from ``kernels/cl/tube_frames.cl`` (one work item per curve): t, n, b (P, 3) float32.
+
+    arc, total: from `polylines.arc_lengths`. Needs double precision on the device.
+    """
+    cl = runtime.cl
+    mf = cl.mem_flags
+    n_pts, n_curves = len(lines.points), lines.n_curves
+    out = [np.empty((n_pts, 3), np.float32) for _ in range(3)]
+    if n_pts == 0:
+        return tuple(out)
+    ctx = runtime.context
+
+    def buf(a):
+        return cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a))
+
+    args = [buf(lines.points.astype(np.float64)), buf(lines.offsets.astype(np.int64)),
+            buf(lines.cyclic.astype(np.uint8)), buf(lines.tilt.astype(np.float64)), buf(arc.astype(np.float64)),
+            buf(total.astype(np.float64))]
+    outs = [cl.Buffer(ctx, mf.WRITE_ONLY, o.nbytes) for o in out]
+    kernel = runtime.kernel("tube_frames", "tube_frames")
+    kernel(runtime.queue, (n_curves,), None, *args, *outs, np.int32(n_curves))
+    for host, dev in zip(out, outs, strict=True):
+        cl.enqueue_copy(runtime.queue, host, dev)
+    return tuple(out)
+
+
+def has_fp64(runtime):
+    return runtime is not None and "cl_khr_fp64" in runtime.device.extensions

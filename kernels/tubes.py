@@ -137,17 +137,21 @@ def prepare_lines(lines, settings):
     return lines
 
 
-def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None):
+def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, backend="auto"):
     """Tube mesh around every curve of ``lines`` (`polylines.Polylines`). Returns a `PolygonMesh`.
 
     Layout: tubes sorted by side count (stable, so FIXED keeps the curve order), bodies first, then caps.
     Output arrays are allocated once at their final size and written in chunks of curves, so memory stays
-    close to the output itself.
+    close to the output itself. ``backend``: "auto" (OpenCL when a device with doubles exists, else numpy),
+    "numpy" or "opencl" (the same numbering; values equal within float32 rounding).
     """
+    from .tubes_opencl import TubeDevice, runtime_for
+
     settings.validate(camera)
+    runtime = runtime_for(backend)
     lines = prepare_lines(lines, settings)
     report = progress or (lambda f: None)
-    frames = _frames(lines, settings, camera)
+    frames = _frames(lines, settings, camera, runtime)
     report(0.3)
     layout = _Layout(lines, frames["sides"], settings)
     mesh = layout.allocate(settings)
@@ -155,9 +159,12 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None):
     caps = []
     cursor = {"v": 0, "f": 0, "c": 0, "e": 0, "cap_v": layout.body_v, "cap_e": layout.body_e}
     units = list(layout.units())
+    device = TubeDevice(runtime, mesh) if runtime is not None else None
     for i, (n, curves) in enumerate(units):
-        _write_body(mesh, lines, frames, n, curves, cursor, settings, caps)
+        _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device)
         report(0.3 + 0.65 * (i + 1) / len(units))
+    if device is not None:
+        device.finish()
     _write_caps(mesh, caps, layout, settings)
     if settings.caps == "FLAT":
         mesh.corner_normals[: layout.body_c] = mesh.point_normals[mesh.corner_verts[: layout.body_c]]
@@ -169,8 +176,10 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None):
 def tube_sections(lines, settings, camera=None):
     """What a GPU draw of the tubes needs: the prepared `Polylines` and per point unit N, B (float32 (P, 3))
     and the radius before the anti-aliasing clamp (which the shader applies per frame); sides per curve."""
+    from .tubes_opencl import runtime_for
+
     lines = prepare_lines(lines, settings)
-    frames = _frames(lines, replace(settings, aa_clamp=False), camera)
+    frames = _frames(lines, replace(settings, aa_clamp=False), camera, runtime_for("auto"))
     return lines, frames
 
 
@@ -180,11 +189,16 @@ def lod_sides(lines, settings, camera):
     return tube_sides(lines, settings, pixel)
 
 
-def _frames(lines, settings, camera):
-    """Per point: unit T, N, B (float32), effective radius; per curve: sides. Chunked for memory."""
+def _frames(lines, settings, camera, runtime=None):
+    """Per point: unit T, N, B (float32), effective radius, arc length; per curve: sides and length.
+
+    Chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
+    from .frames import rotation_minimizing_frames_opencl
+
     n_pts = len(lines.points)
     out = {k: np.empty((n_pts, 3), np.float32) for k in ("t", "n", "b")}
     out["radius"] = np.empty(n_pts, np.float32)
+    out["arc"], out["total"] = np.empty(n_pts), np.empty(lines.n_curves)
     out["sides"] = np.empty(lines.n_curves, np.int64)
     for c0, c1 in chunks(lines, 1 << 20):
         sub = take_curves(lines, c0, c1)
@@ -196,9 +210,13 @@ def _frames(lines, settings, camera):
         if settings.aa_clamp:
             radius = effective_radius(radius, pixel, np.repeat(sides, sub.counts), settings.max_radius)
         out["radius"][p0:p1] = radius
-        t, nrm, bin_ = rotation_minimizing_frames(sub)
+        arc, total = arc_lengths(sub)
+        out["arc"][p0:p1], out["total"][c0:c1] = arc, total
+        if runtime is not None:
+            t, nrm, bin_ = rotation_minimizing_frames_opencl(runtime, sub, arc, total)
+        else:
+            t, nrm, bin_ = rotation_minimizing_frames(sub)
         out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = t, nrm, bin_
-    out["arc"], out["total"] = arc_lengths(lines)
     return out
 
 
@@ -263,13 +281,53 @@ def _unit_points(lines, curves):
     return idx, counts
 
 
-def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps):
-    """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
+def _unit_topology(lines, curves):
+    """Points and segments of one run of curves: a dict of per-point arrays (local ids)."""
     pick, counts = _unit_points(lines, curves)
     cyclic = lines.cyclic[curves]
     n_pts = int(counts.sum())
     local = np.concatenate(([0], np.cumsum(counts)))
     last = local[1:] - 1
+    # segments: every point but the last of an open curve; the last of a cyclic curve closes it
+    has_seg = np.ones(n_pts, bool)
+    has_seg[last[~cyclic]] = False
+    seg = np.nonzero(has_seg)[0]
+    nxt = seg + 1
+    closing = np.isin(seg, last[cyclic])
+    nxt[closing] = local[:-1][cyclic]
+    curve_of_point = np.repeat(np.arange(len(curves)), counts)
+    return {"pick": pick, "counts": counts, "cyclic": cyclic, "n_pts": n_pts, "local": local, "seg": seg,
+            "nxt": nxt, "closing": closing, "curve_of_point": curve_of_point}
+
+
+def _segment_u(frames, curves, unit):
+    """UV u at both ends of every segment: (S,) float32 each (a closing segment ends at u = 1)."""
+    arc = frames["arc"][unit["pick"]]
+    total = frames["total"][curves][unit["curve_of_point"]]
+    u = arc / np.maximum(total, 1e-300)
+    seg, nxt = unit["seg"], unit["nxt"]
+    return u[seg].astype(np.float32), np.where(unit["closing"], 1.0, u[nxt]).astype(np.float32)
+
+
+def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=None):
+    """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
+    unit = _unit_topology(lines, curves)
+    if device is not None:
+        device.write_body(mesh, lines, frames, n, curves, unit, cursor, settings)
+    else:
+        _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, settings)
+    if settings.caps != "NONE":
+        _collect_caps(lines, frames, n, curves, unit["pick"], unit["local"], unit["cyclic"], cursor["v"],
+                      cursor["e"], cursor, settings, caps)
+    n_pts, n_seg = unit["n_pts"], len(unit["seg"])
+    cursor["v"] += n_pts * n
+    cursor["f"] += n_seg * n
+    cursor["c"] += 4 * n_seg * n
+    cursor["e"] += (n_pts + n_seg) * n
+
+
+def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, settings):
+    pick, n_pts, seg, nxt = unit["pick"], unit["n_pts"], unit["seg"], unit["nxt"]
     v0, f0, c0, e0 = cursor["v"], cursor["f"], cursor["c"], cursor["e"]
 
     # vertices: radial directions (the normals), then centre + radius * radial
@@ -282,13 +340,6 @@ def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps):
     np.multiply(nrm_out, frames["radius"][pick][:, None, None], out=pos_out)
     pos_out += lines.points[pick].astype(np.float32)[:, None, :]
 
-    # segments: every point but the last of an open curve; the last of a cyclic curve closes it
-    has_seg = np.ones(n_pts, bool)
-    has_seg[last[~cyclic]] = False
-    seg = np.nonzero(has_seg)[0]
-    nxt = seg + 1
-    closing = np.isin(seg, last[cyclic])
-    nxt[closing] = local[:-1][cyclic]
     n_seg = len(seg)
     j = np.arange(n, dtype=np.int64)
     j1 = (j + 1) % n
@@ -307,25 +358,15 @@ def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps):
     ce[..., 0], ce[..., 1] = (e0 + seg * n)[:, None] + j, along + j1
     ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
     mesh.face_sizes[f0:f0 + n_seg * n] = 4
-    curve_of_point = np.repeat(np.arange(len(curves)), counts)
-    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][curve_of_point[seg]], n)
+    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][unit["curve_of_point"][seg]], n)
     if settings.uvs:
-        arc, total = frames["arc"][pick], frames["total"][curves][curve_of_point]
-        u = arc / np.maximum(total, 1e-300)
-        u0 = u[seg].astype(np.float32)
-        u1 = np.where(closing, 1.0, u[nxt]).astype(np.float32)
+        u0, u1 = _segment_u(frames, curves, unit)
         v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
         uv = mesh.corner_uvs[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4, 2)
         uv[:, :, 0, 0] = uv[:, :, 1, 0] = u0[:, None]
         uv[:, :, 2, 0] = uv[:, :, 3, 0] = u1[:, None]
         uv[:, :, 0, 1] = uv[:, :, 3, 1] = v_lo
         uv[:, :, 1, 1] = uv[:, :, 2, 1] = v_hi
-    if settings.caps != "NONE":
-        _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps)
-    cursor["v"] += n_pts * n
-    cursor["f"] += n_seg * n
-    cursor["c"] += 4 * n_seg * n
-    cursor["e"] += (n_pts + n_seg) * n
 
 
 def _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps):

@@ -2,12 +2,21 @@
 
 import numpy as np
 import pytest
+from tessera.kernels import opencl_runtime
 from tessera.kernels.camera import Camera
 from tessera.kernels.curve_refine import catmull_rom, select_points
 from tessera.kernels.errors import InvalidInputError
 from tessera.kernels.frames import rotation_minimizing_frames, tangents
 from tessera.kernels.polylines import Polylines, drop_duplicates
 from tessera.kernels.tubes import TubeSettings, build_tubes, pixel_world_size, prepare_lines
+
+
+@pytest.fixture(autouse=True)
+def numpy_reference():
+    """These tests check the numpy reference; tests/test_opencl.py compares the OpenCL path with it."""
+    opencl_runtime.configure(mode="0")
+    yield
+    opencl_runtime.configure()
 
 
 def helix(a=1.0, b=0.3, turns=2.0, n=400):

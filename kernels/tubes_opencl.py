@@ -1,0 +1,89 @@
+"""OpenCL paths of the tube kernel: frames (``cl/tube_frames.cl``) and bodies (``cl/tube_body.cl``).
+
+Same numbering and values as the numpy reference in `tubes` (tests compare them). The whole-mesh output
+arrays are shared with the device (``USE_HOST_PTR``: no copy on a CPU device such as PoCL) and mapped back
+once at the end.
+"""
+
+import numpy as np
+
+from .errors import OpenCLUnavailableError
+from .frames import has_fp64
+from .opencl_runtime import get_runtime
+
+BACKENDS = ("auto", "numpy", "opencl")
+
+
+def runtime_for(backend):
+    """The OpenCL runtime to use for ``backend``, or None for numpy."""
+    if backend == "numpy":
+        return None
+    runtime = get_runtime()
+    if runtime is not None and has_fp64(runtime):
+        return runtime
+    if backend == "opencl":
+        raise OpenCLUnavailableError("The tube kernels need an OpenCL device with double precision (cl_khr_fp64)")
+    return None
+
+
+class TubeDevice:
+    """Writes tube bodies into ``mesh`` (a preallocated `tubes.PolygonMesh`) with OpenCL."""
+
+    OUTPUTS = ("positions", "point_normals", "edges", "corner_verts", "corner_edges", "face_sizes", "face_material",
+               "corner_uvs")
+
+    def __init__(self, runtime, mesh):
+        self.runtime, self.mesh = runtime, mesh
+        cl = runtime.cl
+        flags = cl.mem_flags.READ_WRITE | cl.mem_flags.USE_HOST_PTR
+        self.buffers = {}
+        for name in self.OUTPUTS:
+            host = getattr(mesh, name)
+            if host is None or host.size == 0:
+                host = np.zeros(1, np.float32)  # a placeholder argument (e.g. no UVs)
+                setattr(self, f"_{name}_dummy", host)
+            self.buffers[name] = cl.Buffer(runtime.context, flags, hostbuf=host)
+
+    def _in(self, array, dtype):
+        cl = self.runtime.cl
+        a = np.ascontiguousarray(array, dtype=dtype)
+        if a.size == 0:
+            a = np.zeros(1, dtype)
+        return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=a)
+
+    def write_body(self, mesh, lines, frames, n, curves, unit, cursor, settings):
+        from .tubes import _segment_u
+
+        pick, n_pts = unit["pick"], unit["n_pts"]
+        seg_of = np.full(n_pts, -1, np.int32)
+        seg_of[unit["seg"]] = np.arange(len(unit["seg"]), dtype=np.int32)
+        nxt = np.zeros(n_pts, np.int32)
+        nxt[unit["seg"]] = unit["nxt"]
+        u0 = np.zeros(n_pts, np.float32)
+        u1 = np.zeros(n_pts, np.float32)
+        if settings.uvs:
+            u0[unit["seg"]], u1[unit["seg"]] = _segment_u(frames, curves, unit)
+        material = lines.material_index[curves][unit["curve_of_point"]]
+        b = self.buffers
+        kernel = self.runtime.kernel("tube_body", "tube_body")
+        kernel(self.runtime.queue, (max(n_pts, 1),), None,
+               self._in(lines.points[pick], np.float32), self._in(frames["n"][pick], np.float32),
+               self._in(frames["b"][pick], np.float32), self._in(frames["radius"][pick], np.float32),
+               self._in(seg_of, np.int32), self._in(nxt, np.int32), self._in(u0, np.float32),
+               self._in(u1, np.float32), self._in(material, np.int32),
+               np.int32(n), np.int32(n_pts), np.int32(len(unit["seg"])), np.int64(cursor["v"]), np.int64(cursor["e"]),
+               np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(bool(settings.uvs)),
+               b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
+               b["face_material"], b["corner_uvs"])
+
+    def finish(self):
+        """Wait for the device and make its writes visible in the host arrays."""
+        cl = self.runtime.cl
+        queue = self.runtime.queue
+        for name, buf in self.buffers.items():
+            host = getattr(self.mesh, name)
+            if host is None or host.size == 0:
+                continue
+            mapped, _ = cl.enqueue_map_buffer(queue, buf, cl.map_flags.READ, 0, host.shape, host.dtype)
+            mapped.base.release(queue)
+        queue.finish()
