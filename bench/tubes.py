@@ -171,7 +171,8 @@ def main():
     gn_copy, _ = geometry_nodes(bpy, ob, copy_mesh=True)
     op, op_verts = operator_case(bpy, ob)
     print(json.dumps({"case": "operator", "vertices": op_verts,
-                      "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object", "seconds": round(op, 3),
+                      "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object",
+                      "seconds": round(op, 3),
                       "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / op, 2)}))
     print(json.dumps(memory_case()))
 
