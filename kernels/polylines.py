@@ -111,8 +111,7 @@ def drop_duplicates(lines):
     # a point is dropped when the segment leaving it has zero length; on an open curve the last point stays
     # and its predecessor goes instead
     dup = has_next & (seg <= DUPLICATE_REL * extent)
-    keep = ~dup
-    out = lines.subset(keep)
+    out = lines.subset(~dup) if dup.any() else replace(lines, notes=list(lines.notes))
     keep_curves = out.counts >= 2
     removed = int(np.sum(~keep_curves))
     if removed:
