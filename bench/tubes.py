@@ -7,6 +7,9 @@ Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M ve
   its own minimum-twist normals, multithreaded). Ratio > 1: Tessera is faster.
 - ``operator``: ``tessera.tubes`` end to end (read the hair, build, write a new mesh object) against the
   same modifier evaluation plus copying its mesh into a new object (what applying the modifier costs).
+- ``preview_bytes``: what the GPU preview uploads (section texture: 48 B per section; patch tables: 16 B per
+  patch of up to 63 segments) against uploading the tube mesh for drawing (position + normal per vertex,
+  two triangles of 32-bit indices per quad): the seed's Table 4.2 argument.
 - ``memory``: peak resident memory of a fresh process building 1 M strands x 32 points with 3 sides,
   against the size of the output arrays.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tubes.py
@@ -124,6 +127,19 @@ def operator_case(bpy, ob):
     return best_of(run)
 
 
+def preview_case(pts):
+    from tessera.gpu_shaders.tube_preview import patch_table, section_order
+    from tessera.kernels.polylines import Polylines
+
+    lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
+    sections = len(section_order(lines)) * 48
+    patches = len(patch_table(lines)[0]) * 16
+    quads = STRANDS * (POINTS - 1) * SIDES
+    mesh = STRANDS * POINTS * SIDES * 24 + quads * 2 * 3 * 4
+    return {"case": "preview_bytes", "preview_upload_mib": round((sections + patches) / 2**20, 1),
+            "mesh_upload_mib": round(mesh / 2**20, 1), "ratio": round(mesh / (sections + patches), 1)}
+
+
 MEMORY_CHILD = """
 import resource, sys
 sys.path.insert(0, sys.argv[1])
@@ -174,6 +190,7 @@ def main():
                       "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object",
                       "seconds": round(op, 3),
                       "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / op, 2)}))
+    print(json.dumps(preview_case(pts)))
     print(json.dumps(memory_case()))
 
 

@@ -109,3 +109,35 @@ def test_poll_explains_itself(clean_scene, bpy_module):
     bpy = bpy_module
     with pytest.raises(RuntimeError, match="Select curves, hair curves or meshes"):
         bpy.ops.tessera.tubes()
+
+
+def test_poly_bezier_and_nurbs_splines_in_one_curve(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bridge = addon_module("addon.bridge")
+    cu = bpy.data.curves.new("Mixed", "CURVE")
+    cu.dimensions = "3D"
+    poly = cu.splines.new("POLY")
+    poly.points.add(3)
+    for i, p in enumerate(poly.points):
+        p.co = (i, 0, 0, 1)
+        p.radius = 1 + i
+    nurbs = cu.splines.new("NURBS")
+    nurbs.points.add(4)
+    for i, p in enumerate(nurbs.points):
+        p.co = (i, 2, (i % 2), 1)
+    nurbs.use_cyclic_u = True
+    bez = cu.splines.new("BEZIER")
+    bez.bezier_points.add(1)
+    bez.bezier_points[1].co = (0, 4, 3)
+    ob = bpy.data.objects.new("Mixed", cu)
+    bpy.context.scene.collection.objects.link(ob)
+    lines, notes = bridge.read_curve_object(ob, 0.1)
+    assert notes == [] and lines.n_curves == 3
+    assert list(lines.cyclic) == [False, True, False]
+    assert lines.counts[0] == 4 and np.allclose(lines.radius[:4], [0.1, 0.2, 0.3, 0.4])
+    assert lines.counts[2] == cu.resolution_u + 1
+    out = run_tubes(bpy, ob, radius=0.1, sides=6, caps="ROUND")
+    _, use = mesh_arrays(out.data)
+    assert np.all(use == 2) and not out.data.validate(verbose=False)
+    bpy.data.objects.remove(ob)
+    bpy.data.curves.remove(cu)
