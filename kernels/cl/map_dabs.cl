@@ -1,0 +1,160 @@
+// Displacement-map edits (seed 004 §5), one work item per texel of the dab's footprint tile.
+// A tile is rows y0.. and columns x0.. of a (H, W, C) float32 map, stored (h, w, C); texel (x, y) sits at
+// map[y, x]. Distances are to integer texel coordinates (seed M6). float4 operands map onto the channels:
+// C = 4: xyzw, C = 3: xyz, C = 1: z (the height). Every kernel has a numpy reference in kernels/map_dabs.py that
+// computes in the same float32 operations (contraction off), so results agree to the last bit in practice.
+#pragma OPENCL FP_CONTRACT OFF
+
+inline float texel_distance(const float2 pos, const int x, const int y)
+{
+  const float dx = (float)x - pos.x, dy = (float)y - pos.y;
+  return sqrt(dx * dx + dy * dy);
+}
+
+inline float operand(const float4 v, const int c, const int channels)
+{
+  if (channels == 1) {
+    return v.z;
+  }
+  return c == 0 ? v.x : (c == 1 ? v.y : (c == 2 ? v.z : v.w));
+}
+
+inline float falloff(const float t, const int kind)
+{
+  // t = d / r in [0, 1): 0 smooth, 1 sphere, 2 linear, 3 sharp, 4 constant
+  const float s = 1.0f - t;
+  if (kind == 0) {
+    return s * s * (3.0f - 2.0f * s);
+  }
+  if (kind == 1) {
+    return sqrt(1.0f - t * t);
+  }
+  if (kind == 2) {
+    return s;
+  }
+  if (kind == 3) {
+    return s * s;
+  }
+  return 1.0f;
+}
+
+#define TEXEL_SETUP                                  \
+  const int gx = get_global_id(0), gy = get_global_id(1); \
+  if (gx >= w || gy >= h) {                          \
+    return;                                          \
+  }                                                  \
+  const int x = x0 + gx, y = y0 + gy;                \
+  __global float *t = tile + ((long)gy * w + gx) * channels;
+
+__kernel void contact(__global float *tile, const int w, const int h, const int channels, const int x0,
+                      const int y0, const float2 pos, const float depth, const float radius)
+{
+  TEXEL_SETUP
+  if (texel_distance(pos, x, y) < radius) {
+    t[channels == 1 ? 0 : 2] -= depth;
+  }
+}
+
+__kernel void force(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
+                    const float2 pos, const float4 f, const float area)
+{
+  TEXEL_SETUP
+  const float dissipation = (area - texel_distance(pos, x, y)) / area;  // = 1 - d / R, exact at the seed's values
+  if (dissipation > 0.0f) {
+    for (int c = 0; c < channels; ++c) {
+      t[c] += operand(f, c, channels) * dissipation;
+    }
+  }
+}
+
+__kernel void test(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
+                   const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
+{
+  TEXEL_SETUP
+  if (texel_distance(arg1.xy, x, y) < arg3.x) {
+    for (int c = 0; c < channels; ++c) {
+      t[c] += operand(arg2, c, channels);
+    }
+  }
+}
+
+__kernel void morphing(__global const float *a, __global const float *b, __global float *out, const long n,
+                       const float time)
+{
+  const long i = get_global_id(0);
+  if (i < n) {
+    out[i] = a[i] * (1.0f - time) + b[i] * time;
+  }
+}
+
+__kernel void draw(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
+                   const float2 pos, const float radius, const float strength, const int kind, const float4 vec)
+{
+  TEXEL_SETUP
+  const float d = texel_distance(pos, x, y);
+  if (d < radius) {
+    const float k = strength * falloff(d / radius, kind);
+    for (int c = 0; c < channels; ++c) {
+      t[c] += operand(vec, c, channels) * k;
+    }
+  }
+}
+
+__kernel void flatten(__global float *tile, const int w, const int h, const int channels, const int x0,
+                      const int y0, const float2 pos, const float radius, const float strength, const int kind,
+                      const float4 target)
+{
+  TEXEL_SETUP
+  const float d = texel_distance(pos, x, y);
+  if (d < radius) {
+    const float k = strength * falloff(d / radius, kind);
+    for (int c = 0; c < channels; ++c) {
+      t[c] += (operand(target, c, channels) - t[c]) * k;
+    }
+  }
+}
+
+// smooth reads a halo tile `src` (hs x ws, origin sx0, sy0, clamped to the map) and writes `tile`
+__kernel void smooth(__global float *tile, const int w, const int h, const int channels, const int x0,
+                     const int y0, __global const float *src, const int ws, const int hs, const int sx0,
+                     const int sy0, const float2 pos, const float radius, const float strength, const int kind)
+{
+  TEXEL_SETUP
+  const float d = texel_distance(pos, x, y);
+  if (d < radius) {
+    const float k = strength * falloff(d / radius, kind);
+    for (int c = 0; c < channels; ++c) {
+      float sum = 0.0f;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int sx = clamp(x + dx - sx0, 0, ws - 1), sy = clamp(y + dy - sy0, 0, hs - 1);
+          sum += src[((long)sy * ws + sx) * channels + c];
+        }
+      }
+      t[c] += (sum / 9.0f - t[c]) * k;
+    }
+  }
+}
+
+// stamp: add strength * (bilinear sample of a (sh, sw, channels) stamp map), rotated by `angle` and scaled
+__kernel void stamp(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
+                    __global const float *st, const int sw, const int sh, const float2 pos, const float2 rot,
+                    const float scale, const float strength)
+{
+  TEXEL_SETUP
+  const float dx = (float)x - pos.x, dy = (float)y - pos.y;
+  const float u = (rot.x * dx + rot.y * dy) / scale + 0.5f * (float)(sw - 1);
+  const float v = (rot.x * dy - rot.y * dx) / scale + 0.5f * (float)(sh - 1);
+  if (u < 0.0f || v < 0.0f || u > (float)(sw - 1) || v > (float)(sh - 1)) {
+    return;
+  }
+  const int iu = min((int)u, sw - 2 < 0 ? 0 : sw - 2), iv = min((int)v, sh - 2 < 0 ? 0 : sh - 2);
+  const float fu = u - (float)iu, fv = v - (float)iv;
+  const int iu1 = min(iu + 1, sw - 1), iv1 = min(iv + 1, sh - 1);
+  for (int c = 0; c < channels; ++c) {
+    const float a = st[((long)iv * sw + iu) * channels + c], b = st[((long)iv * sw + iu1) * channels + c];
+    const float p = st[((long)iv1 * sw + iu) * channels + c], q = st[((long)iv1 * sw + iu1) * channels + c];
+    const float top = a + (b - a) * fu, bottom = p + (q - p) * fu;
+    t[c] += strength * (top + (bottom - top) * fv);
+  }
+}

@@ -1,0 +1,277 @@
+"""Applying dabs to a displacement map: validation, footprints, and the OpenCL or numpy kernel.
+
+`apply_dab(map, kind, backend=..., **params)` edits ``map`` (H, W, C) float32 in place, touching only the
+dab's footprint (a tile: the bounding box of the disc, clipped to the map), and returns that tile's
+``(x0, y0, x1, y1)``. Bad parameters (NaN, a force whose radius |f.xyz|·f.w is not positive, a stamp with the
+wrong channel count) and NaN inside the footprint raise `InvalidInputError` before anything is written, so
+the map is unchanged. OpenCL (``cl/map_dabs.cl``) and numpy (`map_dabs`) give the same result.
+
+`compile_custom` builds a user kernel body into the seed's custom template; compiler errors come back as
+`TesseraError` with the compiler log.
+"""
+
+import numpy as np
+
+from . import map_dabs as ref
+from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+from .opencl_runtime import get_runtime
+
+KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP")
+BACKENDS = ("auto", "numpy", "opencl")
+_FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
+
+
+def check_map(dmap):
+    """A displacement map must be a writable, C-contiguous (H, W, C) float32 array with C in 1, 3, 4."""
+    if not isinstance(dmap, np.ndarray) or dmap.dtype != np.float32 or dmap.ndim != 3 or dmap.shape[2] not in (1, 3, 4):
+        raise InvalidInputError("A displacement map is a float32 array of shape (height, width, 1, 3 or 4)")
+    if not dmap.flags.c_contiguous or not dmap.flags.writeable:
+        raise InvalidInputError("The displacement map must be a writable, contiguous array")
+    return dmap
+
+
+def _finite(name, value):
+    v = np.asarray(value, np.float64)
+    if not np.all(np.isfinite(v)):
+        raise InvalidInputError(f"Dab parameter {name!r} must be finite; got {value!r}")
+    return v
+
+
+def footprint(shape, pos, radius):
+    """Tile ``(x0, y0, x1, y1)`` (end exclusive) of the texels with distance < radius, clipped; None if empty."""
+    h, w = shape[:2]
+    x0 = max(0, int(np.floor(pos[0] - radius)))
+    y0 = max(0, int(np.floor(pos[1] - radius)))
+    x1 = min(w, int(np.ceil(pos[0] + radius)) + 1)
+    y1 = min(h, int(np.ceil(pos[1] + radius)) + 1)
+    if x1 <= x0 or y1 <= y0 or radius <= 0:
+        return None
+    return x0, y0, x1, y1
+
+
+def _plan(dmap, kind, p):
+    """Validated (region, numpy function, OpenCL kernel name, OpenCL scalar args) for one dab."""
+    channels = dmap.shape[2]
+    f32 = np.float32
+    if kind == "CONTACT":
+        pos, depth, radius = _finite("pos", p["pos"]), _finite("depth", p["depth"]), _finite("radius", p["radius"])
+        region = footprint(dmap.shape, pos, float(radius))
+        args = (_f2(pos), f32(depth), f32(radius))
+        return region, lambda t, x0, y0: ref.contact(t, x0, y0, pos, depth, radius), "contact", args
+    if kind == "FORCE":
+        pos, f = _finite("pos", p["pos"]), _finite("force", p["force"])
+        area = ref.force_area(f)
+        if not area > 0:
+            raise InvalidInputError(f"The force's radius |f.xyz| * f.w must be positive; got {float(area):g} "
+                                    f"(f = {tuple(float(x) for x in f)})")
+        region = footprint(dmap.shape, pos, float(area))
+        return region, lambda t, x0, y0: ref.force(t, x0, y0, pos, f), "force", (_f2(pos), _f4(f), f32(area))
+    if kind == "TEST":
+        args = [_finite(f"arg{i}", p.get(f"arg{i}", (0, 0, 0, 0))) for i in range(1, 5)]
+        region = footprint(dmap.shape, args[0][:2], float(args[2][0]))
+        return (region, lambda t, x0, y0: ref.test(t, x0, y0, *args), "test", tuple(_f4(a) for a in args))
+    if kind in ("DRAW", "FLATTEN", "SMOOTH"):
+        pos, radius = _finite("pos", p["pos"]), float(_finite("radius", p["radius"]))
+        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
+                                                                                       p.get("pressure", 1.0)))
+        kind_name = p.get("falloff", "SMOOTH")
+        if kind_name not in _FALLOFF_ID:
+            raise InvalidInputError(f"Falloff must be one of {ref.FALLOFFS}; got {kind_name!r}")
+        region = footprint(dmap.shape, pos, radius)
+        base = (_f2(pos), f32(radius), f32(strength), np.int32(_FALLOFF_ID[kind_name]))
+        if kind == "DRAW":
+            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
+            return (region, lambda t, x0, y0: ref.draw(t, x0, y0, pos, radius, strength, kind_name, vec), "draw",
+                    base + (_f4(vec),))
+        if kind == "FLATTEN":
+            target = p.get("target")
+            if target is None and region is not None:
+                x0, y0, x1, y1 = region
+                target = _flatten_target(dmap[y0:y1, x0:x1], x0, y0, pos, radius)
+            target = _finite("target", target if target is not None else (0, 0, 0, 0))
+            return (region, lambda t, x0, y0: ref.flatten(t, x0, y0, pos, radius, strength, kind_name, target),
+                    "flatten", base + (_f4(target),))
+        return (region, lambda t, x0, y0, src, sx0, sy0: ref.smooth(t, x0, y0, src, sx0, sy0, pos, radius, strength,
+                                                                     kind_name), "smooth", base)
+    if kind == "STAMP":
+        st = p["stamp"]
+        if not isinstance(st, np.ndarray) or st.ndim != 3 or st.shape[2] != channels or st.shape[0] < 1:
+            raise InvalidInputError(f"The stamp must be a (height, width, {channels}) array like the map")
+        st = np.ascontiguousarray(st, np.float32)
+        if not np.all(np.isfinite(st)):
+            raise InvalidInputError("The stamp contains NaN or infinite values")
+        pos, scale = _finite("pos", p["pos"]), float(_finite("scale", p.get("scale", 1.0)))
+        if scale <= 0:
+            raise InvalidInputError("The stamp scale must be positive")
+        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
+                                                                                       p.get("pressure", 1.0)))
+        rot = ref.stamp_rotation(float(_finite("angle", p.get("angle", 0.0))))
+        region = footprint(dmap.shape, pos, ref.stamp_extent(st.shape, scale) + 1.0)
+        return (region, lambda t, x0, y0: ref.stamp(t, x0, y0, st, pos, rot, scale, strength), "stamp",
+                (st, _f2(pos), rot, f32(scale), f32(strength)))
+    raise InvalidInputError(f"Unknown dab kind {kind!r}; expected one of {', '.join(KINDS)}")
+
+
+def _flatten_target(tile, x0, y0, pos, radius):
+    """The falloff-free mean of the texels inside the disc, as a float4 (xyz(w) or z for height maps)."""
+    h, w, c = tile.shape
+    inside = ref.texel_distance(x0, y0, w, h, pos) < np.float32(radius)
+    mean = tile[inside].astype(np.float64).mean(axis=0) if inside.any() else np.zeros(c)
+    out = np.zeros(4)
+    if c == 1:
+        out[2] = mean[0]
+    else:
+        out[:c] = mean
+    return out
+
+
+def _f2(v):
+    return np.array(np.asarray(v, np.float64)[:2], np.float32).view(_float2())[0]
+
+
+def _f4(v):
+    return np.array(np.asarray(v, np.float64).reshape(4), np.float32).view(_float4())[0]
+
+
+def _float2():
+    return np.dtype([("x", np.float32), ("y", np.float32)])
+
+
+def _float4():
+    return np.dtype([("x", np.float32), ("y", np.float32), ("z", np.float32), ("w", np.float32)])
+
+
+def _runtime(backend):
+    if backend not in BACKENDS:
+        raise InvalidInputError(f"backend must be one of {BACKENDS}; got {backend!r}")
+    if backend == "numpy":
+        return None
+    runtime = get_runtime()
+    if runtime is None and backend == "opencl":
+        raise OpenCLUnavailableError("OpenCL was requested for the map edit but no device is available")
+    return runtime
+
+
+def apply_dab(dmap, kind, backend="auto", **params):
+    """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map."""
+    check_map(dmap)
+    region, numpy_fn, cl_name, cl_args = _plan(dmap, kind, params)
+    if region is None:
+        return None
+    x0, y0, x1, y1 = region
+    halo = None
+    if kind == "SMOOTH":
+        hx0, hy0 = max(0, x0 - 1), max(0, y0 - 1)
+        hx1, hy1 = min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1)
+        halo = (hx0, hy0, np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
+        if not np.all(np.isfinite(halo[2])):
+            raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
+    tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+    if not np.all(np.isfinite(tile)):
+        raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
+    runtime = _runtime(backend)
+    if runtime is None:
+        if kind == "SMOOTH":
+            numpy_fn(tile, x0, y0, halo[2], halo[0], halo[1])
+        else:
+            numpy_fn(tile, x0, y0)
+    else:
+        _run_opencl(runtime, tile, x0, y0, cl_name, cl_args, halo)
+    dmap[y0:y1, x0:x1] = tile
+    return region
+
+
+def _run_opencl(runtime, tile, x0, y0, name, args, halo):
+    cl = runtime.cl
+    mf = cl.mem_flags
+    h, w, c = tile.shape
+    ctx = runtime.context
+    d_tile = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile)
+    extra = []
+    if name == "smooth":
+        hx0, hy0, src = halo
+        extra = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=src), np.int32(src.shape[1]),
+                 np.int32(src.shape[0]), np.int32(hx0), np.int32(hy0)]
+    if name == "stamp":
+        st = args[0]
+        extra = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=st), np.int32(st.shape[1]),
+                 np.int32(st.shape[0])]
+        args = args[1:]
+    kernel = runtime.kernel("map_dabs", name)
+    kernel(runtime.queue, (w, h), None, d_tile, np.int32(w), np.int32(h), np.int32(c), np.int32(x0), np.int32(y0),
+           *extra, *args)
+    cl.enqueue_copy(runtime.queue, tile, d_tile)
+
+
+def morph(a, b, time, backend="auto"):
+    """Seed morphing: a new map a * (1 - t) + b * t; ``a`` and ``b`` are not modified."""
+    check_map(a)
+    check_map(b)
+    if a.shape != b.shape:
+        raise InvalidInputError(f"Morphing needs two maps of the same shape; got {a.shape} and {b.shape}")
+    t = float(_finite("time", time))
+    runtime = _runtime(backend)
+    if runtime is None:
+        return ref.morphing(a, b, t)
+    cl = runtime.cl
+    mf = cl.mem_flags
+    out = np.empty_like(a)
+    d_a = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
+    d_b = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=b)
+    d_out = cl.Buffer(runtime.context, mf.WRITE_ONLY, out.nbytes)
+    runtime.kernel("map_dabs", "morphing")(runtime.queue, (a.size,), None, d_a, d_b, d_out, np.int64(a.size),
+                                          np.float32(t))
+    cl.enqueue_copy(runtime.queue, out, d_out)
+    return out
+
+
+CUSTOM_TEMPLATE = """
+#pragma OPENCL FP_CONTRACT OFF
+__kernel void custom(__global float *tile, const int w, const int h, const int channels, const int x0,
+                     const int y0, const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
+{
+  const int gx = get_global_id(0), gy = get_global_id(1);
+  if (gx >= w || gy >= h) {
+    return;
+  }
+  const int x = x0 + gx, y = y0 + gy;
+  __global float *t = tile + ((long)gy * w + gx) * channels;
+  float4 image = (float4)(0.0f);
+  if (channels == 1) { image.z = t[0]; } else { for (int c = 0; c < channels; ++c) { ((float *)&image)[c] = t[c]; } }
+  (void)x; (void)y; (void)arg1; (void)arg2; (void)arg3; (void)arg4;
+#line 1 "custom body"
+%s
+  if (channels == 1) { t[0] = image.z; } else { for (int c = 0; c < channels; ++c) { t[c] = ((float *)&image)[c]; } }
+}
+"""
+
+
+def compile_custom(runtime, body):
+    """Build a custom kernel: ``body`` edits ``float4 image`` at texel (x, y) with arg1..arg4 (seed §5.7).
+
+    Raises `TesseraError` with the compiler log on a compile error. Returns the kernel.
+    """
+    cl = runtime.cl
+    try:
+        program = cl.Program(runtime.context, CUSTOM_TEMPLATE % body).build()
+    except cl.RuntimeError as err:
+        raise TesseraError(f"The custom kernel failed to compile:\n{err}") from err
+    return cl.Kernel(program, "custom")
+
+
+def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4):
+    """Run a compiled custom kernel over ``region`` (default: the whole map) in place; returns the region."""
+    check_map(dmap)
+    h, w = dmap.shape[:2]
+    x0, y0, x1, y1 = region or (0, 0, w, h)
+    vals = [_f4(_finite(f"arg{i + 1}", a)) for i, a in enumerate(args)]
+    tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+    cl = runtime.cl
+    d_tile = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
+    kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int32(x1 - x0), np.int32(y1 - y0),
+           np.int32(dmap.shape[2]), np.int32(x0), np.int32(y0), *vals)
+    cl.enqueue_copy(runtime.queue, tile, d_tile)
+    if not np.all(np.isfinite(tile)):
+        raise TesseraError("The custom kernel produced NaN or infinite values; the map was left unchanged")
+    dmap[y0:y1, x0:x1] = tile
+    return x0, y0, x1, y1
