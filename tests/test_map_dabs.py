@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tessera.kernels.errors import InvalidInputError
 from tessera.kernels.map_edit import apply_dab, morph
 
