@@ -119,6 +119,16 @@ def _set_custom_normals(mesh, normals, domain="CORNER"):
         mesh.normals_split_custom_set(normals)
 
 
+def _add_geometry(mesh, positions, corner_verts, loop_starts):
+    """Allocate and fill vertices (V, 3) float32, corners (L,) int32 and faces (F,) int32 loop starts."""
+    mesh.vertices.add(len(positions))
+    mesh.loops.add(len(corner_verts))
+    mesh.polygons.add(len(loop_starts))
+    mesh.attributes["position"].data.foreach_set("vector", positions.ravel())
+    mesh.attributes[".corner_vert"].data.foreach_set("value", corner_verts)
+    mesh.polygons.foreach_set("loop_start", loop_starts)
+
+
 def write_mesh(name, arrays, info=None):
     """Create a new `bpy.types.Mesh` from triangle `MeshArrays` and return it.
 
@@ -131,12 +141,7 @@ def write_mesh(name, arrays, info=None):
     n_tris = len(tris)
     mesh = bpy.data.meshes.new(name)
     try:
-        mesh.vertices.add(len(positions))
-        mesh.loops.add(3 * n_tris)
-        mesh.polygons.add(n_tris)
-        mesh.attributes["position"].data.foreach_set("vector", positions.ravel())
-        mesh.attributes[".corner_vert"].data.foreach_set("value", tris.ravel())
-        mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * n_tris, 3, dtype=np.int32))
+        _add_geometry(mesh, positions, tris.ravel(), np.arange(0, 3 * n_tris, 3, dtype=np.int32))
         mesh.update(calc_edges=True)
 
         domains = (
@@ -186,15 +191,11 @@ def write_polygons(name, poly):
     marked sharp, so Blender's own normals keep the rim crisp). UVs go to the map "UVMap", materials to
     ``material_index``. Removes the half-built mesh if anything fails.
     """
-    n_v, n_f, n_c = len(poly.positions), len(poly.face_sizes), len(poly.corner_verts)
+    n_f = len(poly.face_sizes)
+    starts = poly.face_offsets[:-1]  # a cumulative sum: computed once
     mesh = bpy.data.meshes.new(name)
     try:
-        mesh.vertices.add(n_v)
-        mesh.loops.add(n_c)
-        mesh.polygons.add(n_f)
-        mesh.attributes["position"].data.foreach_set("vector", np.ascontiguousarray(poly.positions).ravel())
-        mesh.attributes[".corner_vert"].data.foreach_set("value", poly.corner_verts)
-        mesh.polygons.foreach_set("loop_start", poly.face_offsets[:-1].astype(np.int32))
+        _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts.astype(np.int32))
         if poly.edges is not None:
             mesh.edges.add(len(poly.edges))
             mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(poly.edges).ravel())
@@ -204,9 +205,9 @@ def write_polygons(name, poly):
             mesh.update(calc_edges=True)
         if poly.corner_normals is not None:
             corner_face = np.repeat(np.arange(n_f), poly.face_sizes)
-            first = poly.corner_normals[poly.face_offsets[:-1]]
+            first = poly.corner_normals[starts]
             flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < 1e-6, axis=1)
-            sharp = np.logical_and.reduceat(flat, poly.face_offsets[:-1])
+            sharp = np.logical_and.reduceat(flat, starts)
             _new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", sharp)
         if poly.corner_uvs is not None:
             uv = _new_attribute(mesh, "UVMap", "FLOAT2", "CORNER")

@@ -5,6 +5,12 @@ import numpy as np
 from ..kernels.camera import Camera
 from ..kernels.errors import InvalidInputError
 
+#: The camera choice of every view-dependent setting (adaptive levels, tube sides, the pixel clamp).
+CAMERA_ITEMS = (
+    ("SCENE", "Scene Camera", "The scene camera at the render resolution (render and export)"),
+    ("VIEWPORT", "Viewport", "The active 3D viewport"),
+)
+
 
 def scene_camera(context):
     """The scene camera at the render resolution. Raises `InvalidInputError` when the scene has none."""

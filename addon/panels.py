@@ -7,12 +7,17 @@ from .tube_settings import copy_tube_settings, draw_tube_settings
 from .tube_sources import SOURCE_TYPES
 
 
-class TESSERA_PT_tessellate(bpy.types.Panel):
-    bl_idname = "TESSERA_PT_tessellate"
-    bl_label = "Tessellate"
+class _Sidebar:
+    """Where Tessera's panels live: View3D > Sidebar > Tessera."""
+
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = "Tessera"
+
+
+class TESSERA_PT_tessellate(_Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_tessellate"
+    bl_label = "Tessellate"
 
     @classmethod
     def poll(cls, context):
@@ -28,12 +33,9 @@ class TESSERA_PT_tessellate(bpy.types.Panel):
         op.use_object_settings = True
 
 
-class TESSERA_PT_tubes(bpy.types.Panel):
+class TESSERA_PT_tubes(_Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_tubes"
     bl_label = "Tubes"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Tessera"
 
     @classmethod
     def poll(cls, context):

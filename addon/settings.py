@@ -11,6 +11,7 @@ import bpy
 from ..kernels.adaptive import AdaptiveSettings
 from ..kernels.partition import MAX_LEVEL
 from ..kernels.tessellate import SurfaceOptions
+from .cameras import CAMERA_ITEMS
 from .tube_settings import TESSERA_PG_tubes
 
 METHOD_ITEMS = (
@@ -50,10 +51,6 @@ POWER_ITEMS = (
 DISTANCE_MAP_ITEMS = (
     ("LINEAR", "Linear", "Level falls linearly from near to far"),
     ("INVERSE", "Inverse", "Level falls like a z-buffer: most detail close to the camera"),
-)
-CAMERA_ITEMS = (
-    ("SCENE", "Scene Camera", "Levels for the scene camera (render and export)"),
-    ("VIEWPORT", "Viewport", "Levels for the active 3D viewport"),
 )
 OUTPUT_ITEMS = (
     ("NEW_OBJECT", "New Object", "Create a new object beside the source (from the evaluated mesh, with modifiers)"),

@@ -6,6 +6,7 @@ import math
 import bpy
 
 from ..kernels.tubes import TubeSettings
+from .cameras import CAMERA_ITEMS
 
 RADIUS_ITEMS = (
     ("POINT", "From Points", "Curves: point radius times Radius (like a bevel); hair: its 'radius' attribute "
@@ -25,10 +26,6 @@ CAP_ITEMS = (
 REFINE_ITEMS = (
     ("CENTRIPETAL", "Centripetal", "Catmull-Rom with centripetal knots: no cusps or loops inside a segment"),
     ("UNIFORM", "Uniform", "Catmull-Rom with uniform knots (the classic spline)"),
-)
-CAMERA_ITEMS = (
-    ("SCENE", "Scene Camera", "Level of detail and clamp for the scene camera (render and export)"),
-    ("VIEWPORT", "Viewport", "Level of detail and clamp for the active 3D viewport"),
 )
 
 

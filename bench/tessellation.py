@@ -15,20 +15,11 @@ import json
 import time
 
 import numpy as np
-from _setup import enable_extension, import_path
+from _setup import best_of, enable_extension, import_path
 
 LEVEL = 26  # 968 * floor(3 * 26^2 / 2) = 981,552 triangles
 SUBSURF_LEVEL = 5  # 1,007,616 triangles
 REPEAT = 5
-
-
-def best_of(fn, repeat=REPEAT):
-    best, result = float("inf"), None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, result
 
 
 def suzanne(bpy):

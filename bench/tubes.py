@@ -21,7 +21,7 @@ import sys
 import time
 
 import numpy as np
-from _setup import enable_extension, import_path
+from _setup import best_of, enable_extension, import_path
 
 STRANDS, POINTS, SIDES, RADIUS = 100_000, 32, 8, 0.005
 REPEAT = 3
@@ -33,15 +33,6 @@ def strands(count, points, seed=0):
     steps = rng.normal(scale=0.02, size=(count, points, 3))
     steps[:, :, 2] += 0.05
     return (roots + np.cumsum(steps, axis=1)).reshape(-1, 3)
-
-
-def best_of(fn, repeat=REPEAT):
-    best, result = float("inf"), None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, result
 
 
 def hair_object(bpy, pts):
@@ -106,7 +97,7 @@ def kernel_case(pts, backend):
 
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
     settings = TubeSettings(sides=SIDES, caps="NONE", uvs=False)
-    seconds, mesh = best_of(lambda: len(build_tubes(lines, settings, backend=backend).positions))
+    seconds, mesh = best_of(lambda: len(build_tubes(lines, settings, backend=backend).positions), REPEAT)
     return seconds, mesh
 
 
@@ -124,7 +115,7 @@ def operator_case(bpy, ob):
         bpy.data.meshes.remove(me)
         return n
 
-    return best_of(run)
+    return best_of(run, REPEAT)
 
 
 def preview_case(pts):

@@ -10,22 +10,39 @@ import numpy as np
 from . import loader
 
 
-def _describe_flat_mesh():
+def shaded_create_info(name, vertex_file):
+    """A create-info with the shading every Tessera check shader shares: a ``shade`` varying, the push
+    constants ``view_projection``, ``color``, ``light_dir``, ``lit_range`` and ``flat_mesh_frag.glsl``.
+    The caller adds its vertex inputs, other constants and samplers."""
     import gpu
 
-    iface = gpu.types.GPUStageInterfaceInfo("tessera_flat_mesh_iface")
+    iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
     iface.smooth("FLOAT", "shade")
     info = gpu.types.GPUShaderCreateInfo()
     info.push_constant("MAT4", "view_projection")
     info.push_constant("VEC4", "color")
     info.push_constant("VEC3", "light_dir")
     info.push_constant("VEC2", "lit_range")
-    info.vertex_in(0, "VEC3", "pos")
-    info.vertex_in(1, "VEC3", "nor")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(loader.source("flat_mesh_vert.glsl"))
+    info.vertex_source(loader.source(vertex_file))
     info.fragment_source(loader.source("flat_mesh_frag.glsl"))
+    return info
+
+
+def set_shading(shader, view_projection, color, lit):
+    """Bind ``shader`` and set the shared constants; view_projection: (4, 4) row-major."""
+    shader.bind()
+    shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
+    shader.uniform_float("color", tuple(color))
+    shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
+    shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
+
+
+def _describe_flat_mesh():
+    info = shaded_create_info("flat_mesh", "flat_mesh_vert.glsl")
+    info.vertex_in(0, "VEC3", "pos")
+    info.vertex_in(1, "VEC3", "nor")
     return info
 
 
@@ -47,11 +64,7 @@ def render_triangles(positions, triangles, view_projection, size=(256, 256), col
     batch = batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
 
     def draw():
-        shader.bind()
-        shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
-        shader.uniform_float("color", tuple(color))
-        shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
-        shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
+        set_shading(shader, view_projection, color, lit)
         batch.draw(shader)
 
     return render(draw, size, background)

@@ -10,22 +10,15 @@ share their boundary section, so the tube is watertight. The vertex shader appli
 import numpy as np
 
 from . import loader
+from .offscreen import set_shading, shaded_create_info
 
 TEX_WIDTH = 4096
 SECTIONS_PER_PATCH = 64  # 63 segments; the last section is the next patch's first
 
 
 def _describe():
-    import gpu
-
-    iface = gpu.types.GPUStageInterfaceInfo("tessera_tube_iface")
-    iface.smooth("FLOAT", "shade")
-    info = gpu.types.GPUShaderCreateInfo()
-    info.push_constant("MAT4", "view_projection")
+    info = shaded_create_info("tube", "tube_vert.glsl")
     info.push_constant("MAT4", "inverse_view_projection")
-    info.push_constant("VEC4", "color")
-    info.push_constant("VEC3", "light_dir")
-    info.push_constant("VEC2", "lit_range")
     info.push_constant("VEC2", "clamp_radius")
     info.push_constant("FLOAT", "sides")
     info.push_constant("FLOAT", "viewport_width")
@@ -33,10 +26,6 @@ def _describe():
     info.sampler(0, "FLOAT_2D", "sections")
     info.sampler(1, "FLOAT_2D", "patches")
     info.vertex_in(0, "VEC2", "ij")
-    info.vertex_out(iface)
-    info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(loader.source("tube_vert.glsl"))
-    info.fragment_source(loader.source("flat_mesh_frag.glsl"))
     return info
 
 
@@ -134,12 +123,8 @@ class TubeDrawData:
         """Draw into the bound framebuffer. view_projection: (4, 4) row-major, object space to clip."""
         shader = loader.shader("tube_preview", _describe)
         vp = np.asarray(view_projection, np.float64)
-        shader.bind()
-        shader.uniform_float("view_projection", vp.astype(np.float32).T.ravel().tolist())
+        set_shading(shader, vp, color, lit)
         shader.uniform_float("inverse_view_projection", np.linalg.inv(vp).astype(np.float32).T.ravel().tolist())
-        shader.uniform_float("color", tuple(color))
-        shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
-        shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
         shader.uniform_float("clamp_radius", (1.0 if clamp else 0.0, max_radius))
         shader.uniform_float("viewport_width", float(viewport_width))
         shader.uniform_int("tex_width", TEX_WIDTH)

@@ -52,17 +52,14 @@ def catmull_rom(lines, subdivisions, kind="CENTRIPETAL"):
     t = k1[:, None] + s[None, :] * (k2 - k1)[:, None]  # (S, n)
     k0 = np.zeros_like(k1)
 
-    def lerp(pa, pb, ta, tb):
-        w = ((t - ta[:, None]) / (tb - ta)[:, None])[..., None]
-        return (1 - w) * pa[:, None] + w * pb[:, None]
-
-    a1 = lerp(p0, p1, k0, k1)
-    a2 = lerp(p1, p2, k1, k2)
-    a3 = lerp(p2, p3, k2, k3)
+    p0, p1, p2, p3 = (p[:, None] for p in (p0, p1, p2, p3))  # (S, 1, 3) against the (S, n) samples
+    a1 = _lerp_pyramid(p0, p1, t, k0, k1)
+    a2 = _lerp_pyramid(p1, p2, t, k1, k2)
+    a3 = _lerp_pyramid(p2, p3, t, k2, k3)
     b1 = _lerp_pyramid(a1, a2, t, k0, k2)
     b2 = _lerp_pyramid(a2, a3, t, k1, k3)
     c = _lerp_pyramid(b1, b2, t, k1, k2)
-    c[:, 0] = p1  # exactly the input point
+    c[:, 0] = p1[:, 0]  # exactly the input point
 
     curve_of_seg = lines.curve_of_point()[i1]
     counts = np.bincount(curve_of_seg, minlength=lines.n_curves) * n_sub
@@ -88,6 +85,7 @@ def catmull_rom(lines, subdivisions, kind="CENTRIPETAL"):
 
 
 def _lerp_pyramid(pa, pb, t, ta, tb):
+    """One level of the Barry-Goldman pyramid: blend pa -> pb as t (S, n) runs from ta to tb (S,)."""
     w = ((t - ta[:, None]) / (tb - ta)[:, None])[..., None]
     return (1 - w) * pa + w * pb
 

@@ -127,16 +127,15 @@ def rotation_minimizing_frames(lines, t=None):
         return empty, empty, empty
     prev = np.arange(-1, n - 1)
     steps = np.zeros((n, 4))
+    nonempty = lines.counts > 0
+    firsts = lines.offsets[:-1][nonempty]
     inner = np.ones(n, bool)
-    inner[lines.offsets[:-1][lines.counts > 0]] = False
+    inner[firsts] = False
     k = np.nonzero(inner)[0]
     steps[k] = step_rotations(np.stack((pts[prev[k]], pts[k]), axis=1), t[prev[k]], t[k])
     q = prefix_rotations(steps, lines.offsets)
-    starts = np.repeat(lines.offsets[:-1], lines.counts)
-    r0 = any_perpendicular(t[lines.offsets[:-1][lines.counts > 0]])
-    r0_all = np.zeros_like(pts)
-    r0_all[lines.offsets[:-1][lines.counts > 0]] = r0
-    r = rotate(q, r0_all[starts])
+    r0 = any_perpendicular(t[firsts])  # each curve's first normal, carried along by its prefix rotations
+    r = rotate(q, np.repeat(r0, lines.counts[nonempty], axis=0))
     # re-orthogonalise against the tangent (removes accumulated rounding)
     r = _unit(r - np.sum(r * t, axis=1, keepdims=True) * t)[0]
 

@@ -125,20 +125,17 @@ def _flatten_target(tile, x0, y0, pos, radius):
     return out
 
 
+# OpenCL float2 / float4 kernel arguments passed by value
+_FLOAT2 = np.dtype([("x", np.float32), ("y", np.float32)])
+_FLOAT4 = np.dtype([("x", np.float32), ("y", np.float32), ("z", np.float32), ("w", np.float32)])
+
+
 def _f2(v):
-    return np.array(np.asarray(v, np.float64)[:2], np.float32).view(_float2())[0]
+    return np.array(np.asarray(v, np.float64)[:2], np.float32).view(_FLOAT2)[0]
 
 
 def _f4(v):
-    return np.array(np.asarray(v, np.float64).reshape(4), np.float32).view(_float4())[0]
-
-
-def _float2():
-    return np.dtype([("x", np.float32), ("y", np.float32)])
-
-
-def _float4():
-    return np.dtype([("x", np.float32), ("y", np.float32), ("z", np.float32), ("w", np.float32)])
+    return np.array(np.asarray(v, np.float64).reshape(4), np.float32).view(_FLOAT4)[0]
 
 
 def _runtime(backend):

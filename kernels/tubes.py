@@ -17,9 +17,10 @@ import numpy as np
 
 from .curve_refine import catmull_rom, select_points
 from .errors import InvalidInputError
-from .frames import rotation_minimizing_frames
+from .frames import rotation_minimizing_frames, rotation_minimizing_frames_opencl
 from .polylines import arc_lengths, chunks, drop_duplicates, take_curves
 from .tube_caps import cap_pieces, cap_sizes
+from .tubes_opencl import TubeDevice, runtime_for
 
 CAPS = ("NONE", "FLAT", "ROUND")
 SIDES_MODES = ("FIXED", "CAMERA")
@@ -145,8 +146,6 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     close to the output itself. ``backend``: "auto" (OpenCL when a device with doubles exists, else numpy),
     "numpy" or "opencl" (the same numbering; values equal within float32 rounding).
     """
-    from .tubes_opencl import TubeDevice, runtime_for
-
     settings.validate(camera)
     runtime = runtime_for(backend)
     lines = prepare_lines(lines, settings)
@@ -176,8 +175,6 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
 def tube_sections(lines, settings, camera=None):
     """What a GPU draw of the tubes needs: the prepared `Polylines` and per point unit N, B (float32 (P, 3))
     and the radius before the anti-aliasing clamp (which the shader applies per frame); sides per curve."""
-    from .tubes_opencl import runtime_for
-
     lines = prepare_lines(lines, settings)
     frames = _frames(lines, replace(settings, aa_clamp=False), camera, runtime_for("auto"))
     return lines, frames
@@ -193,8 +190,6 @@ def _frames(lines, settings, camera, runtime=None):
     """Per point: unit T, N, B (float32), effective radius, arc length; per curve: sides and length.
 
     Chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
-    from .frames import rotation_minimizing_frames_opencl
-
     n_pts = len(lines.points)
     out = {k: np.empty((n_pts, 3), np.float32) for k in ("t", "n", "b")}
     out["radius"] = np.empty(n_pts, np.float32)
@@ -312,10 +307,11 @@ def _segment_u(frames, curves, unit):
 def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=None):
     """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
     unit = _unit_topology(lines, curves)
+    u_ends = _segment_u(frames, curves, unit) if settings.uvs else None
     if device is not None:
-        device.write_body(mesh, lines, frames, n, curves, unit, cursor, settings)
+        device.write_body(lines, frames, n, curves, unit, cursor, u_ends)
     else:
-        _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, settings)
+        _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends)
     if settings.caps != "NONE":
         _collect_caps(lines, frames, n, curves, unit["pick"], unit["local"], unit["cyclic"], cursor["v"],
                       cursor["e"], cursor, settings, caps)
@@ -326,7 +322,7 @@ def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=N
     cursor["e"] += (n_pts + n_seg) * n
 
 
-def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, settings):
+def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends):
     pick, n_pts, seg, nxt = unit["pick"], unit["n_pts"], unit["seg"], unit["nxt"]
     v0, f0, c0, e0 = cursor["v"], cursor["f"], cursor["c"], cursor["e"]
 
@@ -359,8 +355,8 @@ def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, settings):
     ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
     mesh.face_sizes[f0:f0 + n_seg * n] = 4
     mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][unit["curve_of_point"][seg]], n)
-    if settings.uvs:
-        u0, u1 = _segment_u(frames, curves, unit)
+    if u_ends is not None:
+        u0, u1 = u_ends
         v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
         uv = mesh.corner_uvs[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4, 2)
         uv[:, :, 0, 0] = uv[:, :, 1, 0] = u0[:, None]

@@ -51,9 +51,8 @@ class TubeDevice:
             a = np.zeros(1, dtype)
         return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=a)
 
-    def write_body(self, mesh, lines, frames, n, curves, unit, cursor, settings):
-        from .tubes import _segment_u
-
+    def write_body(self, lines, frames, n, curves, unit, cursor, u_ends):
+        """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None."""
         pick, n_pts = unit["pick"], unit["n_pts"]
         seg_of = np.full(n_pts, -1, np.int32)
         seg_of[unit["seg"]] = np.arange(len(unit["seg"]), dtype=np.int32)
@@ -61,8 +60,8 @@ class TubeDevice:
         nxt[unit["seg"]] = unit["nxt"]
         u0 = np.zeros(n_pts, np.float32)
         u1 = np.zeros(n_pts, np.float32)
-        if settings.uvs:
-            u0[unit["seg"]], u1[unit["seg"]] = _segment_u(frames, curves, unit)
+        if u_ends is not None:
+            u0[unit["seg"]], u1[unit["seg"]] = u_ends
         material = lines.material_index[curves][unit["curve_of_point"]]
         b = self.buffers
         kernel = self.runtime.kernel("tube_body", "tube_body")
@@ -72,7 +71,7 @@ class TubeDevice:
                self._in(seg_of, np.int32), self._in(nxt, np.int32), self._in(u0, np.float32),
                self._in(u1, np.float32), self._in(material, np.int32),
                np.int32(n), np.int32(n_pts), np.int32(len(unit["seg"])), np.int64(cursor["v"]), np.int64(cursor["e"]),
-               np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(bool(settings.uvs)),
+               np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(u_ends is not None),
                b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
                b["face_material"], b["corner_uvs"])
 

@@ -54,11 +54,6 @@ def signed_volume(mesh):
     return vol
 
 
-def ring_centres(lines, mesh, sides):
-    """For a FIXED-sides tube without caps: vertex k*n+j belongs to point k."""
-    return np.repeat(lines.points, sides, axis=0)
-
-
 # ---- frames ----------------------------------------------------------------------------------------------------
 
 
