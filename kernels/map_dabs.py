@@ -156,3 +156,46 @@ def stamp(tile, x0, y0, st, pos, rot, scale, strength):
     top = a + (b - a) * fu
     bottom = p + (q - p) * fu
     tile[inside] += F32(strength) * (top + (bottom - top) * fv)
+
+
+def _lattice(ix, iy, seed):
+    """Random lattice values in [-1, 1] (float32) from integer coordinates: the same hash as ``lattice()``."""
+    with np.errstate(over="ignore"):
+        k = (ix.astype(np.uint32) * np.uint32(0x8DA6B343)) ^ (iy.astype(np.uint32) * np.uint32(0xD8163841)) \
+            ^ (np.uint32(seed) * np.uint32(0xCB1AB31F))
+        k ^= k >> np.uint32(13)
+        k *= np.uint32(0x5BD1E995)
+        k ^= k >> np.uint32(15)
+    return (k & np.uint32(0xFFFFFF)).astype(F32) * (F32(2) / F32(16777215)) - F32(1)
+
+
+def value_noise(xs, ys, cell, seed):
+    """(h, w) float32 value noise at integer texels ``xs`` (w,) and ``ys`` (h,): a lattice every ``cell`` texels."""
+    fx = (xs.astype(F32) / F32(cell))[None, :]
+    fy = (ys.astype(F32) / F32(cell))[:, None]
+    bx, by = np.floor(fx), np.floor(fy)
+    ix, iy = bx.astype(np.int32), by.astype(np.int32)
+    u, v = fx - bx, fy - by
+    su = u * u * (F32(3) - F32(2) * u)
+    sv = v * v * (F32(3) - F32(2) * v)
+    a, b = _lattice(ix, iy, seed), _lattice(ix + 1, iy, seed)
+    c, d = _lattice(ix, iy + 1, seed), _lattice(ix + 1, iy + 1, seed)
+    top = a + (b - a) * su
+    bottom = c + (d - c) * su
+    return top + (bottom - top) * sv
+
+
+def noise(tile, x0, y0, pos, radius, strength, kind, vec, cell, seed):
+    """Add ``vec`` x falloff x value noise (anchored to the map, so overlapping dabs agree)."""
+    h, w, c = tile.shape
+    inside, k = _weights(x0, y0, w, h, pos, radius, strength, kind)
+    n = value_noise(np.arange(x0, x0 + w), np.arange(y0, y0 + h), cell, seed)[inside]
+    tile[inside] += operand(vec, c)[None, :] * k[:, None] * n[:, None]
+
+
+def smooth_full(src, k):
+    """Whole-map smooth, a new (H, W, C) array: each texel moves by ``k`` toward its 3x3 mean (clamped borders)."""
+    p = np.pad(src, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    columns = (p[:-2] + p[1:-1]) + p[2:]
+    total = (columns[:, :-2] + columns[:, 1:-1]) + columns[:, 2:]
+    return src + (total * (F32(1) / F32(9)) - src) * F32(k)

@@ -14,9 +14,10 @@ import numpy as np
 
 from . import map_dabs as ref
 from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+from .map_buffer import MapBuffer
 from .opencl_runtime import get_runtime
 
-KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP")
+KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
 BACKENDS = ("auto", "numpy", "opencl")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
 
@@ -70,7 +71,7 @@ def _plan(dmap, kind, p):
         args = [_finite(f"arg{i}", p.get(f"arg{i}", (0, 0, 0, 0))) for i in range(1, 5)]
         region = footprint(dmap.shape, args[0][:2], float(args[2][0]))
         return (region, lambda t, x0, y0: ref.test(t, x0, y0, *args), "test", tuple(_f4(a) for a in args))
-    if kind in ("DRAW", "FLATTEN", "SMOOTH"):
+    if kind in ("DRAW", "FLATTEN", "SMOOTH", "NOISE"):
         pos, radius = _finite("pos", p["pos"]), float(_finite("radius", p["radius"]))
         strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
                                                                                        p.get("pressure", 1.0)))
@@ -83,6 +84,14 @@ def _plan(dmap, kind, p):
             vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
             return (region, lambda t, x0, y0: ref.draw(t, x0, y0, pos, radius, strength, kind_name, vec), "draw",
                     base + (_f4(vec),))
+        if kind == "NOISE":
+            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
+            cell = float(_finite("cell", p.get("cell", 8.0)))
+            seed = int(p.get("seed", 0)) & 0xFFFFFFFF
+            if not cell > 0:
+                raise InvalidInputError(f"The noise cell size must be positive; got {cell:g}")
+            return (region, lambda t, x0, y0: ref.noise(t, x0, y0, pos, radius, strength, kind_name, vec, cell, seed),
+                    "noise", base + (_f4(vec), f32(cell), np.uint32(seed)))
         if kind == "FLATTEN":
             target = p.get("target")
             if target is None and region is not None:
@@ -149,55 +158,99 @@ def _runtime(backend):
     return runtime
 
 
-def apply_dab(dmap, kind, backend="auto", **params):
-    """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map."""
+def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **params):
+    """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map.
+
+    ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
+    footprint moves; without it the footprint tile is uploaded and read back. ``before_write(region)`` is
+    called once every check has passed and before anything is written (undo records the region there).
+    """
     check_map(dmap)
+    if device is not None and device.host is not dmap:
+        raise InvalidInputError("The device buffer mirrors a different map")
     region, numpy_fn, cl_name, cl_args = _plan(dmap, kind, params)
     if region is None:
         return None
     x0, y0, x1, y1 = region
     halo = None
     if kind == "SMOOTH":
-        hx0, hy0 = max(0, x0 - 1), max(0, y0 - 1)
-        hx1, hy1 = min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1)
-        halo = (hx0, hy0, np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
-        if not np.all(np.isfinite(halo[2])):
-            raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
-    tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
-    if not np.all(np.isfinite(tile)):
-        raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
-    runtime = _runtime(backend)
+        halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
+    _check_finite(dmap, halo or region)
+    runtime = None if backend == "numpy" and device is None else _runtime("opencl" if device else backend)
+    if before_write is not None:
+        before_write(region)
     if runtime is None:
+        tile = dmap[y0:y1, x0:x1]  # a view: the reference edits the map in place
         if kind == "SMOOTH":
-            numpy_fn(tile, x0, y0, halo[2], halo[0], halo[1])
+            hx0, hy0, hx1, hy1 = halo
+            numpy_fn(tile, x0, y0, dmap[hy0:hy1, hx0:hx1].copy(), hx0, hy0)
         else:
             numpy_fn(tile, x0, y0)
     else:
-        _run_opencl(runtime, tile, x0, y0, cl_name, cl_args, halo)
-    dmap[y0:y1, x0:x1] = tile
+        _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
     return region
 
 
-def _run_opencl(runtime, tile, x0, y0, name, args, halo):
+def smooth_map(dmap, strength=1.0, backend="auto", device=None):
+    """Smooth the whole map toward its 3x3 means (clamped borders) in place; returns the region (all of it).
+
+    With OpenCL the map goes through the device once (`MapBuffer.smooth_all`, ping-pong buffers); a temporary
+    device copy is made when no ``device`` is given.
+    """
+    check_map(dmap)
+    k = float(_finite("strength", strength))
+    h, w = dmap.shape[:2]
+    if device is not None and device.host is not dmap:
+        raise InvalidInputError("The device buffer mirrors a different map")
+    runtime = None if backend == "numpy" and device is None else _runtime("opencl" if device else backend)
+    if runtime is None:
+        _check_finite(dmap, (0, 0, w, h))
+        dmap[...] = ref.smooth_full(dmap, k)
+    elif not (device or MapBuffer(runtime, dmap)).smooth_all(k):
+        raise InvalidInputError("The map has NaN or infinite values; nothing was changed")
+    return 0, 0, w, h
+
+
+def _check_finite(dmap, region):
+    x0, y0, x1, y1 = region
+    if not np.isfinite(dmap[y0:y1, x0:x1]).all():
+        raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
+
+
+def _run_opencl(runtime, dmap, region, name, args, halo, device):
+    """One kernel launch over the footprint, on the device-resident map or on an uploaded tile."""
     cl = runtime.cl
     mf = cl.mem_flags
-    h, w, c = tile.shape
     ctx = runtime.context
-    d_tile = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile)
+    x0, y0, x1, y1 = region
+    w, h, channels = x1 - x0, y1 - y0, dmap.shape[2]
+    if device is not None:
+        buf, base, mem_w = device.buf, (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
+    else:
+        tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+        buf, base, mem_w = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w
     extra = []
     if name == "smooth":
-        hx0, hy0, src = halo
-        extra = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=src), np.int32(src.shape[1]),
-                 np.int32(src.shape[0]), np.int32(hx0), np.int32(hy0)]
+        hx0, hy0, hx1, hy1 = halo
+        if device is not None:
+            src = device.snapshot(halo)
+        else:
+            src = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
+        extra = [src, np.int32(hx1 - hx0), np.int32(hy1 - hy0), np.int32(hx0), np.int32(hy0)]
     if name == "stamp":
         st = args[0]
-        extra = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=st), np.int32(st.shape[1]),
-                 np.int32(st.shape[0])]
+        st_buf = device.stamp_buffer(st) if device is not None else cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR,
+                                                                              hostbuf=st)
+        extra = [st_buf, np.int32(st.shape[1]), np.int32(st.shape[0])]
         args = args[1:]
     kernel = runtime.kernel("map_dabs", name)
-    kernel(runtime.queue, (w, h), None, d_tile, np.int32(w), np.int32(h), np.int32(c), np.int32(x0), np.int32(y0),
-           *extra, *args)
-    cl.enqueue_copy(runtime.queue, tile, d_tile)
+    kernel(runtime.queue, (w, h), None, buf, np.int64(base), np.int32(mem_w), np.int32(channels), np.int32(x0),
+           np.int32(y0), np.int32(w), np.int32(h), *extra, *args)
+    if device is not None:
+        device.pull(region)
+    else:
+        cl.enqueue_copy(runtime.queue, tile, buf)
+        dmap[y0:y1, x0:x1] = tile
 
 
 def morph(a, b, time, backend="auto"):
@@ -224,15 +277,16 @@ def morph(a, b, time, backend="auto"):
 
 CUSTOM_TEMPLATE = """
 #pragma OPENCL FP_CONTRACT OFF
-__kernel void custom(__global float *tile, const int w, const int h, const int channels, const int x0,
-                     const int y0, const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
+__kernel void custom(__global float *map, const long base, const int mem_w, const int channels, const int x0,
+                     const int y0, const int w, const int h, const float4 arg1, const float4 arg2, const float4 arg3,
+                     const float4 arg4)
 {
   const int gx = get_global_id(0), gy = get_global_id(1);
   if (gx >= w || gy >= h) {
     return;
   }
   const int x = x0 + gx, y = y0 + gy;
-  __global float *t = tile + ((long)gy * w + gx) * channels;
+  __global float *t = map + base + ((long)gy * mem_w + gx) * channels;
   float4 image = (float4)(0.0f);
   if (channels == 1) { image.z = t[0]; } else { for (int c = 0; c < channels; ++c) { ((float *)&image)[c] = t[c]; } }
   (void)x; (void)y; (void)arg1; (void)arg2; (void)arg3; (void)arg4;
@@ -256,8 +310,12 @@ def compile_custom(runtime, body):
     return cl.Kernel(program, "custom")
 
 
-def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4):
-    """Run a compiled custom kernel over ``region`` (default: the whole map) in place; returns the region."""
+def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4, device=None):
+    """Run a compiled custom kernel over ``region`` (default: the whole map) in place; returns the region.
+
+    The kernel runs on a copy of the region, so output with NaN or infinities is refused with the map unchanged;
+    a `MapBuffer` given as ``device`` is updated afterwards.
+    """
     check_map(dmap)
     h, w = dmap.shape[:2]
     x0, y0, x1, y1 = region or (0, 0, w, h)
@@ -265,10 +323,12 @@ def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4):
     tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
     cl = runtime.cl
     d_tile = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
-    kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int32(x1 - x0), np.int32(y1 - y0),
-           np.int32(dmap.shape[2]), np.int32(x0), np.int32(y0), *vals)
+    kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int64(0), np.int32(x1 - x0), np.int32(dmap.shape[2]),
+           np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *vals)
     cl.enqueue_copy(runtime.queue, tile, d_tile)
     if not np.all(np.isfinite(tile)):
         raise TesseraError("The custom kernel produced NaN or infinite values; the map was left unchanged")
     dmap[y0:y1, x0:x1] = tile
+    if device is not None:
+        device.push((x0, y0, x1, y1))
     return x0, y0, x1, y1

@@ -122,3 +122,15 @@ def test_a_dab_off_the_map_does_nothing():
     m = zero_map()
     assert apply_dab(m, "CONTACT", backend="numpy", pos=(-50, -50), depth=1, radius=5) is None
     assert not m.any()
+
+
+def test_noise_is_bounded_map_anchored_and_seeded():
+    a, b = zero_map(1, 64), zero_map(1, 64)
+    apply_dab(a, "NOISE", backend="numpy", pos=(30, 30), radius=12, strength=0.5, falloff="CONSTANT", cell=4, seed=7)
+    assert np.abs(a).max() <= 0.5 and np.count_nonzero(a) > 300
+    apply_dab(b, "NOISE", backend="numpy", pos=(34, 31), radius=12, strength=0.5, falloff="CONSTANT", cell=4, seed=7)
+    both = (a != 0) & (b != 0)
+    assert both.sum() > 200 and np.array_equal(a[both], b[both])  # the same texel gets the same noise value
+    c = zero_map(1, 64)
+    apply_dab(c, "NOISE", backend="numpy", pos=(30, 30), radius=12, strength=0.5, falloff="CONSTANT", cell=4, seed=8)
+    assert not np.array_equal(a, c)

@@ -1,8 +1,10 @@
 // Displacement-map edits (seed 004 §5), one work item per texel of the dab's footprint tile.
-// A tile is rows y0.. and columns x0.. of a (H, W, C) float32 map, stored (h, w, C); texel (x, y) sits at
-// map[y, x]. Distances are to integer texel coordinates (seed M6). float4 operands map onto the channels:
-// C = 4: xyzw, C = 3: xyz, C = 1: z (the height). Every kernel has a numpy reference in kernels/map_dabs.py that
-// computes in the same float32 operations (contraction off), so results agree to the last bit in practice.
+// The footprint is w x h texels from map texel (x0, y0). Its memory starts at element `base` of `map` with rows
+// `mem_w` texels apart: the whole map kept on the device (base = (y0 * W + x0) * C, mem_w = W) or an uploaded
+// tile (base = 0, mem_w = w). Texel (x, y) of a (H, W, C) float32 map sits at map[y, x].
+// Distances are to integer texel coordinates (seed M6). float4 operands map onto the channels: C = 4: xyzw,
+// C = 3: xyz, C = 1: z (the height). Every kernel has a numpy reference in kernels/map_dabs.py that computes
+// in the same float32 operations (contraction off), so results agree to the last bit in practice.
 #pragma OPENCL FP_CONTRACT OFF
 
 inline float texel_distance(const float2 pos, const int x, const int y)
@@ -38,16 +40,19 @@ inline float falloff(const float t, const int kind)
   return 1.0f;
 }
 
-#define TEXEL_SETUP                                  \
-  const int gx = get_global_id(0), gy = get_global_id(1); \
-  if (gx >= w || gy >= h) {                          \
-    return;                                          \
-  }                                                  \
-  const int x = x0 + gx, y = y0 + gy;                \
-  __global float *t = tile + ((long)gy * w + gx) * channels;
+#define TILE_ARGS                                                                                  \
+  __global float *map, const long base, const int mem_w, const int channels, const int x0, const int y0, \
+      const int w, const int h
 
-__kernel void contact(__global float *tile, const int w, const int h, const int channels, const int x0,
-                      const int y0, const float2 pos, const float depth, const float radius)
+#define TEXEL_SETUP                                             \
+  const int gx = get_global_id(0), gy = get_global_id(1);       \
+  if (gx >= w || gy >= h) {                                     \
+    return;                                                     \
+  }                                                             \
+  const int x = x0 + gx, y = y0 + gy;                           \
+  __global float *t = map + base + ((long)gy * mem_w + gx) * channels;
+
+__kernel void contact(TILE_ARGS, const float2 pos, const float depth, const float radius)
 {
   TEXEL_SETUP
   if (texel_distance(pos, x, y) < radius) {
@@ -55,8 +60,7 @@ __kernel void contact(__global float *tile, const int w, const int h, const int 
   }
 }
 
-__kernel void force(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
-                    const float2 pos, const float4 f, const float area)
+__kernel void force(TILE_ARGS, const float2 pos, const float4 f, const float area)
 {
   TEXEL_SETUP
   const float dissipation = (area - texel_distance(pos, x, y)) / area;  // = 1 - d / R, exact at the seed's values
@@ -67,8 +71,7 @@ __kernel void force(__global float *tile, const int w, const int h, const int ch
   }
 }
 
-__kernel void test(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
-                   const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
+__kernel void test(TILE_ARGS, const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
 {
   TEXEL_SETUP
   if (texel_distance(arg1.xy, x, y) < arg3.x) {
@@ -87,8 +90,8 @@ __kernel void morphing(__global const float *a, __global const float *b, __globa
   }
 }
 
-__kernel void draw(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
-                   const float2 pos, const float radius, const float strength, const int kind, const float4 vec)
+__kernel void draw(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
+                   const float4 vec)
 {
   TEXEL_SETUP
   const float d = texel_distance(pos, x, y);
@@ -100,8 +103,7 @@ __kernel void draw(__global float *tile, const int w, const int h, const int cha
   }
 }
 
-__kernel void flatten(__global float *tile, const int w, const int h, const int channels, const int x0,
-                      const int y0, const float2 pos, const float radius, const float strength, const int kind,
+__kernel void flatten(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
                       const float4 target)
 {
   TEXEL_SETUP
@@ -115,8 +117,7 @@ __kernel void flatten(__global float *tile, const int w, const int h, const int 
 }
 
 // smooth reads a halo tile `src` (hs x ws, origin sx0, sy0, clamped to the map) and writes `tile`
-__kernel void smooth(__global float *tile, const int w, const int h, const int channels, const int x0,
-                     const int y0, __global const float *src, const int ws, const int hs, const int sx0,
+__kernel void smooth(TILE_ARGS, __global const float *src, const int ws, const int hs, const int sx0,
                      const int sy0, const float2 pos, const float radius, const float strength, const int kind)
 {
   TEXEL_SETUP
@@ -137,9 +138,8 @@ __kernel void smooth(__global float *tile, const int w, const int h, const int c
 }
 
 // stamp: add strength * (bilinear sample of a (sh, sw, channels) stamp map), rotated by `angle` and scaled
-__kernel void stamp(__global float *tile, const int w, const int h, const int channels, const int x0, const int y0,
-                    __global const float *st, const int sw, const int sh, const float2 pos, const float2 rot,
-                    const float scale, const float strength)
+__kernel void stamp(TILE_ARGS, __global const float *st, const int sw, const int sh, const float2 pos,
+                    const float2 rot, const float scale, const float strength)
 {
   TEXEL_SETUP
   const float dx = (float)x - pos.x, dy = (float)y - pos.y;
@@ -156,5 +156,85 @@ __kernel void stamp(__global float *tile, const int w, const int h, const int ch
     const float p = st[((long)iv1 * sw + iu) * channels + c], q = st[((long)iv1 * sw + iu1) * channels + c];
     const float top = a + (b - a) * fu, bottom = p + (q - p) * fu;
     t[c] += strength * (top + (bottom - top) * fv);
+  }
+}
+
+// value noise: a lattice of random values in [-1, 1] every `cell` texels, blended with smoothstep weights
+inline float lattice(const int ix, const int iy, const uint seed)
+{
+  uint k = ((uint)ix * 0x8da6b343u) ^ ((uint)iy * 0xd8163841u) ^ (seed * 0xcb1ab31fu);
+  k ^= k >> 13;
+  k *= 0x5bd1e995u;
+  k ^= k >> 15;
+  return (float)(k & 0xffffffu) * (2.0f / 16777215.0f) - 1.0f;
+}
+
+inline float value_noise(const int x, const int y, const float cell, const uint seed)
+{
+  const float fx = (float)x / cell, fy = (float)y / cell;
+  const float bx = floor(fx), by = floor(fy);
+  const int ix = (int)bx, iy = (int)by;
+  const float u = fx - bx, v = fy - by;
+  const float su = u * u * (3.0f - 2.0f * u), sv = v * v * (3.0f - 2.0f * v);
+  const float a = lattice(ix, iy, seed), b = lattice(ix + 1, iy, seed);
+  const float c = lattice(ix, iy + 1, seed), d = lattice(ix + 1, iy + 1, seed);
+  const float top = a + (b - a) * su, bottom = c + (d - c) * su;
+  return top + (bottom - top) * sv;
+}
+
+// noise: add vec * strength * falloff * value_noise (map-anchored, so overlapping dabs agree)
+__kernel void noise(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
+                    const float4 vec, const float cell, const uint seed)
+{
+  TEXEL_SETUP
+  const float d = texel_distance(pos, x, y);
+  if (d < radius) {
+    const float k = strength * falloff(d / radius, kind);
+    const float n = value_noise(x, y, cell, seed);
+    for (int c = 0; c < channels; ++c) {
+      t[c] += operand(vec, c, channels) * k * n;
+    }
+  }
+}
+
+// whole-map smooth (ping-pong: src -> dst). A row is n = W * C floats and a texel's left and right neighbours are
+// C floats away, so each work item does 8 consecutive floats of a row with vector loads; borders clamp. Sums run
+// columns (up + mid) + down, then (left + centre) + right, as in the numpy reference. A non-finite input texel sets
+// `bad` and the host keeps the untouched source.
+inline float smooth_one(const __global float *r0, const __global float *r1, const __global float *r2, const int i,
+                        const int n, const int C, const float k)
+{
+  const int im = i - C < 0 ? i : i - C, ip = i + C >= n ? i : i + C;
+  const float left = (r0[im] + r1[im]) + r2[im], centre = (r0[i] + r1[i]) + r2[i];
+  const float right = (r0[ip] + r1[ip]) + r2[ip];
+  return r1[i] + (((left + centre) + right) * (1.0f / 9.0f) - r1[i]) * k;
+}
+
+__kernel void smooth_all(__global const float *src, __global float *dst, __global int *bad, const int n, const int H,
+                         const int C, const float k)
+{
+  const int y = get_global_id(1), i = get_global_id(0) * 8;
+  if (y >= H || i >= n) {
+    return;
+  }
+  const long row = n;
+  const __global float *r0 = src + max(y - 1, 0) * row, *r1 = src + y * row, *r2 = src + min(y + 1, H - 1) * row;
+  __global float *out = dst + y * row;
+  if (i >= C && i + 8 + C <= n) {
+    const float8 a = (vload8(0, r0 + i - C) + vload8(0, r1 + i - C)) + vload8(0, r2 + i - C);
+    const float8 v = vload8(0, r1 + i);
+    const float8 b = (vload8(0, r0 + i) + v) + vload8(0, r2 + i);
+    const float8 c = (vload8(0, r0 + i + C) + vload8(0, r1 + i + C)) + vload8(0, r2 + i + C);
+    vstore8(v + (((a + b) + c) * (1.0f / 9.0f) - v) * k, 0, out + i);
+    if (any(isnan(v)) || any(isinf(v))) {
+      bad[0] = 1;
+    }
+  } else {
+    for (int j = i; j < min(i + 8, n); ++j) {
+      out[j] = smooth_one(r0, r1, r2, j, n, C, k);
+      if (isnan(r1[j]) || isinf(r1[j])) {
+        bad[0] = 1;
+      }
+    }
   }
 }
