@@ -20,7 +20,7 @@ def test_replay_is_deterministic_and_undo_restores_exact_bytes():
     rng = np.random.default_rng(3)
     base = rng.normal(size=(200, 300, 1)).astype(np.float32)
     t = np.linspace(0, 3, 40)
-    path = np.column_stack([20 + 80 * t, 100 + 60 * np.sin(t), 0.2 + 0.8 * t / 3])
+    path = np.column_stack([20 + 80 * t, 100 + 60 * np.sin(t), np.linspace(0.2, 1, 40)])
     runs = []
     for _ in range(2):
         m = base.copy()
