@@ -9,12 +9,17 @@ import importlib
 _modules = (
     "addon.preferences",
     "addon.tube_settings",
+    "addon.displacement_settings",
     "addon.settings",
+    "addon.displacement_maps",
     "operators.tessellate",
     "operators.tubes",
+    "operators.displacement",
+    "operators.custom_kernel",
     "addon.menus",
     "addon.panels",
     "addon.tube_preview",
+    "addon.brush_tool",
 )
 
 

@@ -10,6 +10,7 @@ class TESSERA_MT_object(bpy.types.Menu):
     def draw(self, context):
         self.layout.operator("tessera.tessellate", icon="MOD_SUBSURF")
         self.layout.operator("tessera.tubes", icon="MESH_CYLINDER")
+        self.layout.operator("tessera.displacement_add", icon="IMAGE_DATA")
 
 
 def _draw_object_menu(self, context):

@@ -2,6 +2,7 @@
 
 import bpy
 
+from .brush_tool import draw_brush_settings
 from .settings import draw_settings
 from .tube_settings import copy_tube_settings, draw_tube_settings
 from .tube_sources import SOURCE_TYPES
@@ -54,5 +55,44 @@ class TESSERA_PT_tubes(_Sidebar, bpy.types.Panel):
         copy_tube_settings(settings, op)
 
 
-classes = (TESSERA_PT_tessellate, TESSERA_PT_tubes)
+class TESSERA_PT_displacement(_Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_displacement"
+    bl_label = "Displacement Map"
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.type == "MESH"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.active_object.tessera.displacement
+        if settings.image is None:
+            layout.operator("tessera.displacement_add", icon="IMAGE_DATA")
+            return
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(settings, "image")
+        layout.prop(settings, "mode")
+        if settings.mode == "VECTOR":
+            layout.prop(settings, "space")
+        layout.prop_search(settings, "uv_map", context.active_object.data, "uv_layers")
+        layout.prop(settings, "mid_level")
+        layout.prop(settings, "strength")
+        row = layout.row()
+        row.operator("tessera.displacement_export", icon="EXPORT")
+        box = layout.box()
+        box.label(text="Brush (Displacement Brush tool)", icon="BRUSH_DATA")
+        draw_brush_settings(box, context.scene.tessera_brush, 1 if settings.mode == "HEIGHT" else 3)
+        box = layout.box()
+        box.label(text="Custom Kernel", icon="SCRIPT")
+        box.prop(settings, "kernel_text", text="")
+        if settings.kernel_text is not None:
+            box.prop(settings, "kernel_args")
+            row = box.row()
+            row.operator("tessera.displacement_trust_kernel", icon="LOCKED")
+            row.operator("tessera.displacement_custom", icon="PLAY")
+
+
+classes = (TESSERA_PT_tessellate, TESSERA_PT_tubes, TESSERA_PT_displacement)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -12,6 +12,7 @@ from ..kernels.adaptive import AdaptiveSettings
 from ..kernels.partition import MAX_LEVEL
 from ..kernels.tessellate import SurfaceOptions
 from .cameras import CAMERA_ITEMS
+from .displacement_settings import TESSERA_PG_displacement
 from .tube_settings import TESSERA_PG_tubes
 
 METHOD_ITEMS = (
@@ -107,6 +108,7 @@ class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
 class TESSERA_PG_object(bpy.types.PropertyGroup):
     tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
     tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
+    displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
 
 
 def copy_settings(source, target):

@@ -29,6 +29,7 @@ def settings_changed(ob):
                 area.tag_redraw()
 
 
+@bpy.app.handlers.persistent  # survive file loads
 def _on_depsgraph(scene, depsgraph):
     cache = _state["cache"]
     if not cache:

@@ -136,7 +136,8 @@ def dab_params(brush, x, y, pressure):
     if brush.kind == "CONTACT":
         p.update(pos=(x, y), radius=radius, depth=p.get("depth", strength))
     elif brush.kind == "FORCE":
-        f = np.array(p.get("force", (0.0, 0.0, -strength, radius / max(strength, 1e-12))), np.float64)
+        # a cone of depth ``strength`` and the brush radius: R = |f.xyz| * f.w = radius (0 strength: refused)
+        f = np.array(p.get("force", (0.0, 0.0, -strength, radius / abs(strength) if strength else 0.0)), np.float64)
         p.update(pos=(x, y), force=f)
     elif brush.kind == "TEST":
         p.update(arg1=(x, y, 0, 0), arg2=p.get("arg2", (0, 0, strength, 0)), arg3=(radius, 0, 0, 0))
@@ -147,14 +148,15 @@ def dab_params(brush, x, y, pressure):
     return p
 
 
-def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, progress=None):
+def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, progress=None, spaced=True):
     """Apply ``brush`` along ``samples`` ((m, 3) x, y, pressure). Returns the changed region or None.
 
+    With ``spaced=False`` the samples are the dabs themselves (a live stroke that spaced them already).
     ``undo`` (a `TileUndo` of ``dmap``) records every touched tile before it changes. A dab that fails validation
     raises before it writes; earlier dabs of the stroke stay applied (undo restores them).
     """
     brush.validate()
-    dabs = stroke_dabs(samples, brush.spacing * brush.radius)
+    dabs = stroke_dabs(samples, brush.spacing * brush.radius) if spaced else np.asarray(samples, np.float64)
     width = dmap.shape[1]
     box = None
     for i, (x, y, pressure) in enumerate(dabs):

@@ -1,0 +1,51 @@
+"""The displacement brush as a 3D Viewport tool (Object Mode): drag to paint the active object's map;
+F and Shift+F change radius and strength as in Sculpt Mode."""
+
+import bpy
+
+
+def draw_brush_settings(layout, brush, channels=1):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    layout.prop(brush, "kind")
+    layout.prop(brush, "radius")
+    layout.prop(brush, "strength")
+    if brush.kind in {"DRAW", "SMOOTH", "FLATTEN", "NOISE"}:
+        layout.prop(brush, "falloff")
+    if brush.kind == "NOISE":
+        layout.prop(brush, "noise_cell")
+        layout.prop(brush, "noise_seed")
+    if channels > 1 and brush.kind in {"DRAW", "NOISE", "TEST"}:
+        layout.prop(brush, "direction")
+    layout.prop(brush, "spacing")
+    col = layout.column(heading="Pressure")
+    col.prop(brush, "use_pressure_strength", text="Strength")
+    col.prop(brush, "use_pressure_radius", text="Radius")
+    layout.prop(brush, "mirror_x")
+
+
+class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
+    bl_space_type = "VIEW_3D"
+    bl_context_mode = "OBJECT"
+    bl_idname = "tessera.displacement_brush"
+    bl_label = "Displacement Brush"
+    bl_description = "Paint the active object's displacement map (Tessera)"
+    bl_icon = "brush.sculpt.draw"
+    bl_keymap = (
+        ("tessera.displacement_stroke", {"type": "LEFTMOUSE", "value": "PRESS"}, None),
+        ("wm.radial_control", {"type": "F", "value": "PRESS"},
+         {"properties": [("data_path_primary", "scene.tessera_brush.radius")]}),
+        ("wm.radial_control", {"type": "F", "value": "PRESS", "shift": True},
+         {"properties": [("data_path_primary", "scene.tessera_brush.strength")]}),
+    )
+
+    def draw_settings(context, layout, tool):
+        draw_brush_settings(layout.column(), context.scene.tessera_brush)
+
+
+def register():
+    bpy.utils.register_tool(TESSERA_TL_displacement_brush, separator=True)
+
+
+def unregister():
+    bpy.utils.unregister_tool(TESSERA_TL_displacement_brush)

@@ -1,0 +1,318 @@
+"""Displacement-map operators: add a map to a mesh, export it, and paint it with strokes.
+
+``tessera.displacement_stroke`` is both the interactive brush (invoke: raycast the mouse onto the displaced
+surface, dabs along the stroke, a brush circle while painting) and the headless replay (execute: the recorded
+``stroke`` elements, with ``location`` a point on the surface in object space, or map texels when
+``map_space`` is set). Both go through one `StrokeSession`, so a replay reproduces the stroke.
+"""
+
+import math
+import time
+
+import bpy
+import gpu
+import mathutils
+import numpy as np
+from bpy_extras import view3d_utils
+from gpu_extras.batch import batch_for_shader
+
+from ..addon.displacement_maps import StrokeSession, channels_for, map_state, sync_modifier
+from ..addon.displacement_settings import MODE_ITEMS, SPACE_ITEMS
+from ..kernels.errors import TesseraError
+from ..kernels.map_io import read_map, write_map
+from ..kernels.map_strokes import Brush
+
+_LIVE_INTERVAL = 0.05  # seconds between image updates while painting
+
+
+def _map_object(context):
+    ob = context.active_object
+    if ob is None or ob.type != "MESH" or ob.tessera.displacement.image is None:
+        return None
+    return ob
+
+
+def kernel_brush(b, channels):
+    """`kernels.map_strokes.Brush` from ``Scene.tessera_brush``."""
+    vector = (*b.direction, 0.0) if channels > 1 else (0.0, 0.0, 1.0, 0.0)
+    params = {"falloff": b.falloff, "vector": vector, "cell": b.noise_cell, "seed": b.noise_seed}
+    if b.kind == "TEST":
+        params["arg2"] = tuple(v * b.strength for v in vector)
+    return Brush(kind=b.kind, radius=b.radius, strength=b.strength, spacing=b.spacing,
+                 pressure_radius=b.use_pressure_radius, pressure_strength=b.use_pressure_strength,
+                 mirror_x=b.mirror_x, params=params).validate()
+
+
+def new_map_image(name, width, height, data=None):
+    """A float, non-colour image of ``width`` x ``height`` (zero height, alpha 1), optionally filled."""
+    image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+    image.colorspace_settings.name = "Non-Color"
+    rgba = np.zeros((height, width, 4), np.float32)
+    rgba[..., 3] = 1.0
+    if data is not None:
+        rgba[..., :3] = data if data.shape[2] != 1 else np.repeat(data, 3, axis=2)
+    image.pixels.foreach_set(rgba.ravel())
+    return image
+
+
+class TESSERA_OT_displacement_add(bpy.types.Operator):
+    """Give the active mesh a float displacement map (new, or read from an EXR/PNG/TIFF file) shown by a
+    Displace modifier"""
+
+    bl_idname = "tessera.displacement_add"
+    bl_label = "Add Displacement Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    width: bpy.props.IntProperty(name="Width", default=1024, min=8, max=32768)
+    height: bpy.props.IntProperty(name="Height", default=1024, min=8, max=32768)
+    mode: bpy.props.EnumProperty(name="Mode", items=MODE_ITEMS, default="HEIGHT")
+    space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL")
+    filepath: bpy.props.StringProperty(name="From File", subtype="FILE_PATH",
+                                       description="Read the map from this file instead (EXR, PNG, TIFF)")
+    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, description="Value of a 0 texel in integer files")
+    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, description="Value of a full texel")
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if ob is None or ob.type != "MESH":
+            cls.poll_message_set("Select a mesh")
+            return False
+        if not ob.data.uv_layers:
+            cls.poll_message_set("The mesh needs a UV map to place the displacement map")
+            return False
+        return True
+
+    def execute(self, context):
+        ob = context.active_object
+        channels = 1 if self.mode == "HEIGHT" else 3
+        data = None
+        try:
+            if self.filepath:
+                data = read_map(bpy.path.abspath(self.filepath), channels=channels, low=self.low, high=self.high)
+        except TesseraError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        h, w = data.shape[:2] if data is not None else (self.height, self.width)
+        image = new_map_image(f"{ob.name} Displacement", w, h, data)
+        settings = ob.tessera.displacement
+        settings.mode, settings.space = self.mode, self.space
+        settings.uv_map = ob.data.uv_layers.active.name
+        settings.image = image  # creates the modifier through the update callback
+        sync_modifier(ob)
+        self.report({"INFO"}, f"Displacement map {w} x {h} ({self.mode.lower()}) on {ob.name}")
+        return {"FINISHED"}
+
+
+class TESSERA_OT_displacement_export(bpy.types.Operator):
+    """Write the active object's displacement map to a 32-bit EXR (exact) or a 16-bit PNG/TIFF file"""
+
+    bl_idname = "tessera.displacement_export"
+    bl_label = "Export Displacement Map"
+
+    filepath: bpy.props.StringProperty(subtype="FILE_PATH")
+    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0)
+    high: bpy.props.FloatProperty(name="16-bit High", default=1.0)
+
+    @classmethod
+    def poll(cls, context):
+        return _map_object(context) is not None
+
+    def invoke(self, context, event):
+        if not self.filepath:
+            self.filepath = "displacement.exr"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        settings = context.active_object.tessera.displacement
+        try:
+            state = map_state(settings.image, channels_for(settings))
+            clipped = write_map(bpy.path.abspath(self.filepath), state.host, low=self.low, high=self.high)
+        except TesseraError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        if clipped:
+            self.report({"WARNING"}, f"{clipped} values lay outside [{self.low:g}, {self.high:g}] and were clipped")
+        return {"FINISHED"}
+
+
+def _texel(mesh, poly_index, co, uv_name, size):
+    """Map texel coordinates of the object-space point ``co`` on polygon ``poly_index`` of ``mesh``."""
+    poly = mesh.polygons[poly_index]
+    weights = mathutils.interpolate.poly_3d_calc([mesh.vertices[i].co for i in poly.vertices], co)
+    layer = mesh.uv_layers.get(uv_name) if uv_name else mesh.uv_layers.active
+    if layer is None:
+        raise TesseraError(f"The mesh has no UV map {uv_name!r}")
+    u = sum(w * layer.uv[li].vector.x for w, li in zip(weights, poly.loop_indices, strict=True))
+    v = sum(w * layer.uv[li].vector.y for w, li in zip(weights, poly.loop_indices, strict=True))
+    return u * size[0] - 0.5, v * size[1] - 0.5
+
+
+def _texel_world_size(ob, mesh, poly_index, uv_name, size):
+    """World length of one texel on a polygon (from its area in the world and in texel space)."""
+    poly = mesh.polygons[poly_index]
+    layer = mesh.uv_layers.get(uv_name) if uv_name else mesh.uv_layers.active
+    uv = [layer.uv[li].vector for li in poly.loop_indices]
+    uv_area = 0.5 * abs(sum(uv[i].x * uv[i - 1].y - uv[i - 1].x * uv[i].y for i in range(len(uv))))
+    scale = ob.matrix_world.to_scale()
+    world_area = poly.area * abs(scale.x * scale.y)  # close enough for a cursor
+    return math.sqrt(world_area / max(uv_area * size[0] * size[1], 1e-30))
+
+
+class TESSERA_OT_displacement_stroke(bpy.types.Operator):
+    """Paint the displacement map of the active object (drag), or replay a recorded stroke"""
+
+    bl_idname = "tessera.displacement_stroke"
+    bl_label = "Displacement Stroke"
+    bl_options = {"REGISTER", "UNDO", "BLOCKING"}
+
+    stroke: bpy.props.CollectionProperty(type=bpy.types.OperatorStrokeElement, options={"SKIP_SAVE"})
+    map_space: bpy.props.BoolProperty(name="Map Space", default=False, options={"SKIP_SAVE"},
+                                      description="Stroke locations are map texels (x, y) instead of surface points")
+
+    @classmethod
+    def poll(cls, context):
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Paint displacement maps in Object Mode")
+            return False
+        if _map_object(context) is None:
+            cls.poll_message_set("The active mesh has no displacement map (Add Displacement Map)")
+            return False
+        return True
+
+    # -- replay -------------------------------------------------------------------------------------------
+    def execute(self, context):
+        ob = context.active_object
+        settings = ob.tessera.displacement
+        try:
+            session = StrokeSession(settings.image, settings, kernel_brush(context.scene.tessera_brush,
+                                                                             channels_for(settings)))
+            samples = self._replay_samples(context, ob, session.state.host.shape)
+            wm = context.window_manager
+            wm.progress_begin(0, len(samples))
+            try:
+                for i, sample in enumerate(samples):
+                    session.add(*sample)
+                    wm.progress_update(i)
+            except TesseraError:
+                session.cancel()
+                raise
+            finally:
+                wm.progress_end()
+        except TesseraError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        session.finish()
+        return {"FINISHED"}
+
+    def _replay_samples(self, context, ob, shape):
+        if self.map_space:
+            return [(e.location.x, e.location.y, e.pressure) for e in self.stroke]
+        settings = ob.tessera.displacement
+        depsgraph = context.evaluated_depsgraph_get()
+        ob_eval = ob.evaluated_get(depsgraph)
+        tree = mathutils.bvhtree.BVHTree.FromObject(ob_eval, depsgraph)
+        mesh = ob_eval.data
+        out = []
+        for e in self.stroke:
+            co, _normal, index, _dist = tree.find_nearest(e.location)
+            if index is None:
+                raise TesseraError("A stroke location found no surface")
+            out.append((*_texel(mesh, index, co, settings.uv_map, (shape[1], shape[0])), e.pressure))
+        return out
+
+    # -- interactive --------------------------------------------------------------------------------------
+    def invoke(self, context, event):
+        if context.area is None or context.area.type != "VIEW_3D":
+            self.report({"ERROR"}, "Paint in a 3D Viewport")
+            return {"CANCELLED"}
+        ob = context.active_object
+        settings = ob.tessera.displacement
+        try:
+            self._session = StrokeSession(settings.image, settings,
+                                          kernel_brush(context.scene.tessera_brush, channels_for(settings)))
+        except TesseraError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        self._last_write = 0.0
+        self._cursor = None
+        self._draw = bpy.types.SpaceView3D.draw_handler_add(self._draw_cursor, (), "WINDOW", "POST_VIEW")
+        self.stroke.clear()
+        self._sample(context, event, first=True)
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type in {"MOUSEMOVE", "INBETWEEN_MOUSEMOVE"}:
+            self._sample(context, event)
+            return {"RUNNING_MODAL"}
+        if event.type == "LEFTMOUSE" and event.value == "RELEASE":
+            self._end(context)
+            self._session.finish()
+            return {"FINISHED"}
+        if event.type in {"ESC", "RIGHTMOUSE"}:
+            self._end(context)
+            self._session.cancel()
+            self._session.state.to_image(self._session.image)
+            return {"CANCELLED"}
+        return {"RUNNING_MODAL"}
+
+    def _end(self, context):
+        bpy.types.SpaceView3D.draw_handler_remove(self._draw, "WINDOW")
+        context.area.tag_redraw()
+
+    def _sample(self, context, event, first=False):
+        ob = context.active_object
+        region, rv3d = context.region, context.region_data
+        mouse = (event.mouse_region_x, event.mouse_region_y)
+        origin = view3d_utils.region_2d_to_origin_3d(region, rv3d, mouse)
+        direction = view3d_utils.region_2d_to_vector_3d(region, rv3d, mouse)
+        depsgraph = context.evaluated_depsgraph_get()
+        ob_eval = ob.evaluated_get(depsgraph)
+        inv = ob.matrix_world.inverted()
+        hit, co, normal, index = ob_eval.ray_cast(inv @ origin, (inv.to_3x3() @ direction).normalized(),
+                                                  depsgraph=depsgraph)
+        if not hit:
+            self._cursor = None
+            context.area.tag_redraw()
+            return
+        settings = ob.tessera.displacement
+        shape = self._session.state.host.shape
+        size = (shape[1], shape[0])
+        x, y = _texel(ob_eval.data, index, co, settings.uv_map, size)
+        pressure = event.pressure if event.pressure > 0 else 1.0
+        try:
+            self._session.add(x, y, pressure)
+        except TesseraError as err:
+            self.report({"WARNING"}, str(err))
+            return
+        element = self.stroke.add()
+        element.location, element.mouse, element.pressure = co, mouse, pressure
+        element.is_start, element.time = first, time.monotonic()
+        world_r = _texel_world_size(ob_eval, ob_eval.data, index, settings.uv_map, size) * self._session.brush.radius
+        self._cursor = (ob.matrix_world @ co, (ob.matrix_world.to_3x3() @ normal).normalized(), world_r)
+        now = time.monotonic()
+        if now - self._last_write > _LIVE_INTERVAL:
+            self._session.state.to_image(self._session.image)
+            self._last_write = now
+        context.area.tag_redraw()
+
+    def _draw_cursor(self):
+        if self._cursor is None:
+            return
+        centre, normal, radius = self._cursor
+        t = normal.orthogonal().normalized()
+        b = normal.cross(t)
+        ring = [centre + radius * (math.cos(a) * t + math.sin(a) * b)
+                for a in np.linspace(0, 2 * math.pi, 49)]
+        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+        batch = batch_for_shader(shader, "LINE_STRIP", {"pos": [tuple(p) for p in ring]})
+        shader.uniform_float("color", (1.0, 0.55, 0.1, 1.0))
+        gpu.state.line_width_set(2.0)
+        batch.draw(shader)
+        gpu.state.line_width_set(1.0)
+
+
+classes = (TESSERA_OT_displacement_add, TESSERA_OT_displacement_export, TESSERA_OT_displacement_stroke)
+register, unregister = bpy.utils.register_classes_factory(classes)
