@@ -62,8 +62,9 @@ class MapBuffer:
                         region=size, src_pitches=(self.row_bytes,), dst_pitches=(size[0],))
         return self._scratch
 
-    def smooth_all(self, strength):
-        """Whole-map smooth on the device into the spare buffer, which then becomes the map; pulls the result.
+    def smooth_all(self, strength, read_back=True):
+        """Whole-map smooth on the device into the spare buffer, which then becomes the map; pulls the result
+        (``read_back=False`` leaves the host stale: benchmarks of the device side only).
 
         Returns False, with host and device unchanged, when the map holds NaN or infinite values.
         """
@@ -82,7 +83,8 @@ class MapBuffer:
         if bad[0]:
             return False
         self.buf, self._scratch = self._scratch, self.buf  # ping-pong: the result becomes the map
-        cl.enqueue_copy(self.runtime.queue, self.host, self.buf)
+        if read_back:
+            cl.enqueue_copy(self.runtime.queue, self.host, self.buf)
         return True
 
     def stamp_buffer(self, stamp):

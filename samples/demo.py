@@ -8,6 +8,9 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   camera (projected edge length, 18 px): the far ones get fewer triangles;
 - ``out/demo_tubes.png``: streamlines of an ABC flow (a wire mesh) turned into tubes with sides per tube
   from the camera (level of detail: near tubes round, far ones triangular) and the pixel clamp;
+- ``out/demo_brushes.png``: a flat plane (left) turned into a landscape (right) by a scripted set of
+  displacement-brush strokes (ridges, a valley, a plateau, noise, smoothing) replayed through
+  ``tessera.displacement_stroke``; the map is also written as ``out/demo_map.exr`` (32-bit float);
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
@@ -189,6 +192,63 @@ def build_tubes_scene():
     return len(tubes.data.polygons), elapsed
 
 
+def stroke(points, **brush):
+    """Replay one stroke in map texels ((x, y, pressure) rows) with the given brush settings."""
+    b = bpy.context.scene.tessera_brush
+    for key, value in brush.items():
+        setattr(b, key, value)
+    elements = [{"name": "", "location": (x, y, 0.0), "mouse": (0, 0), "mouse_event": (0, 0), "pressure": p,
+                 "size": 0, "x_tilt": 0, "y_tilt": 0, "time": 0, "is_start": i == 0}
+                for i, (x, y, p) in enumerate(points)]
+    if bpy.ops.tessera.displacement_stroke(stroke=elements, map_space=True) != {"FINISHED"}:
+        sys.exit("demo: a displacement stroke failed")
+
+
+def curve(xs, ys, pressure=1.0, n=60):
+    """A smooth path through control points (map texels), sampled n times."""
+    t = np.linspace(0, 1, len(xs))
+    u = np.linspace(0, 1, n)
+    return np.column_stack([np.interp(u, t, xs), np.interp(u, t, ys), np.full(n, pressure)])
+
+
+def build_brushes_scene(size=1024):
+    """A flat plane and a painted copy side by side; returns (strokes, seconds)."""
+    clear_scene()
+    ground = material("Ground", (0.55, 0.5, 0.38, 1.0))
+    wire_mat = material("Wire", (0.1, 0.1, 0.1, 1.0))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=48, y_subdivisions=48, size=4, location=(-2.3, 0, 0))
+    flat = bpy.context.active_object
+    flat.data.materials.append(ground)
+    wire_overlay(flat, wire_mat, thickness=0.008)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320, size=4, location=(2.3, 0, 0))
+    land = bpy.context.active_object
+    land.data.materials.append(ground)
+    bpy.ops.object.shade_smooth()
+    bpy.ops.tessera.displacement_add(width=size, height=size, mode="HEIGHT")
+    land.tessera.displacement.strength = 1.0
+    t0 = time.perf_counter()
+    s = size / 1024
+    ridge = curve(np.array([120, 300, 520, 760, 930]) * s, np.array([820, 700, 780, 640, 720]) * s, n=80)
+    for _ in range(6):
+        stroke(ridge, kind="DRAW", radius=150 * s, strength=0.008, falloff="SMOOTH", spacing=0.1)
+    peaks = [(260, 300), (700, 420), (480, 560)]
+    for x, y in peaks:
+        stroke([(x * s, y * s, 1.0)] * 2, kind="DRAW", radius=120 * s, strength=0.2, falloff="SPHERE")
+    stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
+           kind="DRAW", radius=60 * s, strength=-0.012, falloff="SMOOTH", spacing=0.1)
+    stroke([(860 * s, 220 * s, 1.0)], kind="FLATTEN", radius=110 * s, strength=1.0, falloff="SHARP")
+    stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.08, falloff="CONSTANT",
+           noise_cell=64 * s, noise_seed=3)
+    stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.012, falloff="CONSTANT",
+           noise_cell=12 * s, noise_seed=9)
+    stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
+           kind="SMOOTH", radius=40 * s, strength=1.0, falloff="SMOOTH", spacing=0.1)
+    elapsed = time.perf_counter() - t0
+    bpy.ops.tessera.displacement_export(filepath=str(OUT / "demo_map.exr"))
+    add_camera((0.0, -7.0, 3.6), (np.radians(62), 0.0, 0.0), lens=30)
+    return 13, elapsed
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -228,7 +288,11 @@ def main():
     faces, elapsed = build_tubes_scene()
     render("demo_tubes.png")
     print(f"demo: tubes around ABC-flow streamlines: {faces:,} faces in {elapsed:.2f} s")
-    for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png"):
+    strokes, elapsed = build_brushes_scene()
+    render("demo_brushes.png")
+    print(f"demo: landscape painted by {strokes} scripted strokes in {elapsed:.2f} s")
+    for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
+                 "demo_map.exr"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")

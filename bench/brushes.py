@@ -1,0 +1,106 @@
+"""Displacement-map brushes: dab latency, a 200-dab stroke, and whole-map smooth against a memory copy.
+
+- ``dab``: median latency of one DRAW dab (smooth falloff) of radius 16 / 64 / 256 texels on a 4096² and an
+  8192² height map, OpenCL with the map resident on the device (only the footprint comes back) against the
+  numpy reference editing the same map in place. Target: radius 64 on 4096² under 2 ms.
+- ``stroke``: a 200-dab DRAW stroke of radius 64 on 4096², with tile undo recorded, OpenCL vs numpy.
+- ``smooth``: one whole-map smooth of a 4096² map, on the device only and including the read-back to the host,
+  and the numpy reference, each against ``np.copyto`` of the same map in the same run (the bandwidth ratio is
+  copy time / smooth time: both move the map once in and once out). Target: >= 25 %.
+Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/brushes.py
+"""
+
+import json
+import time
+
+import numpy as np
+from _setup import best_of, import_path
+
+import_path()
+from tessera.kernels.map_buffer import MapBuffer  # noqa: E402
+from tessera.kernels.map_edit import apply_dab, smooth_map  # noqa: E402
+from tessera.kernels.map_strokes import Brush, TileUndo, run_stroke  # noqa: E402
+from tessera.kernels.opencl_runtime import get_runtime  # noqa: E402
+
+RADII = (16, 64, 256)
+
+
+def dab_latency(dmap, radius, count, **where):
+    times = []
+    h, w = dmap.shape[:2]
+    for i in range(count):
+        pos = (w / 2 + 3.7 * i, h / 2 + 1.3 * i)
+        t = time.perf_counter()
+        apply_dab(dmap, "DRAW", pos=pos, radius=radius, strength=0.01, **where)
+        times.append(time.perf_counter() - t)
+    return float(np.median(times))
+
+
+def dab_cases(runtime):
+    for size in (4096, 8192):
+        dmap = np.zeros((size, size, 1), np.float32)
+        device = MapBuffer(runtime, dmap)
+        for radius in RADII:
+            dab_latency(dmap, radius, 3, device=device)  # warm: kernels built
+            cl = dab_latency(dmap, radius, 50, device=device)
+            ref = dab_latency(dmap, radius, 10 if radius > 64 else 30, backend="numpy")
+            yield {"case": "dab", "map": size, "radius": radius, "opencl_ms": round(cl * 1e3, 3),
+                   "numpy_ms": round(ref * 1e3, 3), "speedup": round(ref / cl, 2),
+                   "target_ms": 2.0 if (size, radius) == (4096, 64) else None}
+        del device, dmap
+
+
+def stroke_case(runtime):
+    size, radius = 4096, 64.0
+    brush = Brush(kind="DRAW", radius=radius, strength=0.01, spacing=0.25)
+    spacing = brush.spacing * radius
+    path = np.column_stack([np.linspace(500, 500 + 199 * spacing, 2), [2000, 2100], [1.0, 1.0]])
+    out = {}
+    for name in ("opencl", "numpy"):
+        dmap = np.zeros((size, size, 1), np.float32)
+        device = MapBuffer(runtime, dmap) if name == "opencl" else None
+
+        def run(dmap=dmap, device=device, name=name):
+            undo = TileUndo(dmap)
+            run_stroke(dmap, brush, path, backend=name, device=device, undo=undo)
+            return undo.close(dmap)
+
+        seconds, undo = best_of(run, 3)
+        out[f"{name}_ms"] = round(seconds * 1e3, 2)
+    out.update(case="stroke", map=size, radius=radius, dabs=200, undo_tiles=len(undo.before),
+               undo_mib=round(undo.nbytes / 2**20, 2), speedup=round(out["numpy_ms"] / out["opencl_ms"], 2))
+    return out
+
+
+def smooth_case(runtime):
+    size = 4096
+    rng = np.random.default_rng(0)
+    dmap = rng.random((size, size, 1), dtype=np.float32)
+    copy = np.empty_like(dmap)
+    t_copy, _ = best_of(lambda: np.copyto(copy, dmap), 7)
+    device = MapBuffer(runtime, dmap)
+    device.smooth_all(0.5)  # warm
+    t_device, _ = best_of(lambda: (device.smooth_all(0.5, read_back=False), runtime.queue.finish()), 7)
+    t_full, _ = best_of(lambda: smooth_map(dmap, 0.5, device=device), 7)
+    t_numpy, _ = best_of(lambda: smooth_map(dmap, 0.5, backend="numpy"), 3)
+    return {"case": "smooth", "map": size, "bytes": dmap.nbytes, "copy_ms": round(t_copy * 1e3, 2),
+            "device_ms": round(t_device * 1e3, 2), "with_read_back_ms": round(t_full * 1e3, 2),
+            "numpy_ms": round(t_numpy * 1e3, 2),
+            "device_vs_copy": round(t_copy / t_device, 3), "with_read_back_vs_copy": round(t_copy / t_full, 3),
+            "numpy_vs_copy": round(t_copy / t_numpy, 3), "target": 0.25}
+
+
+def main():
+    runtime = get_runtime()
+    if runtime is None:
+        print(json.dumps({"case": "skipped", "why": "no OpenCL device"}))
+        return
+    print(json.dumps({"case": "device", "opencl": runtime.description}))
+    for row in dab_cases(runtime):
+        print(json.dumps(row))
+    print(json.dumps(stroke_case(runtime)))
+    print(json.dumps(smooth_case(runtime)))
+
+
+if __name__ == "__main__":
+    main()
