@@ -202,6 +202,7 @@ def stroke(points, **brush):
                 for i, (x, y, p) in enumerate(points)]
     if bpy.ops.tessera.displacement_stroke(stroke=elements, map_space=True) != {"FINISHED"}:
         sys.exit("demo: a displacement stroke failed")
+    return 1
 
 
 def curve(xs, ys, pressure=1.0, n=60):
@@ -229,24 +230,25 @@ def build_brushes_scene(size=1024):
     t0 = time.perf_counter()
     s = size / 1024
     ridge = curve(np.array([120, 300, 520, 760, 930]) * s, np.array([820, 700, 780, 640, 720]) * s, n=80)
+    count = 0
     for _ in range(6):
-        stroke(ridge, kind="DRAW", radius=150 * s, strength=0.008, falloff="SMOOTH", spacing=0.1)
+        count += stroke(ridge, kind="DRAW", radius=150 * s, strength=0.008, falloff="SMOOTH", spacing=0.1)
     peaks = [(260, 300), (700, 420), (480, 560)]
     for x, y in peaks:
-        stroke([(x * s, y * s, 1.0)] * 2, kind="DRAW", radius=120 * s, strength=0.2, falloff="SPHERE")
-    stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
-           kind="DRAW", radius=60 * s, strength=-0.012, falloff="SMOOTH", spacing=0.1)
-    stroke([(860 * s, 220 * s, 1.0)], kind="FLATTEN", radius=110 * s, strength=1.0, falloff="SHARP")
-    stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.08, falloff="CONSTANT",
+        count += stroke([(x * s, y * s, 1.0)] * 2, kind="DRAW", radius=120 * s, strength=0.2, falloff="SPHERE")
+    count += stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
+                    kind="DRAW", radius=60 * s, strength=-0.012, falloff="SMOOTH", spacing=0.1)
+    count += stroke([(860 * s, 220 * s, 1.0)], kind="FLATTEN", radius=110 * s, strength=1.0, falloff="SHARP")
+    count += stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.08, falloff="CONSTANT",
            noise_cell=64 * s, noise_seed=3)
-    stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.012, falloff="CONSTANT",
+    count += stroke([(512 * s, 512 * s, 1.0)], kind="NOISE", radius=800 * s, strength=0.012, falloff="CONSTANT",
            noise_cell=12 * s, noise_seed=9)
-    stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
-           kind="SMOOTH", radius=40 * s, strength=1.0, falloff="SMOOTH", spacing=0.1)
+    count += stroke(curve(np.array([0, 200, 420, 600, 1023]) * s, np.array([180, 260, 200, 330, 250]) * s, n=80),
+                    kind="SMOOTH", radius=40 * s, strength=1.0, falloff="SMOOTH", spacing=0.1)
     elapsed = time.perf_counter() - t0
     bpy.ops.tessera.displacement_export(filepath=str(OUT / "demo_map.exr"))
     add_camera((0.0, -7.0, 3.6), (np.radians(62), 0.0, 0.0), lens=30)
-    return 13, elapsed
+    return count, elapsed
 
 
 def export(tess):
