@@ -16,7 +16,7 @@ import numpy as np
 
 from ..kernels.errors import InvalidInputError, TesseraError
 from ..kernels.map_buffer import MapBuffer
-from ..kernels.map_strokes import TileUndo, run_stroke, stroke_dabs
+from ..kernels.map_strokes import TileUndo, run_stroke, stroke_dabs, union_region
 from ..kernels.opencl_runtime import get_runtime
 
 MODIFIER_NAME = "Tessera Displacement"
@@ -120,7 +120,7 @@ class StrokeSession:
             return None
         region = run_stroke(self.state.host, self.brush, new, backend=self.state.backend, device=self.state.device,
                             undo=self.undo, spaced=False)
-        self.region = _union(self.region, region)
+        self.region = union_region(self.region, region)
         return region
 
     def cancel(self):
@@ -144,12 +144,6 @@ def commit(state, image, undo):
     state.steps[state.serial] = undo
     image.tessera_serial = state.serial
     state.to_image(image)
-
-
-def _union(a, b):
-    if a is None or b is None:
-        return a or b
-    return min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])
 
 
 def sync_modifier(ob):
@@ -181,23 +175,21 @@ def sync_modifier(ob):
 
 
 def _maps_in_use():
-    for ob in bpy.data.objects:
-        if ob.type == "MESH" and ob.tessera.displacement.image is not None:
-            settings = ob.tessera.displacement
-            state = _states.get(settings.image.session_uid)
-            if state is not None:
-                yield settings.image, state
+    """(image, state) of every map being edited and bound to an object, each image once."""
+    images = {ob.tessera.displacement.image for ob in bpy.data.objects
+              if ob.type == "MESH" and ob.tessera.displacement.image is not None}
+    return [(image, _states[image.session_uid]) for image in images if image.session_uid in _states]
 
 
 @bpy.app.handlers.persistent
 def _on_undo_redo(*_args):
-    for image, state in list(_maps_in_use()):
+    for image, state in _maps_in_use():
         state.rewind(image, image.tessera_serial)
 
 
 @bpy.app.handlers.persistent
 def _on_save_pre(*_args):
-    for image, state in list(_maps_in_use()):
+    for image, state in _maps_in_use():
         state.to_image(image)
         image.file_format = "OPEN_EXR"
         image.pack()

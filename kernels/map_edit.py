@@ -158,6 +158,11 @@ def _runtime(backend):
     return runtime
 
 
+def _backend_runtime(backend, device):
+    """The OpenCL runtime to use, or None for numpy; a device-resident map always runs on its device."""
+    return _runtime("opencl") if device is not None else _runtime(backend)
+
+
 def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **params):
     """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map.
 
@@ -176,7 +181,7 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **para
     if kind == "SMOOTH":
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
-    runtime = None if backend == "numpy" and device is None else _runtime("opencl" if device else backend)
+    runtime = _backend_runtime(backend, device)
     if before_write is not None:
         before_write(region)
     if runtime is None:
@@ -202,7 +207,7 @@ def smooth_map(dmap, strength=1.0, backend="auto", device=None):
     h, w = dmap.shape[:2]
     if device is not None and device.host is not dmap:
         raise InvalidInputError("The device buffer mirrors a different map")
-    runtime = None if backend == "numpy" and device is None else _runtime("opencl" if device else backend)
+    runtime = _backend_runtime(backend, device)
     if runtime is None:
         _check_finite(dmap, (0, 0, w, h))
         dmap[...] = ref.smooth_full(dmap, k)

@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from .errors import InvalidInputError, TesseraError
+from .map_edit import check_map
 
 FLOAT_EXTENSIONS = (".exr",)
 INT16_EXTENSIONS = (".png", ".tif", ".tiff")
@@ -25,8 +26,6 @@ def _oiio():
 
 def write_map(path, dmap, low=0.0, high=1.0):
     """Write ``dmap`` to ``path`` (.exr float32, .png/.tif uint16). Returns the number of clipped values."""
-    from .map_edit import check_map
-
     check_map(dmap)
     ext = os.path.splitext(path)[1].lower()
     h, w, c = dmap.shape

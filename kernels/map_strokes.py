@@ -109,11 +109,11 @@ class TileUndo:
                 min(int(ty.max() + 1) * TILE, self.shape[0]))
 
 
-def _mirrored(brush, params, width):
+def _mirrored(params, width):
     """The dab's parameters mirrored across x = (width - 1) / 2: positions flip, vector x components negate."""
     out = dict(params)
-    for key in ("pos",):
-        out[key] = (width - 1 - params[key][0], params[key][1])
+    if "pos" in out:
+        out["pos"] = (width - 1 - params["pos"][0], params["pos"][1])
     for key in ("vector", "force", "arg2"):
         if key in out:
             v = np.array(out[key], np.float64)
@@ -161,9 +161,9 @@ def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, pro
     box = None
     for i, (x, y, pressure) in enumerate(dabs):
         params = dab_params(brush, x, y, pressure)
-        todo = [params, _mirrored(brush, params, width)] if brush.mirror_x else [params]
+        todo = [params, _mirrored(params, width)] if brush.mirror_x else [params]
         for p in todo:
-            box = _union(box, _apply(dmap, brush.kind, p, backend, device, undo))
+            box = union_region(box, _apply(dmap, brush.kind, p, backend, device, undo))
         if progress is not None and i % 64 == 0:
             progress((i + 1) / len(dabs))
     return box
@@ -174,7 +174,8 @@ def _apply(dmap, kind, params, backend, device, undo):
     return apply_dab(dmap, kind, backend=backend, device=device, before_write=before, **params)
 
 
-def _union(a, b):
+def union_region(a, b):
+    """Bounding box of two regions ``(x0, y0, x1, y1)``; either may be None."""
     if a is None or b is None:
         return a or b
     return min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])

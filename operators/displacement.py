@@ -160,6 +160,12 @@ def _texel_world_size(ob, mesh, poly_index, uv_name, size):
     return math.sqrt(world_area / max(uv_area * size[0] * size[1], 1e-30))
 
 
+def _new_session(context):
+    """A stroke on the active object's map with the scene's brush."""
+    settings = context.active_object.tessera.displacement
+    return StrokeSession(settings.image, settings, kernel_brush(context.scene.tessera_brush, channels_for(settings)))
+
+
 class TESSERA_OT_displacement_stroke(bpy.types.Operator):
     """Paint the displacement map of the active object (drag), or replay a recorded stroke"""
 
@@ -184,10 +190,8 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
     # -- replay -------------------------------------------------------------------------------------------
     def execute(self, context):
         ob = context.active_object
-        settings = ob.tessera.displacement
         try:
-            session = StrokeSession(settings.image, settings, kernel_brush(context.scene.tessera_brush,
-                                                                             channels_for(settings)))
+            session = _new_session(context)
             samples = self._replay_samples(context, ob, session.state.host.shape)
             wm = context.window_manager
             wm.progress_begin(0, len(samples))
@@ -227,11 +231,8 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         if context.area is None or context.area.type != "VIEW_3D":
             self.report({"ERROR"}, "Paint in a 3D Viewport")
             return {"CANCELLED"}
-        ob = context.active_object
-        settings = ob.tessera.displacement
         try:
-            self._session = StrokeSession(settings.image, settings,
-                                          kernel_brush(context.scene.tessera_brush, channels_for(settings)))
+            self._session = _new_session(context)
         except TesseraError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}

@@ -40,6 +40,18 @@ inline float falloff(const float t, const int kind)
   return 1.0f;
 }
 
+// the weight strength * falloff(d / r) of texel (x, y) in *k; false outside the open disc d < r
+inline bool brush_weight(const float2 pos, const int x, const int y, const float radius, const float strength,
+                         const int kind, float *k)
+{
+  const float d = texel_distance(pos, x, y);
+  if (!(d < radius)) {
+    return false;
+  }
+  *k = strength * falloff(d / radius, kind);
+  return true;
+}
+
 #define TILE_ARGS                                                                                  \
   __global float *map, const long base, const int mem_w, const int channels, const int x0, const int y0, \
       const int w, const int h
@@ -94,9 +106,8 @@ __kernel void draw(TILE_ARGS, const float2 pos, const float radius, const float 
                    const float4 vec)
 {
   TEXEL_SETUP
-  const float d = texel_distance(pos, x, y);
-  if (d < radius) {
-    const float k = strength * falloff(d / radius, kind);
+  float k;
+  if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(vec, c, channels) * k;
     }
@@ -107,9 +118,8 @@ __kernel void flatten(TILE_ARGS, const float2 pos, const float radius, const flo
                       const float4 target)
 {
   TEXEL_SETUP
-  const float d = texel_distance(pos, x, y);
-  if (d < radius) {
-    const float k = strength * falloff(d / radius, kind);
+  float k;
+  if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     for (int c = 0; c < channels; ++c) {
       t[c] += (operand(target, c, channels) - t[c]) * k;
     }
@@ -121,9 +131,8 @@ __kernel void smooth(TILE_ARGS, __global const float *src, const int ws, const i
                      const int sy0, const float2 pos, const float radius, const float strength, const int kind)
 {
   TEXEL_SETUP
-  const float d = texel_distance(pos, x, y);
-  if (d < radius) {
-    const float k = strength * falloff(d / radius, kind);
+  float k;
+  if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     for (int c = 0; c < channels; ++c) {
       float sum = 0.0f;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -187,9 +196,8 @@ __kernel void noise(TILE_ARGS, const float2 pos, const float radius, const float
                     const float4 vec, const float cell, const uint seed)
 {
   TEXEL_SETUP
-  const float d = texel_distance(pos, x, y);
-  if (d < radius) {
-    const float k = strength * falloff(d / radius, kind);
+  float k;
+  if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     const float n = value_noise(x, y, cell, seed);
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(vec, c, channels) * k * n;
