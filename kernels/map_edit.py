@@ -13,12 +13,11 @@ the map is unchanged. OpenCL (``cl/map_dabs.cl``) and numpy (`map_dabs`) give th
 import numpy as np
 
 from . import map_dabs as ref
-from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+from .errors import InvalidInputError, TesseraError
 from .map_buffer import MapBuffer
-from .opencl_runtime import get_runtime
+from .opencl_runtime import backend_runtime
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
-BACKENDS = ("auto", "numpy", "opencl")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
 
 
@@ -148,14 +147,7 @@ def _f4(v):
 
 
 def _runtime(backend):
-    if backend not in BACKENDS:
-        raise InvalidInputError(f"backend must be one of {BACKENDS}; got {backend!r}")
-    if backend == "numpy":
-        return None
-    runtime = get_runtime()
-    if runtime is None and backend == "opencl":
-        raise OpenCLUnavailableError("OpenCL was requested for the map edit but no device is available")
-    return runtime
+    return backend_runtime(backend, "the map edit")
 
 
 def _backend_runtime(backend, device):

@@ -15,7 +15,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import OpenCLUnavailableError, TesseraError
+from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
 
 log = logging.getLogger(__name__)
 
@@ -159,3 +159,21 @@ def get_runtime():
     if _state["runtime"] is None and mode == "require":
         raise OpenCLUnavailableError("OpenCL is required (TESSERA_OPENCL=require) but unavailable")
     return _state["runtime"]
+
+
+BACKENDS = ("auto", "numpy", "opencl")
+
+
+def backend_runtime(backend, purpose="this kernel"):
+    """The runtime for a ``backend`` choice ("auto", "numpy", "opencl"): None means numpy.
+
+    "opencl" raises `OpenCLUnavailableError` when no device is available; "auto" falls back quietly.
+    """
+    if backend not in BACKENDS:
+        raise InvalidInputError(f"backend must be one of {BACKENDS}; got {backend!r}")
+    if backend == "numpy":
+        return None
+    runtime = get_runtime()
+    if runtime is None and backend == "opencl":
+        raise OpenCLUnavailableError(f"OpenCL was requested for {purpose} but no device is available")
+    return runtime
