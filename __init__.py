@@ -10,15 +10,18 @@ _modules = (
     "addon.preferences",
     "addon.tube_settings",
     "addon.displacement_settings",
+    "addon.terrain_settings",
     "addon.settings",
     "addon.displacement_maps",
     "operators.tessellate",
     "operators.tubes",
     "operators.displacement",
     "operators.custom_kernel",
+    "operators.terrain",
     "addon.menus",
     "addon.panels",
     "addon.tube_preview",
+    "addon.terrain_preview",
     "addon.brush_tool",
 )
 

@@ -11,6 +11,8 @@ class TESSERA_MT_object(bpy.types.Menu):
         self.layout.operator("tessera.tessellate", icon="MOD_SUBSURF")
         self.layout.operator("tessera.tubes", icon="MESH_CYLINDER")
         self.layout.operator("tessera.displacement_add", icon="IMAGE_DATA")
+        self.layout.operator("tessera.terrain_add", icon="RNDCURVE")
+        self.layout.operator("tessera.terrain_bake", icon="VIEW_CAMERA")
 
 
 def _draw_object_menu(self, context):

@@ -4,6 +4,7 @@ import bpy
 
 from .brush_tool import draw_brush_settings
 from .settings import draw_settings
+from .terrain_settings import draw_terrain_settings
 from .tube_settings import copy_tube_settings, draw_tube_settings
 from .tube_sources import SOURCE_TYPES
 
@@ -94,5 +95,24 @@ class TESSERA_PT_displacement(_Sidebar, bpy.types.Panel):
             row.operator("tessera.displacement_custom", icon="PLAY")
 
 
-classes = (TESSERA_PT_tessellate, TESSERA_PT_tubes, TESSERA_PT_displacement)
+class TESSERA_PT_terrain(_Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_terrain"
+    bl_label = "Terrain"
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.tessera.terrain.is_terrain
+
+    def draw_header(self, context):
+        self.layout.prop(context.active_object.tessera.terrain, "preview", text="")
+
+    def draw(self, context):
+        draw_terrain_settings(self.layout, context.active_object.tessera.terrain)
+        row = self.layout.row()
+        row.scale_y = 1.4
+        row.operator("tessera.terrain_bake", icon="VIEW_CAMERA")
+
+
+classes = (TESSERA_PT_tessellate, TESSERA_PT_tubes, TESSERA_PT_displacement, TESSERA_PT_terrain)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -13,6 +13,7 @@ from ..kernels.partition import MAX_LEVEL
 from ..kernels.tessellate import SurfaceOptions
 from .cameras import CAMERA_ITEMS
 from .displacement_settings import TESSERA_PG_displacement
+from .terrain_settings import TESSERA_PG_terrain
 from .tube_settings import TESSERA_PG_tubes
 
 METHOD_ITEMS = (
@@ -109,6 +110,7 @@ class TESSERA_PG_object(bpy.types.PropertyGroup):
     tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
     tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
     displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
+    terrain: bpy.props.PointerProperty(type=TESSERA_PG_terrain)
 
 
 def copy_settings(source, target):

@@ -11,6 +11,7 @@ Per tile, from the `terrain_analysis.TileTable`:
 - the distance law (5-5..5-7): ``T = T_max`` below ``d_max``, ``T_max·d_max²/d²`` up to
   ``d_min = d_max·sqrt(T_max/T_min)``, ``T_min`` beyond; i.e. ``clamp(T_max·d_max²/d², T_min, T_max)``.
 
+Levels never exceed the tile size in texels (a quad always covers at least a texel, seed §5.4.2).
 Edge levels use the edge's midpoint (on the terrain surface) and ``max`` of the two tiles' T_max and T_min;
 every input is the same for both tiles, and only +, -, ×, / and sqrt touch it, so both tiles compute the
 same level bit for bit. The inner level uses the tile centre and the tile's own bounds. Tiles whose bounding
@@ -20,7 +21,7 @@ Coordinates: sample (x, y) is at world ``((x - (W-1)/2)·texel, (y - (H-1)/2)·t
 given in that (terrain-local) space.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -211,7 +212,7 @@ def _round(levels, settings):
     if settings.levels == "POW2":
         n = np.exp2(np.ceil(np.log2(f)))
         n = np.where(n * 0.5 >= f, n * 0.5, n)  # exact powers of two, whatever log2's last bit says
-        return np.where(n < f, n * 2.0, n)
+        return np.minimum(np.where(n < f, n * 2.0, n), settings.max_level)
     return f
 
 
@@ -230,11 +231,17 @@ def _neighbour(a, side, fill):
 
 
 def select(hm, table, camera, settings=TerrainLod()):
-    """Edge and inner levels of every tile for ``camera`` (a `camera.Camera` in terrain-local space)."""
+    """Edge and inner levels of every tile for ``camera`` (a `camera.Camera` in terrain-local space).
+
+    With ``camera=None`` the result is view-independent: every level is its T_max (the terrain as close up
+    as it ever needs to be), nothing is culled.
+    """
     if table.shape != (hm.height, hm.width):
         raise InvalidInputError("The tile table was made for a different height map; analyse the map again")
     ntx, nty = table.counts
     ts = table.tile_size
+    # "a quad always covers a texel" (seed §5.4.2): no level above the tile's size in texels
+    settings = replace(settings, max_level=min(settings.max_level, ts))
     xb = tile_bounds(np.arange(ntx), ts, hm.width)
     yb = tile_bounds(np.arange(nty), ts, hm.height)
     xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
@@ -245,11 +252,16 @@ def select(hm, table, camera, settings=TerrainLod()):
         t_min = t_max.copy()
     elif settings.mode == "DISTANCE":
         t_max, t_min = np.full((nty, ntx), top), np.ones((nty, ntx))
+    elif camera is None:
+        t_max = g_of_ham(table.ham_max, settings)
+        t_min = t_max
     else:
         t_max = g_of_ham(table.ham_max, settings)
         t_min = t_min_levels(hm, table, camera, settings, t_max, xs, ys)
-    eye = camera.eye
-    d_max = auto_d_max(hm, camera, settings)
+    if camera is None:  # the distance law at d = 0 everywhere: T_max
+        eye, d_max = np.zeros(3), np.inf
+    else:
+        eye, d_max = camera.eye, auto_d_max(hm, camera, settings)
     (x0, x1), (y0, y1) = xs, ys
     mx, my = (x0 + x1) * 0.5, (y0 + y1) * 0.5
     points = ((mx, y0), (x1, my), (mx, y1), (x0, my))
@@ -261,7 +273,10 @@ def select(hm, table, camera, settings=TerrainLod()):
         edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
     centre = to_world(hm, mx, my, hm.sample(mx, my))
     inner = distance_level(_distance(eye, centre), t_max, t_min, d_max)
-    culled = _culled(hm, table, camera, xs, ys) if settings.culling else np.zeros((nty, ntx), bool)
+    if settings.culling and camera is not None:
+        culled = _culled(hm, table, camera, xs, ys)
+    else:
+        culled = np.zeros((nty, ntx), bool)
     rounded = _round(edge, settings)
     h_edges = np.concatenate([rounded[:, :, 0], rounded[-1:, :, 2]], axis=0)
     v_edges = np.concatenate([rounded[:, :, 3], rounded[:, -1:, 1]], axis=1)

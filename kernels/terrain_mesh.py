@@ -72,6 +72,47 @@ def pattern(c0, c1, c2, c3, n):
     return np.array(tris, np.int32)
 
 
+def _tile_counts(selection):
+    """Edge segment counts (nty, ntx, 4) and the inner counts the patterns use (nty, ntx)."""
+    sp = selection.spacing
+    hc, vc = segment_counts(selection.h_edges, sp), segment_counts(selection.v_edges, sp)
+    ec = np.stack([hc[:-1], vc[:, 1:], hc[1:], vc[:, :-1]], -1)  # per tile: BOTTOM, RIGHT, TOP, LEFT
+    n = selection.inner_counts.astype(np.int64)
+    return ec, np.where((n == 1) & (ec.max(-1) > 1), 2, n)
+
+
+def triangle_count(selection):
+    """Triangles `bake` will make, without making them (for memory guards and benchmarks): int."""
+    ec, n = _tile_counts(selection)
+    m = n - 1
+    per_tile = np.where(m == 0, 2, ec.sum(-1) + 4 * (m - 1) + 2 * (m - 1) ** 2)
+    return int(per_tile[~selection.culled].sum())
+
+
+def pattern_codes(c0, c1, c2, c3, n):
+    """What each local vertex of `pattern` is, for GPU patterns: (L, 3) float32 rows (kind, a, b).
+
+    kind 0: corner at (u, v) = (a, b); kinds 1-4: point ``a`` of side BOTTOM, RIGHT, TOP, LEFT; kind 5: inner
+    grid point (i, j) = (a, b). Positions follow from the tile's levels with `partition.point_params`.
+    """
+    rows = [(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)]
+    for s, c in enumerate((c0, c1, c2, c3)):
+        rows += [(s + 1, k, 0) for k in range(1, c)]
+    if not (n == 1 and max(c0, c1, c2, c3) == 1):
+        rows += [(5, i, j) for j in range(1, n) for i in range(1, n)]
+    return np.array(rows, np.float32)
+
+
+def pattern_classes(selection):
+    """Tiles grouped by pattern: dict (c0, c1, c2, c3, n) -> visible tile indices (row-major) int64."""
+    ec, n = _tile_counts(selection)
+    keys = np.concatenate([ec.reshape(-1, 4), n.reshape(-1, 1)], 1)
+    visible = np.nonzero(~selection.culled.ravel())[0]
+    classes, inverse = np.unique(keys[visible], axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    return {tuple(int(v) for v in key): visible[inverse == k] for k, key in enumerate(classes)}
+
+
 def _edge_points(levels, spacing, fixed, lo, hi, along_x):
     """Interior points of a family of edges: counts (k,), first index (k,), sample coords (total, 2)."""
     counts = segment_counts(levels, spacing).ravel()
@@ -96,9 +137,7 @@ def bake(hm, table, selection):
     corners = np.stack([gx.ravel(), gy.ravel()], 1)  # (nty + 1) * (ntx + 1), row-major
     hc, hf, hxy = _edge_points(selection.h_edges, spacing, gy[:, :-1], gx[:, :-1], gx[:, 1:], True)
     vc, vf, vxy = _edge_points(selection.v_edges, spacing, gx[:-1, :], gy[:-1, :], gy[1:, :], False)
-    ec = np.stack([hc[:-1], vc[:, 1:], hc[1:], vc[:, :-1]], -1)  # per tile: BOTTOM, RIGHT, TOP, LEFT
-    n = selection.inner_counts.astype(np.int64)
-    n = np.where((n == 1) & (ec.max(-1) > 1), 2, n)
+    _, n = _tile_counts(selection)
     f_in = clamp_levels(selection.inner, spacing)  # EQUAL spacing ignores it; a forced 2 stays exact
     # inner grid points per tile, row-major, (n - 1)² each
     m = (n - 1).ravel()
@@ -116,21 +155,16 @@ def bake(hm, table, selection):
     base_in = n_c + n_h + vxy.shape[0]
     samples = np.concatenate([corners, hxy, vxy, ixy])
     tri_parts = []
-    keys = np.concatenate([ec.reshape(-1, 4), n.reshape(-1, 1)], 1)
-    visible = ~selection.culled.ravel()
-    classes, inverse = np.unique(keys[visible], axis=0, return_inverse=True)
-    tiles_visible = np.nonzero(visible)[0]
-    for k, key in enumerate(classes):
-        tiles = tiles_visible[inverse.ravel() == k]
-        c = [int(v) for v in key[:4]]
-        tmpl = pattern(*c, int(key[4]))
+    for key, tiles in pattern_classes(selection).items():
+        c = key[:4]
+        tmpl = pattern(*key)
         tyi, txi = tiles // ntx, tiles % ntx
         cols = [tyi * (ntx + 1) + txi, tyi * (ntx + 1) + txi + 1, (tyi + 1) * (ntx + 1) + txi + 1,
                 (tyi + 1) * (ntx + 1) + txi]
         starts = (n_c + hf[tyi, txi], n_c + n_h + vf[tyi, txi + 1], n_c + hf[tyi + 1, txi], n_c + n_h + vf[tyi, txi])
         for s in range(4):
             cols += [starts[s] + q for q in range(c[s] - 1)]
-        mloc = int(key[4]) - 1
+        mloc = key[4] - 1
         if not (mloc == 0 and max(c) == 1):
             cols += [base_in + inner_first[tiles] + q for q in range(mloc * mloc)]
         lmap = np.stack(cols, 1)

@@ -81,13 +81,15 @@ def test_random_cameras_shared_edges_agree_bit_for_bit_and_meshes_have_no_holes(
         assert sel.edge.max() <= 64 and sel.edge.min() >= 1
         assert np.all(sel.edge <= np.maximum(sel.t_max[..., None], 64))
         mesh = tm.bake(hm, table, sel)
+        assert len(mesh.triangles) == tm.triangle_count(sel)
         boundary, counts = _boundary_edges(mesh.triangles)
         s = mesh.samples[boundary]  # (k, 2 ends, xy)
         on_border = ((s[..., 0] == 0).all(1) | (s[..., 0] == hm.width - 1).all(1)
                      | (s[..., 1] == 0).all(1) | (s[..., 1] == hm.height - 1).all(1))
         assert on_border.all() and counts.max() == 2  # closed inside, manifold
         p = mesh.samples[mesh.triangles]
-        cross = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+        e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+        cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
         assert cross.min() > 0 and cross.sum() / 2 == pytest.approx((hm.width - 1) * (hm.height - 1))
         assert np.isfinite(mesh.positions).all()
 
@@ -102,6 +104,7 @@ def test_culled_tiles_produce_no_triangles():
         sel = tl.select(hm, table, cam, tl.TerrainLod(culling=True))
         seen_culled += sel.culled.sum()
         mesh = tm.bake(hm, table, sel)
+        assert len(mesh.triangles) == tm.triangle_count(sel)
         if not len(mesh.triangles):
             assert sel.culled.all()
             continue

@@ -1,0 +1,99 @@
+"""Live terrain preview in the 3D viewport: terrain objects with ``tessera.terrain.preview`` are drawn on the GPU.
+
+The height map is uploaded once per object (until its source settings change); levels are selected again
+only when the view changes (numpy, a few milliseconds for 65k tiles), and only the tile table of the new
+selection is uploaded. The preview is drawn even while the object itself is hidden, so the baked mesh can be
+hidden during a fly-through. Nothing is drawn or compiled in background mode.
+"""
+
+import bpy
+import numpy as np
+
+from ..kernels.camera import Camera
+from ..kernels.errors import TesseraError
+from ..kernels.terrain_lod import select
+from . import terrain_data
+from .terrain_settings import lod_settings, source_key
+
+_state = {"handler": None, "cache": {}, "errors": {}}
+
+
+def settings_changed(ob):
+    """Forget ``ob``'s selection (and its upload when the source changed) and redraw (property update)."""
+    if isinstance(ob, bpy.types.Object):
+        entry = _state["cache"].get(ob.name)
+        if entry is not None and entry["source"] != source_key(ob.tessera.terrain):
+            _state["cache"].pop(ob.name, None)
+        elif entry is not None:
+            entry["view"] = None
+        _state["errors"].pop(ob.name, None)
+    for window in getattr(bpy.context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+def entry_for(ob):
+    """Cached GPU data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
+    from ..gpu_shaders.terrain_preview import TerrainDrawData
+
+    cache = _state["cache"]
+    if ob.name not in cache and ob.name not in _state["errors"]:
+        try:
+            hm, table = terrain_data.analysis(ob)
+        except TesseraError as err:
+            _state["errors"][ob.name] = str(err)
+            return None
+        cache[ob.name] = {"source": source_key(ob.tessera.terrain), "view": None,
+                          "draw": TerrainDrawData(hm, table)}
+    return cache.get(ob.name)
+
+
+def update_view(ob, entry, view, projection, width, height):
+    """Re-select levels when the view (or a setting) changed; returns True when it did."""
+    model = np.array(ob.matrix_world)
+    key = (view @ model).tobytes() + np.asarray(projection).tobytes() + bytes((width % 256, height % 256))
+    if entry["view"] == key:
+        return False
+    draw = entry["draw"]
+    camera = Camera(view @ model, projection, width, height)
+    draw.set_selection(select(draw.hm, draw.table, camera, lod_settings(ob.tessera.terrain)))
+    entry["view"] = key
+    return True
+
+
+def _draw():
+    import gpu
+
+    context = bpy.context
+    region, rv3d = context.region, context.region_data
+    if region is None or rv3d is None:
+        return
+    view, proj = np.array(rv3d.view_matrix), np.array(rv3d.window_matrix)
+    gpu.state.depth_test_set("LESS_EQUAL")
+    gpu.state.depth_mask_set(True)
+    for ob in context.view_layer.objects:
+        s = ob.tessera.terrain
+        if not (s.is_terrain and s.preview):
+            continue
+        entry = entry_for(ob)
+        if entry is None:
+            continue
+        update_view(ob, entry, view, proj, region.width, region.height)
+        entry["draw"].draw(proj @ view @ np.array(ob.matrix_world))
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+
+
+def register():
+    if not bpy.app.background:
+        _state["handler"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+
+
+def unregister():
+    if _state["handler"] is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_state["handler"], "WINDOW")
+        _state["handler"] = None
+    _state["cache"].clear()
+    _state["errors"].clear()
+    terrain_data.forget()

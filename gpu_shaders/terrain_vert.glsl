@@ -1,0 +1,74 @@
+/* Terrain preview (seed 000 §5.6, without a tessellation stage): one instanced pattern per tile class
+ * (four edge segment counts `edge_counts` and the inner count `inner_count`), one instance per tile.
+ * Instance t reads texels 3t..3t+2 of `tiles`: (x0, y0, x1, y1) in samples, the four edge levels, (inner
+ * level, 0, 0, 0). Pattern vertex `code` = (kind, a, b): 0 corner (a, b); 1-4 point a of side BOTTOM, RIGHT,
+ * TOP, LEFT; 5 inner grid point (a, b). Heights are sampled bilinearly from `heights` (R32F, one texel per
+ * sample, `height_stride` samples per texel) in the vertex shader. Same partition as kernels/partition.py. */
+
+vec4 fetch_tile(int i)
+{
+  return texelFetch(tiles, ivec2(i % tex_width, i / tex_width), 0);
+}
+
+float param(float f, float n, float j)
+{
+  float jm = min(j, n - j);
+  float h;
+  if (fractional == 0) {
+    h = jm / n;
+  }
+  else {
+    f = clamp(f, 2.0, 64.0);
+    float long_len = n > 2.0 ? (2.0 * n - 2.0 - f) / (n * (n - 2.0)) : 0.5;
+    h = (2.0 * jm == n) ? 0.5 : jm * long_len;
+  }
+  return 2.0 * j <= n ? h : 1.0 - h;
+}
+
+float height_at(vec2 s)
+{
+  vec2 t = s / height_stride;
+  ivec2 size = textureSize(heights, 0);
+  t = clamp(t, vec2(0.0), vec2(size - 1));
+  ivec2 i0 = min(ivec2(floor(t)), size - 2);
+  vec2 f = t - vec2(i0);
+  float h00 = texelFetch(heights, i0, 0).r, h10 = texelFetch(heights, i0 + ivec2(1, 0), 0).r;
+  float h01 = texelFetch(heights, i0 + ivec2(0, 1), 0).r, h11 = texelFetch(heights, i0 + ivec2(1, 1), 0).r;
+  return mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
+}
+
+void main()
+{
+  vec4 rect = fetch_tile(3 * gl_InstanceID);
+  vec4 lev = fetch_tile(3 * gl_InstanceID + 1);
+  float f_in = fetch_tile(3 * gl_InstanceID + 2).x;
+  int kind = int(code.x);
+  vec2 uv;
+  if (kind == 0) {
+    uv = code.yz;
+  }
+  else if (kind == 1) {
+    uv = vec2(param(lev.x, edge_counts.x, code.y), 0.0);
+  }
+  else if (kind == 2) {
+    uv = vec2(1.0, param(lev.y, edge_counts.y, code.y));
+  }
+  else if (kind == 3) {
+    uv = vec2(param(lev.z, edge_counts.z, code.y), 1.0);
+  }
+  else if (kind == 4) {
+    uv = vec2(0.0, param(lev.w, edge_counts.w, code.y));
+  }
+  else {
+    uv = vec2(param(f_in, inner_count, code.y), param(f_in, inner_count, code.z));
+  }
+  vec2 s = rect.xy + uv * (rect.zw - rect.xy);
+  float z = height_at(s);
+  vec3 world = vec3((s - grid.xy) * grid.z, z);
+  gl_Position = view_projection * vec4(world, 1.0);
+  float d = grid.z * height_stride;
+  vec3 n = normalize(vec3(height_at(s - vec2(height_stride, 0.0)) - height_at(s + vec2(height_stride, 0.0)),
+                          height_at(s - vec2(0.0, height_stride)) - height_at(s + vec2(0.0, height_stride)),
+                          2.0 * d));
+  shade = abs(dot(n, light_dir));
+}

@@ -1,0 +1,143 @@
+"""``tessera.terrain_add`` (a terrain object from a height map) and ``tessera.terrain_bake`` (its crack-free
+adaptive mesh for a camera, for render and export)."""
+
+import time
+
+import bpy
+
+from ..addon import terrain_data
+from ..addon.cameras import camera_for, object_camera
+from ..addon.preferences import get_preferences
+from ..addon.terrain_settings import copy_terrain_settings, draw_terrain_settings, lod_settings, terrain_annotations
+from ..kernels.errors import BudgetError, InvalidInputError, TesseraError
+from ..kernels.terrain_lod import select
+from ..kernels.terrain_mesh import bake, triangle_count
+
+#: Blender memory per output triangle (vertex share, 3 corners, edges, face, UVs), for the memory guard.
+_BYTES_PER_TRIANGLE = 80
+
+
+def _camera_or_none(context, source):
+    """The chosen camera, or None (view-independent levels) when there is none to use."""
+    try:
+        return camera_for(context, source)
+    except InvalidInputError:
+        return None
+
+
+def _bake_into(context, ob, camera, report):
+    """Select levels for ``camera``, check the budget, bake and write the mesh. Returns the selection."""
+    s = ob.tessera.terrain
+    wm = context.window_manager
+    hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)))
+    t0 = time.perf_counter()
+    sel = select(hm, table, object_camera(camera, ob.matrix_world) if camera else None, lod_settings(s))
+    t_select = time.perf_counter() - t0
+    n_tris = triangle_count(sel)
+    budget = get_preferences(context).memory_budget_bytes
+    if budget and n_tris * _BYTES_PER_TRIANGLE > budget:
+        raise BudgetError(f"The terrain mesh would have {n_tris:,} triangles (about "
+                          f"{n_tris * _BYTES_PER_TRIANGLE / 2**20:,.0f} MiB), over the memory budget of "
+                          f"{budget / 2**20:,.0f} MiB. Raise the error in pixels, use Adaptive levels, or raise "
+                          "the budget in the Tessera preferences.")
+    wm.progress_update(85)
+    mesh = bake(hm, table, sel)
+    terrain_data.write_terrain_mesh(ob, f"{ob.name}.terrain", mesh)
+    full = 2 * (hm.width - 1) * (hm.height - 1)
+    view = "for the camera" if camera is not None else "view-independent (no camera)"
+    report({"INFO"}, f"Terrain {view}: {len(mesh.triangles):,} triangles, {100 * len(mesh.triangles) / full:.2f}% "
+                     f"of the full grid; {int(sel.culled.sum())} of {sel.culled.size} tiles culled; "
+                     f"levels selected in {t_select * 1e3:.1f} ms")
+    return sel
+
+
+class TESSERA_OT_terrain_add(bpy.types.Operator):
+    """Add a terrain object from a height map, meshed adaptively for the scene camera"""
+
+    bl_idname = "tessera.terrain_add"
+    bl_label = "Terrain from Height Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    __annotations__ = {
+        **terrain_annotations(),
+        "filter_glob": bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw",
+                                                options={"HIDDEN"}),
+    }
+
+    @classmethod
+    def poll(cls, context):
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode to add a terrain")
+            return False
+        return True
+
+    def invoke(self, context, event):
+        if self.source == "FILE" and not self.filepath:
+            context.window_manager.fileselect_add(self)
+            return {"RUNNING_MODAL"}
+        return self.execute(context)
+
+    def draw(self, context):
+        draw_terrain_settings(self.layout, self)
+
+    def execute(self, context):
+        mesh = bpy.data.meshes.new("Terrain")
+        ob = bpy.data.objects.new("Terrain", mesh)
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            copy_terrain_settings(self, ob.tessera.terrain)
+            ob.tessera.terrain.is_terrain = True
+            ob.location = context.scene.cursor.location
+            context.collection.objects.link(ob)
+            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report)
+        except TesseraError as err:
+            terrain_data.forget(ob)
+            data = ob.data
+            bpy.data.objects.remove(ob)
+            for m in {data, mesh}:
+                if m.users == 0:
+                    bpy.data.meshes.remove(m)
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        for other in context.selected_objects:
+            other.select_set(False)
+        ob.select_set(True)
+        context.view_layer.objects.active = ob
+        return {"FINISHED"}
+
+
+class TESSERA_OT_terrain_bake(bpy.types.Operator):
+    """Re-mesh the active terrain for its camera (scene camera or viewport): crack-free, for render and export"""
+
+    bl_idname = "tessera.terrain_bake"
+    bl_label = "Bake Terrain for Camera"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if ob is None or ob.type != "MESH" or not ob.tessera.terrain.is_terrain:
+            cls.poll_message_set("Select a terrain object (Add > Tessera > Terrain from Height Map)")
+            return False
+        return True
+
+    def execute(self, context):
+        ob = context.active_object
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            camera = camera_for(context, ob.tessera.terrain.camera_source)
+            _bake_into(context, ob, camera, self.report)
+        except TesseraError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_terrain_add, TESSERA_OT_terrain_bake)
+register, unregister = bpy.utils.register_classes_factory(classes)
