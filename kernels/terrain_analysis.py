@@ -16,7 +16,7 @@ Everything runs on bands of tile rows, so a memory-mapped map of any size is ana
 by a few bands (`tile_table`), and an edit re-analyses only the tiles it can reach (`update_tiles`).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -86,6 +86,8 @@ class TileTable:
     h_max: np.ndarray
     peak_x: np.ndarray
     peak_y: np.ndarray
+    #: camera-independent values derived from the table (level selection fills it; edits clear it)
+    derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     @classmethod
     def empty(cls, shape, tile_size):
@@ -195,4 +197,5 @@ def update_tiles(table, hm, region):
     tx0, ty0 = max(0, (gx0 - 1) // ts), max(0, (gy0 - 1) // ts)
     tx1, ty1 = min(ntx, gx1 // ts + 1), min(nty, gy1 // ts + 1)
     _analyse(table, hm, ty0, ty1, tx0, tx1)
+    table.derived.clear()
     return tx0, ty0, tx1, ty1

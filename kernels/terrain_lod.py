@@ -141,8 +141,15 @@ def _distance(eye, points):
     return np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2])
 
 
-def _peak_error_px(hm, table, camera, xs, ys, level):
-    """Projected vertical error at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64.
+def _cached(table, key, make):
+    """A camera-independent array derived from the table, computed once (edits clear `TileTable.derived`)."""
+    if key not in table.derived:
+        table.derived[key] = make()
+    return table.derived[key]
+
+
+def _grid_height_at_peak(hm, table, xs, ys, level):
+    """Height at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64.
 
     The grid cell around the peak is split along its (i, j)-(i+1, j+1) diagonal, as the mesh splits it.
     """
@@ -157,9 +164,16 @@ def _peak_error_px(hm, table, camera, xs, ys, level):
     z00, z10 = hm.sample(gx0, gy0).astype(np.float64), hm.sample(gx1, gy0).astype(np.float64)
     z01, z11 = hm.sample(gx0, gy1).astype(np.float64), hm.sample(gx1, gy1).astype(np.float64)
     lower = u >= v
-    z = np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00))
-    top = to_world(hm, px, py, table.h_max)
-    base = to_world(hm, px, py, z)
+    return np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00))
+
+
+def _peak_error_px(hm, table, camera, xs, ys, level):
+    """Projected vertical error at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64."""
+    z = _cached(table, ("peak_base", level), lambda: _grid_height_at_peak(hm, table, xs, ys, level))
+    px, py = table.peak_x, table.peak_y
+    top = _cached(table, "peak", lambda: to_world(hm, px, py, table.h_max))
+    base = top.copy()
+    base[..., 2] = z
     (p0, w0), (p1, w1) = _project(camera, top), _project(camera, base)
     err = np.hypot(p0[..., 0] - p1[..., 0], p0[..., 1] - p1[..., 1])
     return np.where((w0 > 0) & (w1 > 0) & np.isfinite(err), err, 0.0)
@@ -187,19 +201,21 @@ def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
     return np.clip(t, 1.0, t_max)
 
 
+def _box_corners(hm, table, xs, ys):
+    """Homogeneous world corners of every tile's bounding box: (nty * ntx * 8, 4) float64."""
+    (x0, x1), (y0, y1) = xs, ys
+    corners = [to_world(hm, x, y, z) for x in (x0, x1) for y in (y0, y1) for z in (table.h_min, table.h_max)]
+    c = np.stack(corners, axis=-2).reshape(-1, 3)
+    return np.concatenate([c, np.ones((len(c), 1))], axis=1)
+
+
 def _culled(hm, table, camera, xs, ys):
     """Tiles whose bounding box lies outside one frustum plane: (nty, ntx) bool."""
-    (x0, x1), (y0, y1) = xs, ys
-    corners = []
-    for x in (x0, x1):
-        for y in (y0, y1):
-            for z in (table.h_min, table.h_max):
-                corners.append(to_world(hm, x, y, z))
-    c = np.stack(corners, axis=-2)  # (nty, ntx, 8, 3)
+    c = _cached(table, "box", lambda: _box_corners(hm, table, xs, ys))
     m = np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
-    clip = c @ m[:, :3].T + m[:, 3]
+    clip = (c @ m.T).reshape(xs[0].shape + (8, 4))
     w = clip[..., 3]
-    out = np.zeros(c.shape[:2], bool)
+    out = np.zeros(xs[0].shape, bool)
     for axis in range(3):
         out |= np.all(clip[..., axis] < -w, axis=-1) | np.all(clip[..., axis] > w, axis=-1)
     return out
@@ -267,11 +283,11 @@ def select(hm, table, camera, settings=TerrainLod()):
     points = ((mx, y0), (x1, my), (mx, y1), (x0, my))
     edge = np.empty((nty, ntx, 4))
     for side, (px, py) in enumerate(points):
-        p = to_world(hm, px, py, hm.sample(px, py))
+        p = _cached(table, ("edge", side), lambda px=px, py=py: to_world(hm, px, py, hm.sample(px, py)))
         e_max = np.maximum(t_max, _neighbour(t_max, side, 0.0))
         e_min = np.maximum(t_min, _neighbour(t_min, side, 0.0))
         edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
-    centre = to_world(hm, mx, my, hm.sample(mx, my))
+    centre = _cached(table, "centre", lambda: to_world(hm, mx, my, hm.sample(mx, my)))
     inner = distance_level(_distance(eye, centre), t_max, t_min, d_max)
     if settings.culling and camera is not None:
         culled = _culled(hm, table, camera, xs, ys)
