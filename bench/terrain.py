@@ -92,7 +92,8 @@ def main():
 
     big, big_table, peak, path = out_of_core(16385 if "--full" not in sys.argv else 65537, heights)
     print(json.dumps({"case": "out_of_core", "map": f"{big.width}x{big.height}",
-                      "file_mib": os.path.getsize(path) / 2**20, "float32_map_mib": big.width * big.height * 4 / 2**20, "peak_alloc_mib": peak / 2**20,
+                      "file_mib": os.path.getsize(path) / 2**20,
+                      "float32_map_mib": big.width * big.height * 4 / 2**20, "peak_alloc_mib": peak / 2**20,
                       "tiles": int(big_table.ham_max.size)}))
     times = []
     for cam in path_cameras(big, 6):
