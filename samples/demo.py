@@ -11,6 +11,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
 - ``out/demo_brushes.png``: a flat plane (left) turned into a landscape (right) by a scripted set of
   displacement-brush strokes (ridges, a valley, a plateau, noise, smoothing) replayed through
   ``tessera.displacement_stroke``; the map is also written as ``out/demo_map.exr`` (32-bit float);
+- ``out/demo_terrain.png``: a synthetic ridged terrain (1025², written as a 16-bit PNG height map) added with
+  ``tessera.terrain_add`` and meshed adaptively for the scene camera, wireframe on top;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
@@ -251,6 +253,36 @@ def build_brushes_scene(size=1024):
     return count, elapsed
 
 
+def build_terrain_scene(size=1025):
+    """A synthetic ridged terrain written as a 16-bit PNG, added with ``tessera.terrain_add`` and meshed for the
+    scene camera (adaptive, crack-free, frustum-culled); wireframe on top. Returns (triangles, full grid)."""
+    import OpenImageIO as oiio
+
+    clear_scene()
+    heights = np.asarray(_synth().ridged_terrain(size, seed=7))
+    path = str(OUT / "demo_heightmap.png")
+    out = oiio.ImageOutput.create(path)
+    out.open(path, oiio.ImageSpec(size, size, 1, "uint16"))
+    out.write_image(np.ascontiguousarray(np.round(heights[::-1] * 65535).astype(np.uint16))[..., None])
+    out.close()
+    add_camera((0.0, -640.0, 260.0), (1.2, 0.0, 0.0), lens=30)
+    bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 1280, 620
+    result = bpy.ops.tessera.terrain_add(filepath=path, texel_size=1.0, height_scale=180.0, tile_size=32,
+                                         epsilon=2.0)
+    if result != {"FINISHED"}:
+        sys.exit(f"demo: terrain_add returned {result}")
+    ob = bpy.context.active_object
+    ob.data.materials.append(material("Rock", (0.55, 0.5, 0.42, 1.0)))
+    wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=0.25)
+    return len(ob.data.polygons), 2 * (size - 1) ** 2
+
+
+def _synth():
+    import importlib
+
+    return importlib.import_module("bl_ext.tessera_demo.tessera.kernels.terrain_synth")
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -293,8 +325,11 @@ def main():
     strokes, elapsed = build_brushes_scene()
     render("demo_brushes.png")
     print(f"demo: landscape painted by {strokes} scripted strokes in {elapsed:.2f} s")
+    tris, full = build_terrain_scene()
+    render("demo_terrain.png")
+    print(f"demo: terrain for the camera: {tris:,} triangles ({100 * tris / full:.2f}% of the {full:,}-triangle grid)")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr"):
+                 "demo_map.exr", "demo_terrain.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
