@@ -14,6 +14,7 @@ from ..kernels.errors import TesseraError
 from ..kernels.terrain_lod import select
 from . import terrain_data
 from .terrain_settings import lod_settings, source_key
+from .viewport import tag_view3d_redraw
 
 _state = {"handler": None, "cache": {}, "errors": {}}
 
@@ -27,10 +28,7 @@ def settings_changed(ob):
         elif entry is not None:
             entry["view"] = None
         _state["errors"].pop(ob.name, None)
-    for window in getattr(bpy.context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
+    tag_view3d_redraw()
 
 
 def entry_for(ob):

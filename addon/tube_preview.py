@@ -14,6 +14,7 @@ from ..kernels.errors import TesseraError
 from ..kernels.tubes import lod_sides, tube_sections
 from .tube_settings import kernel_settings
 from .tube_sources import SOURCE_TYPES, read_lines
+from .viewport import tag_view3d_redraw
 
 _state = {"handler": None, "cache": {}, "errors": {}}
 
@@ -23,10 +24,7 @@ def settings_changed(ob):
     if isinstance(ob, bpy.types.Object):
         _state["cache"].pop(ob.name, None)
         _state["errors"].pop(ob.name, None)
-    for window in getattr(bpy.context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
+    tag_view3d_redraw()
 
 
 @bpy.app.handlers.persistent  # survive file loads

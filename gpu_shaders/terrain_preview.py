@@ -14,8 +14,8 @@ from ..kernels.terrain_analysis import tile_bounds
 from ..kernels.terrain_mesh import pattern, pattern_classes, pattern_codes
 from . import loader
 from .offscreen import set_shading, shaded_create_info
+from .textures import TEX_WIDTH, rgba_texture
 
-TEX_WIDTH = 4096
 MAX_TEXTURE = 8192
 
 
@@ -31,16 +31,6 @@ def _describe():
     info.sampler(1, "FLOAT_2D", "heights")
     info.vertex_in(0, "VEC3", "code")
     return info
-
-
-def _texture(rows):
-    import gpu
-
-    height = max(1, -(-len(rows) // TEX_WIDTH))
-    data = np.zeros((height * TEX_WIDTH, 4), np.float32)
-    data[: len(rows)] = rows
-    return gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F",
-                                data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 
 _patterns = {}
@@ -87,7 +77,7 @@ class TerrainDrawData:
         for key, tiles in pattern_classes(selection).items():
             rows = np.zeros((len(tiles), 3, 4), np.float32)
             rows[:, 0], rows[:, 1], rows[:, 2, 0] = self.rects[tiles], levels[tiles], inner[tiles]
-            self.buckets[key] = (_texture(rows.reshape(-1, 4)), len(tiles))
+            self.buckets[key] = (rgba_texture(rows.reshape(-1, 4)), len(tiles))
             self.tile_bytes += rows.nbytes
 
     def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True):

@@ -11,8 +11,8 @@ import numpy as np
 
 from . import loader
 from .offscreen import set_shading, shaded_create_info
+from .textures import TEX_WIDTH, rgba_texture
 
-TEX_WIDTH = 4096
 SECTIONS_PER_PATCH = 64  # 63 segments; the last section is the next patch's first
 
 
@@ -66,17 +66,6 @@ def section_order(lines):
     return np.insert(idx, where, extra)
 
 
-def _texture(rows):
-    """An RGBA32F texture TEX_WIDTH wide holding ``rows`` (K, 4) float32 texels."""
-    import gpu
-
-    height = max(1, -(-len(rows) // TEX_WIDTH))
-    data = np.zeros((height * TEX_WIDTH, 4), np.float32)
-    data[: len(rows)] = rows
-    buf = gpu.types.Buffer("FLOAT", data.size, data.ravel())
-    return gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F", data=buf)
-
-
 _patterns = {}
 
 
@@ -100,7 +89,7 @@ class TubeDrawData:
     def __init__(self, lines, normals, binormals, radius):
         self.lines = lines
         order = section_order(lines)
-        self.sections = _texture(section_table(lines, normals, binormals, radius)[
+        self.sections = rgba_texture(section_table(lines, normals, binormals, radius)[
             (3 * order[:, None] + np.arange(3)).ravel()])
         self.section_bytes = len(order) * 48
         self.patches, self.patch_curve = patch_table(lines)
@@ -115,7 +104,7 @@ class TubeDrawData:
         for n in np.unique(per_patch):
             rows = np.zeros((int(np.sum(per_patch == n)), 4), np.float32)
             rows[:, :2] = self.patches[per_patch == n]
-            self.buckets[int(n)] = (_texture(rows), len(rows))
+            self.buckets[int(n)] = (rgba_texture(rows), len(rows))
             self.patch_bytes += rows.nbytes
 
     def draw(self, view_projection, viewport_width, color=(0.8, 0.8, 0.8, 1.0), lit=True, clamp=False,

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InvalidInputError, TesseraError
+from .map_io import oiio_module
 
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
 RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
@@ -142,19 +143,11 @@ def read_raw(path, width, height, dtype=None, texel_size=1.0, scale=1.0, offset=
     return HeightMap(samples, float(texel_size), float(scale), float(offset), path)
 
 
-def _oiio():
-    try:
-        import OpenImageIO as oiio
-    except ImportError as err:
-        raise TesseraError(f"OpenImageIO is not available ({err})") from err
-    return oiio
-
-
 def read_image(path, texel_size=1.0, scale=1.0, offset=0.0):
     """Read a PNG/TIFF/EXR height map with OpenImageIO, keeping its precision (channel 0 is the height)."""
     if not os.path.isfile(path):
         raise TesseraError(f"No such height map file: {path}")
-    oiio = _oiio()
+    oiio = oiio_module()
     inp = oiio.ImageInput.open(path)
     if inp is None:
         raise TesseraError(f"Cannot read {path}: {oiio.geterror()}")

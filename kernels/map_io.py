@@ -16,7 +16,8 @@ FLOAT_EXTENSIONS = (".exr",)
 INT16_EXTENSIONS = (".png", ".tif", ".tiff")
 
 
-def _oiio():
+def oiio_module():
+    """The OpenImageIO module, or a `TesseraError` saying it is missing (a broken install)."""
     try:
         import OpenImageIO as oiio
     except ImportError as err:  # a dependency of the package; only a broken install lacks it
@@ -40,7 +41,7 @@ def write_map(path, dmap, low=0.0, high=1.0):
         fmt, data = "uint16", np.round(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
     else:
         raise InvalidInputError(f"Write maps as {', '.join(FLOAT_EXTENSIONS + INT16_EXTENSIONS)}; got {path!r}")
-    oiio = _oiio()
+    oiio = oiio_module()
     spec = oiio.ImageSpec(w, h, c, fmt)
     if ext == ".exr":
         spec.attribute("compression", "zip")  # lossless
@@ -60,7 +61,7 @@ def read_map(path, channels=None, low=0.0, high=1.0):
     ``channels`` (1, 3 or 4) selects/pads channels: a grey file read as 3 channels repeats its value; extra
     channels are dropped. Raises `TesseraError` for unreadable files and `InvalidInputError` for NaN.
     """
-    oiio = _oiio()
+    oiio = oiio_module()
     if not os.path.isfile(path):
         raise TesseraError(f"No such map file: {path}")
     inp = oiio.ImageInput.open(path)

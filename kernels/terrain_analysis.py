@@ -107,16 +107,16 @@ class TileTable:
                          self.peak_y.astype(np.float32)], axis=-1)
 
 
-def _windows(band, tile_size, tx0, tx1, fill):
-    """Tile windows of a band of rows: (tx1 - tx0, rows, tile_size + 1) view (padded with ``fill``)."""
-    x0, width = tx0 * tile_size, band.shape[1]
-    need = tx1 * tile_size + 1
-    cols = band[:, x0:min(width, need)]
-    if cols.shape[1] < need - x0:
-        cols = np.pad(cols, ((0, 0), (0, need - x0 - cols.shape[1])), constant_values=fill)
+def _windows(band, tile_size, count, fill):
+    """The first ``count`` tile windows of a band of rows: (count, rows, tile_size + 1) view (padded with
+    ``fill`` past the band's last column)."""
+    need = count * tile_size + 1
+    cols = band[:, :need]
+    if cols.shape[1] < need:
+        cols = np.pad(cols, ((0, 0), (0, need - cols.shape[1])), constant_values=fill)
     cols = np.ascontiguousarray(cols)
     s0, s1 = cols.strides
-    return np.lib.stride_tricks.as_strided(cols, (tx1 - tx0, cols.shape[0], tile_size + 1),
+    return np.lib.stride_tricks.as_strided(cols, (count, cols.shape[0], tile_size + 1),
                                            (s1 * tile_size, s0, s1), writeable=False)
 
 
@@ -124,18 +124,13 @@ def _analyse(table, hm, ty0, ty1, tx0, tx1, progress=None):
     """Fill tiles rows ``[ty0, ty1)``, columns ``[tx0, tx1)`` of ``table`` from height map ``hm``."""
     ts, (n_rows, width) = table.tile_size, table.shape
     inv_texel = np.float32(1.0 / hm.texel_size)
-
-    def texel_rows(idx):
-        lo, hi = int(idx.min()), int(idx.max()) + 1
-        return hm.rows(lo, hi)[idx - lo] * inv_texel
-
     c0, c1 = tx0 * ts, min(width, tx1 * ts + 1)
     for ty in range(ty0, ty1):
-        y0, y1 = tile_bounds(ty, ts, n_rows)
-        y0, y1 = int(y0), int(y1)
-        h_band = hm.rows(y0, y1 + 1)[:, c0:c1]
-        band = ham_rows(texel_rows, n_rows, y0, y1)[:, c0:c1]
-        _fill_row(table, ty, tx0, tx1, band, h_band, y0)
+        y0, y1 = (int(v) for v in tile_bounds(ty, ts, n_rows))
+        lo = max(0, y0 - HAM_REACH)
+        rows = hm.rows(lo, min(n_rows, y1 + 1 + HAM_REACH))  # the band and its HAM halo, read once
+        band = ham_rows(lambda idx, rows=rows, lo=lo: rows[idx - lo] * inv_texel, n_rows, y0, y1)[:, c0:c1]
+        _fill_row(table, ty, tx0, tx1, band, rows[y0 - lo:y1 + 1 - lo, c0:c1], y0)
         if progress is not None:
             progress(ty - ty0 + 1, ty1 - ty0)
 
@@ -144,9 +139,9 @@ def _fill_row(table, ty, tx0, tx1, ham_band, h_band, y0):
     """Tile statistics of one tile row from bands that start at column ``tx0 · tile_size``."""
     ts = table.tile_size
     sl = (ty, slice(tx0, tx1))
-    table.ham_max[sl] = _windows(ham_band, ts, 0, tx1 - tx0, -np.inf).max(axis=(1, 2))
-    table.h_min[sl] = _windows(h_band, ts, 0, tx1 - tx0, np.inf).min(axis=(1, 2))
-    win = _windows(h_band, ts, 0, tx1 - tx0, -np.inf)
+    table.ham_max[sl] = _windows(ham_band, ts, tx1 - tx0, -np.inf).max(axis=(1, 2))
+    table.h_min[sl] = _windows(h_band, ts, tx1 - tx0, np.inf).min(axis=(1, 2))
+    win = _windows(h_band, ts, tx1 - tx0, -np.inf)
     flat = win.reshape(win.shape[0], -1)
     arg = flat.argmax(axis=1)
     table.h_max[sl] = flat[np.arange(flat.shape[0]), arg]

@@ -1,0 +1,17 @@
+"""Data textures for vertex pulling: rows of RGBA32F texels in a texture `TEX_WIDTH` wide (row-major), read in
+GLSL with ``texelFetch(tex, ivec2(i % tex_width, i / tex_width), 0)``."""
+
+import numpy as np
+
+TEX_WIDTH = 4096
+
+
+def rgba_texture(rows):
+    """An RGBA32F texture holding ``rows`` (K, 4) float32 texels (zero-padded to whole rows)."""
+    import gpu
+
+    height = max(1, -(-len(rows) // TEX_WIDTH))
+    data = np.zeros((height * TEX_WIDTH, 4), np.float32)
+    data[: len(rows)] = rows
+    return gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F",
+                                data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
