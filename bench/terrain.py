@@ -90,20 +90,23 @@ def main():
     out["ours_culled_vs_distance_only"] = float(np.mean(counts["ours_culled"]) / np.mean(counts["distance_only"]))
     print(json.dumps(out))
 
-    big, big_table, peak, path = out_of_core(16385 if "--full" not in sys.argv else 65537, heights)
-    print(json.dumps({"case": "out_of_core", "map": f"{big.width}x{big.height}",
-                      "file_mib": os.path.getsize(path) / 2**20,
-                      "float32_map_mib": big.width * big.height * 4 / 2**20, "peak_alloc_mib": peak / 2**20,
-                      "tiles": int(big_table.ham_max.size)}))
-    times = []
-    for cam in path_cameras(big, 6):
-        _, dt = timed(lambda c=cam: select(big, big_table, c, TerrainLod()), 1)
-        times.append(dt)
-    print(json.dumps({"case": "select", "frame_budget_ms": 1000 / 60,
-                      f"{SIZE}_median_ms": 1e3 * float(np.median(sel_times)),
-                      f"{big.width}_median_ms": 1e3 * float(np.median(times)),
-                      f"{big.width}_tiles": int(big_table.ham_max.size)}))
-    os.unlink(path)
+    select_case = {"case": "select", "frame_budget_ms": 1000 / 60,
+                   f"{SIZE}_median_ms": 1e3 * float(np.median(sel_times))}
+    for size in (16385, 65537) if "--full" in sys.argv else (16385,):
+        big, big_table, peak, path = out_of_core(size, heights)
+        print(json.dumps({"case": "out_of_core", "map": f"{big.width}x{big.height}",
+                          "file_mib": os.path.getsize(path) / 2**20,
+                          "float32_map_mib": big.width * big.height * 4 / 2**20, "peak_alloc_mib": peak / 2**20,
+                          "tiles": int(big_table.ham_max.size)}), flush=True)
+        times = []
+        select(big, big_table, next(iter(path_cameras(big, 6))), TerrainLod())  # builds the cached tile geometry
+        for cam in path_cameras(big, 6):
+            _, dt = timed(lambda c=cam: select(big, big_table, c, TerrainLod()), 1)
+            times.append(dt)
+        select_case.update({f"{big.width}_median_ms": 1e3 * float(np.median(times)),
+                            f"{big.width}_tiles": int(big_table.ham_max.size)})
+        os.unlink(path)
+    print(json.dumps(select_case))
 
 
 def out_of_core(size, heights):

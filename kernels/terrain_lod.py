@@ -126,19 +126,43 @@ def auto_d_max(hm, camera, settings):
     return hm.texel_size * focal / settings.quad_pixels
 
 
+def _clip_matrix(camera):
+    return np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
+
+
 def _project(camera, points):
     """Pixel coordinates (..., 2) and clip w (...) of world points (..., 3)."""
-    m = np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
-    p = points @ m[:3, :3].T + m[:3, 3]
-    w = points @ m[3, :3] + m[3, 3]
+    cx, cy, w = _clip(_clip_matrix(camera), points)
     with np.errstate(divide="ignore", invalid="ignore"):
-        px = np.stack([(p[..., 0] / w + 1) * 0.5 * camera.width, (p[..., 1] / w + 1) * 0.5 * camera.height], -1)
+        px = np.stack([(cx / w + 1) * 0.5 * camera.width, (cy / w + 1) * 0.5 * camera.height], -1)
     return px, w
 
 
-def _distance(eye, points):
-    d = points - eye
-    return np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2])
+def _clip(m, points):
+    """Clip x, y and w of world points (..., 3) under the 4x4 matrix ``m``: three (...) arrays."""
+    x, y, z = points[..., 0], points[..., 1], points[..., 2]
+    return [m[r, 0] * x + m[r, 1] * y + m[r, 2] * z + m[r, 3] for r in (0, 1, 3)]
+
+
+def _vertical_error_px(camera, m, top, dz):
+    """Pixels between clip points ``top`` (cx, cy, w, each (n,)) and the same world points moved by ``dz`` (n,)
+    along z; 0 where either point is behind the camera: (n,) float64."""
+    cx, cy, w = top
+    bx, by, bw = cx + m[0, 2] * dz, cy + m[1, 2] * dz, w + m[3, 2] * dz
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err = np.hypot((cx / w - bx / bw) * (0.5 * camera.width), (cy / w - by / bw) * (0.5 * camera.height))
+    return np.where((w > 0) & (bw > 0) & np.isfinite(err), err, 0.0)
+
+
+def _distance(eye, xyz):
+    """Distances from ``eye`` (3,) of points given as three planes ``xyz`` (3, ...): (...) float64."""
+    dx, dy, dz = xyz[0] - eye[0], xyz[1] - eye[1], xyz[2] - eye[2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+def _planes(points):
+    """(..., 3) points as contiguous (3, ...) coordinate planes (fast to stream through)."""
+    return np.ascontiguousarray(np.moveaxis(points, -1, 0))
 
 
 def _cached(table, key, make):
@@ -167,32 +191,45 @@ def _grid_height_at_peak(hm, table, xs, ys, level):
     return np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00))
 
 
+def _peak_base(hm, table, xs, ys, level):
+    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height."""
+    def make():
+        return (_grid_height_at_peak(hm, table, xs, ys, level) - table.h_max).ravel()
+    return _cached(table, ("peak_dz", level), make)
+
+
+def _peak_clip(hm, table, m):
+    """Clip x, y, w of every tile's peak, flat (nty * ntx,) each."""
+    top = _cached(table, "peak", lambda: to_world(hm, table.peak_x, table.peak_y, table.h_max).reshape(-1, 3))
+    return _clip(m, top)
+
+
 def _peak_error_px(hm, table, camera, xs, ys, level):
     """Projected vertical error at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64."""
-    z = _cached(table, ("peak_base", level), lambda: _grid_height_at_peak(hm, table, xs, ys, level))
-    px, py = table.peak_x, table.peak_y
-    top = _cached(table, "peak", lambda: to_world(hm, px, py, table.h_max))
-    base = top.copy()
-    base[..., 2] = z
-    (p0, w0), (p1, w1) = _project(camera, top), _project(camera, base)
-    err = np.hypot(p0[..., 0] - p1[..., 0], p0[..., 1] - p1[..., 1])
-    return np.where((w0 > 0) & (w1 > 0) & np.isfinite(err), err, 0.0)
+    m = _clip_matrix(camera)
+    err = _vertical_error_px(camera, m, _peak_clip(hm, table, m), _peak_base(hm, table, xs, ys, level))
+    return err.reshape(table.h_max.shape)
 
 
 def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
-    """T_min per tile, clamped to [1, T_max]: (nty, ntx) float64."""
+    """T_min per tile, clamped to [1, T_max]: (nty, ntx) float64.
+
+    SEARCH tests each power of two only on the tiles no coarser level has brought within ε.
+    """
     eps = settings.epsilon
     if settings.t_min_rule == "SEARCH":
-        t = np.ones_like(t_max)
-        done = _peak_error_px(hm, table, camera, xs, ys, 1) <= eps
-        level = 2
-        while level <= settings.max_level and not done.all():
-            ok = _peak_error_px(hm, table, camera, xs, ys, level) <= eps
-            t = np.where(done, t, level)
-            done |= ok
+        m = _clip_matrix(camera)
+        top = _peak_clip(hm, table, m)
+        t = np.full(t_max.size, float(settings.max_level))
+        todo = np.arange(t_max.size)
+        level = 1
+        while level <= settings.max_level and len(todo):
+            dz = _peak_base(hm, table, xs, ys, level)[todo]
+            ok = _vertical_error_px(camera, m, [c[todo] for c in top], dz) <= eps
+            t[todo[ok]] = level
+            todo = todo[~ok]
             level *= 2
-        if not done.all():
-            t = np.where(done, t, settings.max_level)
+        t = t.reshape(t_max.shape)
     else:
         h_hat = _peak_error_px(hm, table, camera, xs, ys, 1)
         with np.errstate(divide="ignore"):
@@ -201,23 +238,24 @@ def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
     return np.clip(t, 1.0, t_max)
 
 
-def _box_corners(hm, table, xs, ys):
-    """Homogeneous world corners of every tile's bounding box: (nty * ntx * 8, 4) float64."""
-    (x0, x1), (y0, y1) = xs, ys
-    corners = [to_world(hm, x, y, z) for x in (x0, x1) for y in (y0, y1) for z in (table.h_min, table.h_max)]
-    c = np.stack(corners, axis=-2).reshape(-1, 3)
-    return np.concatenate([c, np.ones((len(c), 1))], axis=1)
-
-
 def _culled(hm, table, camera, xs, ys):
-    """Tiles whose bounding box lies outside one frustum plane: (nty, ntx) bool."""
-    c = _cached(table, "box", lambda: _box_corners(hm, table, xs, ys))
-    m = np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
-    clip = (c @ m.T).reshape(xs[0].shape + (8, 4))
-    w = clip[..., 3]
-    out = np.zeros(xs[0].shape, bool)
+    """Tiles whose bounding box lies outside one frustum plane: (nty, ntx) bool.
+
+    Per plane ``p`` (clip ±x, ±y, ±z against w) a box is outside when its corner that maximises ``p`` is: the
+    maximum of a linear function over a box is the sum of its per-axis maxima (x per tile column, y per row).
+    """
+    m = _clip_matrix(camera)
+    (x0, x1), (y0, y1) = xs, ys
+    wx = [(x[0] - (hm.width - 1) * 0.5) * hm.texel_size for x in (x0, x1)]  # (ntx,) each, as in to_world
+    wy = [(y[:, 0] - (hm.height - 1) * 0.5) * hm.texel_size for y in (y0, y1)]  # (nty,) each
+    out = np.zeros(x0.shape, bool)
     for axis in range(3):
-        out |= np.all(clip[..., axis] < -w, axis=-1) | np.all(clip[..., axis] > w, axis=-1)
+        for sign in (1.0, -1.0):
+            p = m[3] + sign * m[axis]
+            top_x = np.maximum(p[0] * wx[0], p[0] * wx[1])
+            top_y = np.maximum(p[1] * wy[0], p[1] * wy[1])
+            top_z = p[2] * (table.h_max if p[2] > 0 else table.h_min)
+            out |= (top_z + top_y[:, None]) + (top_x[None, :] + p[3]) < 0
     return out
 
 
@@ -226,9 +264,8 @@ def _round(levels, settings):
     if settings.levels == "INTEGER":
         return np.ceil(f)
     if settings.levels == "POW2":
-        n = np.exp2(np.ceil(np.log2(f)))
-        n = np.where(n * 0.5 >= f, n * 0.5, n)  # exact powers of two, whatever log2's last bit says
-        return np.minimum(np.where(n < f, n * 2.0, n), settings.max_level)
+        m, e = np.frexp(f)  # f = m·2^e, m in [0.5, 1): the next power of two is 2^e, or f itself when m = 0.5
+        return np.minimum(np.ldexp(1.0, e - (m == 0.5)), settings.max_level)
     return f
 
 
@@ -283,11 +320,11 @@ def select(hm, table, camera, settings=TerrainLod()):
     points = ((mx, y0), (x1, my), (mx, y1), (x0, my))
     edge = np.empty((nty, ntx, 4))
     for side, (px, py) in enumerate(points):
-        p = _cached(table, ("edge", side), lambda px=px, py=py: to_world(hm, px, py, hm.sample(px, py)))
+        p = _cached(table, ("edge", side), lambda px=px, py=py: _planes(to_world(hm, px, py, hm.sample(px, py))))
         e_max = np.maximum(t_max, _neighbour(t_max, side, 0.0))
         e_min = np.maximum(t_min, _neighbour(t_min, side, 0.0))
         edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
-    centre = _cached(table, "centre", lambda: to_world(hm, mx, my, hm.sample(mx, my)))
+    centre = _cached(table, "centre", lambda: _planes(to_world(hm, mx, my, hm.sample(mx, my))))
     inner = distance_level(_distance(eye, centre), t_max, t_min, d_max)
     if settings.culling and camera is not None:
         culled = _culled(hm, table, camera, xs, ys)

@@ -116,6 +116,33 @@ def test_culled_tiles_produce_no_triangles():
     assert seen_culled > 0
 
 
+def test_culling_by_box_maxima_equals_the_eight_corner_test():
+    hm = _terrain(seed=3)
+    table = ta.tile_table(hm, 32, backend="numpy")
+    rng = np.random.default_rng(9)
+    xb, yb = ta.tile_bounds(np.arange(8), 32, hm.width), ta.tile_bounds(np.arange(8), 32, hm.height)
+    culled = 0
+    for _ in range(20):
+        cam = _random_camera(rng, hm)
+        sel = tl.select(hm, table, cam, tl.TerrainLod(culling=True))
+        m = np.asarray(cam.projection) @ np.asarray(cam.view)
+        for ty in range(8):
+            for tx in range(8):
+                corners = np.array([tl.to_world(hm, x[tx], y[ty], z[ty, tx])
+                                    for x in xb for y in yb for z in (table.h_min, table.h_max)])
+                c = np.concatenate([corners.reshape(-1, 3), np.ones((8, 1))], 1) @ m.T
+                out = any(np.all(c[:, a] < -c[:, 3]) or np.all(c[:, a] > c[:, 3]) for a in range(3))
+                assert sel.culled[ty, tx] == out
+        culled += sel.culled.sum()
+    assert 0 < culled < 20 * 64
+
+
+def test_pow2_levels_are_the_next_power_of_two():
+    f = np.array([1.0, 1.0000001, 1.5, 2.0, 2.0000001, 3.0, 4.0, 5.5, 8.0, 31.9, 32.0, 33.0, 64.0])
+    want = np.array([1, 2, 2, 2, 4, 4, 4, 8, 8, 32, 32, 64, 64], float)
+    assert np.array_equal(tl._round(f, tl.TerrainLod(levels="POW2")), want)
+
+
 def test_culling_keeps_every_tile_in_view():
     hm = _terrain(seed=3)
     table = ta.tile_table(hm, 32, backend="numpy")
