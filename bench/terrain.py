@@ -101,7 +101,7 @@ def main():
         times = []
         select(big, big_table, next(iter(path_cameras(big, 6))), TerrainLod())  # builds the cached tile geometry
         for cam in path_cameras(big, 6):
-            _, dt = timed(lambda c=cam: select(big, big_table, c, TerrainLod()), 1)
+            _, dt = timed(lambda c=cam, m=big, t=big_table: select(m, t, c, TerrainLod()), 1)
             times.append(dt)
         select_case.update({f"{big.width}_median_ms": 1e3 * float(np.median(times)),
                             f"{big.width}_tiles": int(big_table.ham_max.size)})
