@@ -19,6 +19,11 @@ def source(name):
     return _sources[name]
 
 
+def sources(*names):
+    """The files ``names`` joined in order (shared functions first), for one shader stage."""
+    return "\n".join(source(name) for name in names)
+
+
 def shader(name, describe):
     """Compiled shader ``name``; ``describe()`` returns its `gpu.types.GPUShaderCreateInfo` on first use."""
     if name not in _shaders:

@@ -10,10 +10,11 @@ import numpy as np
 from . import loader
 
 
-def shaded_create_info(name, vertex_file):
+def shaded_create_info(name, *vertex_files):
     """A create-info with the shading every Tessera check shader shares: a ``shade`` varying, the push
     constants ``view_projection``, ``color``, ``light_dir``, ``lit_range`` and ``flat_mesh_frag.glsl``.
-    The caller adds its vertex inputs, other constants and samplers."""
+    The vertex stage is ``vertex_files`` joined in order. The caller adds its vertex inputs, other constants
+    and samplers."""
     import gpu
 
     iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
@@ -25,7 +26,7 @@ def shaded_create_info(name, vertex_file):
     info.push_constant("VEC2", "lit_range")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(loader.source(vertex_file))
+    info.vertex_source(loader.sources(*vertex_files))
     info.fragment_source(loader.source("flat_mesh_frag.glsl"))
     return info
 
@@ -47,19 +48,24 @@ def _describe_flat_mesh():
 
 
 def render_triangles(positions, triangles, view_projection, size=(256, 256), color=(0.8, 0.8, 0.8, 1.0),
-                     background=(0.0, 0.0, 0.0, 1.0), lit=True):
+                     background=(0.0, 0.0, 0.0, 1.0), lit=True, normals=None):
     """Draw triangles offscreen and return the image.
 
     positions: (V, 3) float32 world space; triangles: (T, 3) int32; view_projection: (4, 4) row-major
-    matrix; size: (width, height). Returns (height, width, 4) uint8, row 0 at the bottom. Needs a GPU context.
+    matrix; size: (width, height); normals: None (flat shading), (V, 3) per vertex or (T, 3, 3) per corner.
+    Returns (height, width, 4) uint8, row 0 at the bottom. Needs a GPU context.
     """
     from gpu_extras.batch import batch_for_shader
 
     tris = np.ascontiguousarray(triangles, dtype=np.int32)
-    corners = np.ascontiguousarray(positions, dtype=np.float32)[tris]  # (T, 3, 3) unshared: flat normals
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
-    nor = np.repeat(normals, 3, axis=0).astype(np.float32)
+    corners = np.ascontiguousarray(positions, dtype=np.float32)[tris]  # (T, 3, 3) unshared
+    if normals is None:
+        flat = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-30)
+        nor = np.repeat(flat, 3, axis=0).astype(np.float32)
+    else:
+        normals = np.asarray(normals, np.float32)
+        nor = np.ascontiguousarray((normals if normals.ndim == 3 else normals[tris]).reshape(-1, 3))
     shader = loader.shader("flat_mesh", _describe_flat_mesh)
     batch = batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
 

@@ -20,7 +20,7 @@ MAX_TEXTURE = 8192
 
 
 def _describe():
-    info = shaded_create_info("terrain", "terrain_vert.glsl")
+    info = shaded_create_info("terrain", "partition.glsl", "terrain_vert.glsl")
     info.push_constant("VEC4", "edge_counts")
     info.push_constant("FLOAT", "inner_count")
     info.push_constant("VEC3", "grid")

@@ -3,26 +3,11 @@
  * Instance t reads texels 3t..3t+2 of `tiles`: (x0, y0, x1, y1) in samples, the four edge levels, (inner
  * level, 0, 0, 0). Pattern vertex `code` = (kind, a, b): 0 corner (a, b); 1-4 point a of side BOTTOM, RIGHT,
  * TOP, LEFT; 5 inner grid point (a, b). Heights are sampled bilinearly from `heights` (R32F, one texel per
- * sample, `height_stride` samples per texel) in the vertex shader. Same partition as kernels/partition.py. */
+ * sample, `height_stride` samples per texel) in the vertex shader. `param` is partition.glsl. */
 
 vec4 fetch_tile(int i)
 {
   return texelFetch(tiles, ivec2(i % tex_width, i / tex_width), 0);
-}
-
-float param(float f, float n, float j)
-{
-  float jm = min(j, n - j);
-  float h;
-  if (fractional == 0) {
-    h = jm / n;
-  }
-  else {
-    f = clamp(f, 2.0, 64.0);
-    float long_len = n > 2.0 ? (2.0 * n - 2.0 - f) / (n * (n - 2.0)) : 0.5;
-    h = (2.0 * jm == n) ? 0.5 : jm * long_len;
-  }
-  return 2.0 * j <= n ? h : 1.0 - h;
 }
 
 float height_at(vec2 s)
@@ -42,25 +27,26 @@ void main()
   vec4 rect = fetch_tile(3 * gl_InstanceID);
   vec4 lev = fetch_tile(3 * gl_InstanceID + 1);
   float f_in = fetch_tile(3 * gl_InstanceID + 2).x;
+  bool frac = fractional != 0;
   int kind = int(code.x);
   vec2 uv;
   if (kind == 0) {
     uv = code.yz;
   }
   else if (kind == 1) {
-    uv = vec2(param(lev.x, edge_counts.x, code.y), 0.0);
+    uv = vec2(param(lev.x, edge_counts.x, code.y, frac), 0.0);
   }
   else if (kind == 2) {
-    uv = vec2(1.0, param(lev.y, edge_counts.y, code.y));
+    uv = vec2(1.0, param(lev.y, edge_counts.y, code.y, frac));
   }
   else if (kind == 3) {
-    uv = vec2(param(lev.z, edge_counts.z, code.y), 1.0);
+    uv = vec2(param(lev.z, edge_counts.z, code.y, frac), 1.0);
   }
   else if (kind == 4) {
-    uv = vec2(0.0, param(lev.w, edge_counts.w, code.y));
+    uv = vec2(0.0, param(lev.w, edge_counts.w, code.y, frac));
   }
   else {
-    uv = vec2(param(f_in, inner_count, code.y), param(f_in, inner_count, code.z));
+    uv = vec2(param(f_in, inner_count, code.y, frac), param(f_in, inner_count, code.z, frac));
   }
   vec2 s = rect.xy + uv * (rect.zw - rect.xy);
   float z = height_at(s);

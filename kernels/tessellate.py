@@ -146,6 +146,49 @@ def _alpha_values(mesh, options):
     return values
 
 
+@dataclass
+class SurfaceInputs:
+    """What a curved surface is built from, after the sharp-edge policy (shared by the CPU and GPU paths).
+
+    mesh: the mesh the surface is built on (``SPLIT`` mode: split along sharp edges); positions: (V, 3) float64;
+    vertex_normals: (V, 3) one geometry normal per vertex; split: (T, 3) bool corners whose shading normal
+    differs from the vertex normal, or None; edge_levels: (E,) for ``mesh``'s edges; alpha: (V,) per-vertex
+    Phong factors, or None for ``options.alpha``; opened_edges: edges ``SPLIT`` cut open.
+    """
+
+    mesh: MeshArrays
+    positions: np.ndarray
+    vertex_normals: np.ndarray
+    split: np.ndarray | None
+    edge_levels: np.ndarray
+    alpha: np.ndarray | None
+    opened_edges: int = 0
+
+    def shading_normals(self):
+        """Per-corner shading normals (T, 3, 3) float64: a split face keeps all its own corner normals."""
+        tris = self.mesh.triangles
+        out = np.asarray(self.vertex_normals, np.float64)[tris]
+        if self.split is not None:
+            faces = self.split.any(axis=1)
+            out[faces] = np.asarray(self.mesh.corner_normals, np.float64)[faces]
+        return out
+
+
+def surface_inputs(mesh, edge_levels, method, options):
+    """Apply ``options.normal_mode`` to ``mesh`` for ``method`` (PHONG or PN): a `SurfaceInputs`."""
+    positions = np.asarray(mesh.positions, np.float64)
+    if options.normal_mode == "SPLIT" and mesh.corner_normals is not None:
+        source, vertex_normals, edge_levels, opened = _split_mesh(mesh, edge_levels)
+        alpha = _alpha_values(source, options) if method == "PHONG" else None
+        return SurfaceInputs(source, np.asarray(source.positions, np.float64), vertex_normals, None,
+                             np.asarray(edge_levels, np.float64), alpha, opened)
+    vertex_normals = shared_vertex_normals(positions, mesh.triangles, mesh.corner_normals)
+    split = None if mesh.corner_normals is None else split_corners(mesh.triangles, mesh.corner_normals,
+                                                                   vertex_normals)
+    alpha = _alpha_values(mesh, options) if method == "PHONG" else None
+    return SurfaceInputs(mesh, positions, vertex_normals, split, np.asarray(edge_levels, np.float64), alpha)
+
+
 def _edge_data(ref, positions, normals):
     lo, hi = ref.edges[:, 0], ref.edges[:, 1]
     return positions[lo], positions[hi], normals[lo], normals[hi]
@@ -183,13 +226,16 @@ def _normal_field(method, options):
             lambda p, n: np.asarray(n, np.float64), patches.linear_basis)
 
 
-def _shading_normals(ref, method, options, positions, vertex_normals, corner_normals, split):
-    """Unit shading normals: (point normals (n_vertices, 3), corner normals (M, 3, 3) or None)."""
+def _shading_normals(ref, method, options, positions, vertex_normals, corner_normals, split, points=None):
+    """Unit shading normals: (point normals (n_vertices, 3), corner normals (M, 3, 3) or None).
+
+    points: the point normals when another path (the GPU) evaluated them already."""
     edge_fn, edge_basis, face_fn, face_basis = _normal_field(method, options)
-    pa, pb, na, nb = _edge_data(ref, positions, vertex_normals)
-    points = evaluate_surface(ref, vertex_normals, edge_fn(pa, pb, na, nb), edge_basis,
-                              face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis)
-    points = normalized(points)
+    if points is None:
+        pa, pb, na, nb = _edge_data(ref, positions, vertex_normals)
+        points = evaluate_surface(ref, vertex_normals, edge_fn(pa, pb, na, nb), edge_basis,
+                                  face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis)
+        points = normalized(points)
     if split is None or not split.any():
         return points, None
     corners = points[ref.triangles]
@@ -203,13 +249,15 @@ def _shading_normals(ref, method, options, positions, vertex_normals, corner_nor
 
 
 def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LINEAR", backend="auto",
-               progress=None, options=None):
+               progress=None, options=None, surface=None):
     """Tessellate a `MeshArrays` and return a `Tessellation`.
 
     edge_levels: (E,) float, one per edge of `kernels.topology.triangle_edges`; inner_levels: (T,) float or
     None; spacing: see `kernels.partition`; method: one of `METHODS`; backend: see
     `kernels.interpolate.gather_weighted`; progress: optional callable ``(fraction)``; options:
-    `SurfaceOptions` for PHONG and PN. Face attributes of the output are per output triangle. Curved
+    `SurfaceOptions` for PHONG and PN; surface: for PHONG and PN, an optional evaluator
+    ``(refinement, SurfaceInputs) -> (positions (N, 3), unit point normals (N, 3))`` that replaces the numpy
+    surface (the GPU compute path). Face attributes of the output are per output triangle. Curved
     methods write unit ``point_normals`` (and ``corner_normals`` where the input has split normals).
     """
     options = options or SurfaceOptions()
@@ -225,21 +273,18 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
         if mesh.corner_normals is not None:
             out.corner_normals = normalized(corner_values(ref, mesh.corner_normals, backend))
     else:
-        source, split = mesh, None
-        positions = np.asarray(mesh.positions, np.float64)
-        if options.normal_mode == "SPLIT" and mesh.corner_normals is not None:
-            source, vertex_normals, edge_levels, result.opened_edges = _split_mesh(mesh, edge_levels)
-            positions = np.asarray(source.positions, np.float64)
-            if result.opened_edges:
-                result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
-        else:
-            vertex_normals = shared_vertex_normals(positions, mesh.triangles, mesh.corner_normals)
-            if mesh.corner_normals is not None:
-                split = split_corners(mesh.triangles, mesh.corner_normals, vertex_normals)
-        alpha = _alpha_values(source, options) if method == "PHONG" else None
+        inputs = surface_inputs(mesh, edge_levels, method, options)
+        source, positions, vertex_normals, split, edge_levels, alpha = (
+            inputs.mesh, inputs.positions, inputs.vertex_normals, inputs.split, inputs.edge_levels, inputs.alpha)
+        result.opened_edges = inputs.opened_edges
+        if result.opened_edges:
+            result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
         ref = refine(source.triangles, len(source.positions), edge_levels, inner_levels, spacing)
         report(0.4)
-        if method == "PN":
+        points = None
+        if surface is not None:
+            out_positions, points = surface(ref, inputs)
+        elif method == "PN":
             out_positions = _pn_positions(ref, positions, vertex_normals)
         else:
             out_positions = _phong_positions(ref, positions, vertex_normals,
@@ -248,7 +293,7 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
         out = MeshArrays(positions=out_positions, triangles=ref.triangles, attribute_types=dict(mesh.attribute_types))
         corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
         out.point_normals, out.corner_normals = _shading_normals(
-            ref, method, options, positions, vertex_normals, corner_normals, split)
+            ref, method, options, positions, vertex_normals, corner_normals, split, points)
         mesh = source
     report(0.7)
     out.point_attributes = {k: point_values(ref, v, backend) for k, v in mesh.point_attributes.items()}
