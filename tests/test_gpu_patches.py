@@ -117,3 +117,60 @@ def test_adaptive_pn_preview_has_no_cracks(gpu_renderer, addon_module):
         inside = p[1:-1, 1:-1] & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
         assert inside.sum() > 1500
         assert not (inside & (img[..., 0] <= 127)).any(), int((inside & (img[..., 0] <= 127)).sum())
+
+
+def _bilinear(image, uv):
+    """Sample (h, w, 4) texels at (..., 2) UVs like GL_LINEAR with clamp-to-edge (texel centres at +0.5)."""
+    h, w = image.shape[:2]
+    x = np.clip(uv[..., 0] * w - 0.5, 0, w - 1)
+    y = np.clip(uv[..., 1] * h - 0.5, 0, h - 1)
+    x0, y0 = np.minimum(np.floor(x).astype(int), w - 2), np.minimum(np.floor(y).astype(int), h - 2)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    top = image[y0, x0] * (1 - fx) + image[y0, x0 + 1] * fx
+    bottom = image[y0 + 1, x0] * (1 - fx) + image[y0 + 1, x0 + 1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+@pytest.mark.parametrize("mode", ["HEIGHT", "VECTOR"])
+def test_displacement_hook_moves_the_preview_like_the_cpu(gpu_renderer, addon_module, suzanne, mode):
+    """A smooth map sampled at the UVs in the vertex shader displaces the preview as the same map applied to the
+    CPU mesh per corner ((value - mid) * strength along the shading normal, or as an object-space vector)."""
+    import gpu
+
+    tess = addon_module("kernels.tessellate")
+    preview = addon_module("gpu_shaders.patch_preview")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    Camera = addon_module("kernels.camera").Camera
+    size = 256
+    v, u = np.mgrid[0:size, 0:size] / size
+    image = np.zeros((size, size, 4), np.float32)
+    image[..., 0] = 0.5 + 0.4 * np.sin(6 * u) * np.cos(5 * v)
+    image[..., 1] = 0.5 + 0.3 * np.cos(4 * u + 1)
+    image[..., 2] = 0.5 + 0.3 * np.sin(3 * v)
+    image[..., 3] = 1.0
+    texture = gpu.types.GPUTexture((size, size), format="RGBA32F", data=gpu.types.Buffer("FLOAT", image.size,
+                                                                                           image.ravel()))
+    levels = tess.uniform_levels(suzanne, 4)
+    out = tess.tessellate(suzanne, levels, method="PN", backend="numpy").mesh
+    inputs = tess.surface_inputs(suzanne, levels, "PN", tess.SurfaceOptions())
+    data = preview.PatchDrawData(inputs, "PN", uvs=suzanne.corner_attributes["UVMap"])
+    data.set_levels(inputs.edge_levels)
+    disp = preview.Displacement(texture, mode, mid_level=0.5, strength=0.3)
+    corners = out.positions[out.triangles].astype(np.float64)  # (M, 3, 3), per corner: UV seams stay apart
+    normals = out.corner_normals if out.corner_normals is not None else out.point_normals[out.triangles]
+    value = _bilinear(image, out.corner_attributes["UVMap"].astype(np.float64))[..., :3]
+    if mode == "HEIGHT":
+        moved = corners + normals * ((value.mean(axis=-1) - 0.5) * 0.3)[..., None]
+    else:
+        moved = corners + (value - 0.5) * 0.3
+    flat = np.arange(moved.size // 3).reshape(-1, 3)
+    changed = 0.0
+    for cam in _cameras(Camera, np.random.default_rng(8), 3):
+        vp = cam.projection @ cam.view
+        cpu = offscreen.render_triangles(moved.reshape(-1, 3), flat, vp, size=(200, 200), normals=normals)
+        gpu_img = offscreen.render(lambda vp=vp: data.draw(vp, displacement=disp), size=(200, 200))
+        plain = offscreen.render(lambda vp=vp: data.draw(vp), size=(200, 200))
+        close = np.all(np.abs(cpu.astype(int) - gpu_img.astype(int)) <= 2, axis=-1)
+        assert close.mean() >= 0.995, close.mean()
+        changed += np.mean(np.any(plain != gpu_img, axis=-1))
+    assert changed / 3 > 0.02  # the map visibly moved the surface
