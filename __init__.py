@@ -22,6 +22,7 @@ _modules = (
     "addon.panels",
     "addon.tube_preview",
     "addon.terrain_preview",
+    "addon.patch_preview",
     "addon.brush_tool",
 )
 

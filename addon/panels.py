@@ -28,6 +28,7 @@ class TESSERA_PT_tessellate(_Sidebar, bpy.types.Panel):
 
     def draw(self, context):
         settings = context.active_object.tessera.tessellate
+        self.layout.prop(settings, "preview", icon="HIDE_OFF")
         draw_settings(self.layout, settings)
         row = self.layout.row()
         row.scale_y = 1.4

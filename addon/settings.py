@@ -54,6 +54,10 @@ DISTANCE_MAP_ITEMS = (
     ("LINEAR", "Linear", "Level falls linearly from near to far"),
     ("INVERSE", "Inverse", "Level falls like a z-buffer: most detail close to the camera"),
 )
+EVALUATE_ITEMS = (
+    ("CPU", "CPU", "Evaluate the surface with the numpy kernels"),
+    ("GPU", "GPU", "Evaluate the surface with a compute shader (same surface; falls back to the CPU without a GPU)"),
+)
 OUTPUT_ITEMS = (
     ("NEW_OBJECT", "New Object", "Create a new object beside the source (from the evaluated mesh, with modifiers)"),
     ("REPLACE", "Replace Mesh", "Replace the object's own mesh data (modifiers stay and apply on top)"),
@@ -94,6 +98,7 @@ def setting_annotations():
         "curvature_gain": props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
                                               default=10.0, min=0.0, soft_max=50.0),
         "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE"),
+        "evaluate_on": props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU"),
         "output": props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT"),
     }
 
@@ -101,9 +106,22 @@ def setting_annotations():
 SETTING_NAMES = tuple(setting_annotations())
 
 
+def _redraw(self, context):
+    from .viewport import tag_view3d_redraw
+
+    tag_view3d_redraw()
+
+
 class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
-    __annotations__ = {**setting_annotations(), "stored": bpy.props.BoolProperty(
-        name="Stored", description="These settings were saved by a tessellation run", default=False)}
+    __annotations__ = {
+        **setting_annotations(),
+        "stored": bpy.props.BoolProperty(name="Stored", description="These settings were saved by a tessellation run",
+                                         default=False),
+        "preview": bpy.props.BoolProperty(
+            name="Live Preview", default=False, update=_redraw,
+            description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
+                        "view); the object itself can be hidden meanwhile"),
+    }
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
@@ -154,6 +172,7 @@ def draw_settings(layout, settings, show_output=True):
         layout.prop(settings, "pn_normals")
     if settings.method != "LINEAR":
         layout.prop(settings, "normal_mode")
+        layout.prop(settings, "evaluate_on")
     layout.prop(settings, "spacing")
     layout.prop(settings, "level_mode")
     if settings.level_mode == "UNIFORM":

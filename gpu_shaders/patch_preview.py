@@ -54,13 +54,19 @@ def _describe_compute():
 _patterns = {}
 
 
-def _pattern_batch(shader, key):
+def _pattern_batch(shader, key, wireframe=False):
+    """The pattern of class ``key`` as triangles, or as its unique edges for a wireframe."""
     from gpu_extras.batch import batch_for_shader
 
-    if key not in _patterns:
+    if (key, wireframe) not in _patterns:
         codes, tris = pi.pattern(*key)
-        _patterns[key] = batch_for_shader(shader, "TRIS", {"code": codes}, indices=tris)
-    return _patterns[key]
+        if wireframe:
+            edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+            _patterns[key, wireframe] = batch_for_shader(shader, "LINES", {"code": codes},
+                                                         indices=np.unique(edges, axis=0).astype(np.int32))
+        else:
+            _patterns[key, wireframe] = batch_for_shader(shader, "TRIS", {"code": codes}, indices=tris)
+    return _patterns[key, wireframe]
 
 
 def _set_surface(shader, method, pn_quadratic, fractional, control):
@@ -111,9 +117,9 @@ class PatchDrawData:
         """Triangles one draw produces."""
         return sum(len(pi.pattern(*key)[1]) * count for key, (_, count) in self.buckets.items())
 
-    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, displacement=None):
+    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, displacement=None, wireframe=False):
         """Draw into the bound framebuffer. view_projection: (4, 4) row-major, mesh space to clip space;
-        displacement: a `Displacement` or None."""
+        displacement: a `Displacement` or None; wireframe: draw the edges of the output triangles instead."""
         shader = loader.shader("patch_preview", _describe_preview)
         set_shading(shader, view_projection, color, lit)
         _set_surface(shader, self.method, self.pn_quadratic, self.fractional, self.control)
@@ -127,7 +133,7 @@ class PatchDrawData:
         for key, (texture, count) in self.buckets.items():
             shader.uniform_float("counts", tuple(float(c) for c in key))
             shader.uniform_sampler("instances", texture)
-            _pattern_batch(shader, key).draw_instanced(shader, instance_start=0, instance_count=count)
+            _pattern_batch(shader, key, wireframe).draw_instanced(shader, instance_start=0, instance_count=count)
 
 
 def evaluate_on_gpu(ref, inputs, method="PN", alpha=0.75, pn_quadratic=True):

@@ -5,6 +5,7 @@ import numpy as np
 
 from ..addon import bridge
 from ..addon.cameras import camera_for
+from ..addon.gpu_context import ensure_gpu_context
 from ..addon.preferences import get_preferences
 from ..addon.settings import (
     adaptive_settings,
@@ -15,7 +16,7 @@ from ..addon.settings import (
     surface_options,
 )
 from ..kernels.adaptive import adaptive_levels
-from ..kernels.errors import TesseraError
+from ..kernels.errors import GPUContextError, TesseraError
 from ..kernels.tessellate import check_budget, estimate, tessellate, uniform_levels
 
 
@@ -104,15 +105,31 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
         edge_levels, inner_levels = self._levels(context, ob, arrays)
         budget = get_preferences(context).memory_budget_bytes
         check_budget(estimate(arrays, edge_levels, inner_levels, spacing=self.spacing), budget)
+        notes = []
         result = tessellate(
             arrays, edge_levels, inner_levels, spacing=self.spacing, method=self.method,
             options=surface_options(self), progress=lambda f: progress(0.1 + 0.7 * f),
+            surface=self._gpu_surface(notes),
         )
         mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result.mesh, info)
         for material in ob.data.materials:
             mesh.materials.append(material)
         progress(1.0)
-        return mesh, info.skipped, result.notes
+        return mesh, info.skipped, notes + result.notes
+
+    def _gpu_surface(self, notes):
+        """The compute-shader evaluator when asked for and a GPU context can be had, else None (numpy)."""
+        if self.evaluate_on != "GPU" or self.method == "LINEAR":
+            return None
+        try:
+            ensure_gpu_context()
+        except GPUContextError as err:
+            notes.append(f"No GPU for the compute path ({err}); evaluated on the CPU")
+            return None
+        from ..gpu_shaders.patch_preview import evaluate_on_gpu
+
+        method, alpha, quadratic = self.method, self.alpha, self.pn_normals == "QUADRATIC"
+        return lambda ref, inputs: evaluate_on_gpu(ref, inputs, method, alpha, quadratic)
 
     def _place(self, context, ob, mesh):
         """Put the new mesh in the scene; returns the object that holds it."""

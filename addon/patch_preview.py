@@ -1,0 +1,158 @@
+"""Live tessellation preview in the 3D viewport: meshes with ``tessera.tessellate.preview`` are drawn tessellated
+on the GPU (instanced patterns, `gpu_shaders.patch_preview`), with the object's own tessellation settings.
+
+Per object the mesh is read once and its control texture uploaded; it is read again only when the mesh or
+the surface settings change (depsgraph handler, settings key). Adaptive levels are recomputed only when the
+view (or the object's transform) changes; uniform levels only when the settings do. A displacement map set on
+the object (Tessera > Displacement) is sampled in the vertex shader, so brush strokes show live on the
+tessellated surface. The preview is drawn even while the object is hidden, so the original can be hidden.
+Nothing is drawn or compiled in background mode.
+"""
+
+import bpy
+import numpy as np
+
+from ..kernels.adaptive import adaptive_levels
+from ..kernels.camera import Camera
+from ..kernels.errors import TesseraError
+from ..kernels.tessellate import surface_inputs, uniform_levels
+from . import bridge
+from .settings import SETTING_NAMES, adaptive_settings, surface_options
+
+_state = {"handler": None, "cache": {}, "errors": {}}
+#: Settings that change what is uploaded per mesh (the rest only change levels).
+SURFACE_NAMES = ("method", "alpha", "alpha_attribute", "normal_mode", "pn_normals")
+
+
+def _key(settings, names):
+    return tuple(tuple(sorted(v)) if isinstance(v, set) else v for v in (getattr(settings, n) for n in names))
+
+
+@bpy.app.handlers.persistent  # survive file loads
+def _on_depsgraph(scene, depsgraph):
+    cache = _state["cache"]
+    if not cache:
+        return
+    for update in depsgraph.updates:
+        obj = update.id.original if hasattr(update.id, "original") else update.id
+        if isinstance(obj, bpy.types.Object) and obj.name in cache and update.is_updated_geometry:
+            forget(obj)
+        elif isinstance(obj, bpy.types.Mesh):
+            for name, entry in list(cache.items()):
+                if entry["data"] == obj.name:
+                    cache.pop(name, None)
+                    _state["errors"].pop(name, None)
+
+
+def forget(ob):
+    """Drop ``ob``'s uploaded data (it is rebuilt on the next draw)."""
+    _state["cache"].pop(ob.name, None)
+    _state["errors"].pop(ob.name, None)
+
+
+def _uvs(arrays, ob):
+    """Corner UVs (T, 3, 2) of the UV map the displacement uses (its own, else the active one), or None."""
+    name = ob.tessera.displacement.uv_map or getattr(ob.data.uv_layers.active, "name", None)
+    return arrays.corner_attributes.get(name) if name else None
+
+
+def entry_for(ob):
+    """Cached GPU data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
+    from ..gpu_shaders.patch_preview import PatchDrawData
+
+    s = ob.tessera.tessellate
+    cache, surface = _state["cache"], _key(s, SURFACE_NAMES)
+    entry = cache.get(ob.name)
+    if entry is not None and entry["surface"] != surface:
+        forget(ob)
+    if ob.name not in cache and ob.name not in _state["errors"]:
+        try:
+            arrays, _ = bridge.read_mesh(ob.data)
+            method = s.method
+            inputs = surface_inputs(arrays, uniform_levels(arrays, 1), method if method != "LINEAR" else "PN",
+                                    surface_options(s))
+            draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=_uvs(arrays, ob))
+        except TesseraError as err:
+            _state["errors"][ob.name] = str(err)
+            return None
+        cache[ob.name] = {"data": ob.data.name, "surface": surface, "levels": None, "draw": draw}
+    return cache.get(ob.name)
+
+
+def update_levels(ob, entry, view, projection, width, height):
+    """Recompute levels when the view, the transform or a level setting changed; returns True when it did."""
+    s = ob.tessera.tessellate
+    model = np.array(ob.matrix_world)
+    key = _key(s, SETTING_NAMES)
+    if s.level_mode == "ADAPTIVE":
+        key += ((view @ model).tobytes(), np.asarray(projection).tobytes(), width, height)
+    if entry["levels"] == key:
+        return False
+    draw = entry["draw"]
+    mesh = draw.inputs.mesh
+    if s.level_mode == "UNIFORM":
+        edge, inner = uniform_levels(mesh, s.level), None
+    else:
+        world = mesh.positions.astype(np.float64) @ model[:3, :3].T + model[:3, 3]
+        camera = Camera(view, projection, width, height)
+        edge, inner = adaptive_levels(world, mesh.triangles, adaptive_settings(s), camera, mesh.corner_normals)
+    draw.set_levels(edge, inner, s.spacing)
+    entry["levels"] = key
+    return True
+
+
+def displacement_for(ob):
+    """The object's displacement map as a preview `Displacement`, or None (no map, or world-space vectors,
+    which the preview does not show)."""
+    from ..gpu_shaders.patch_preview import Displacement
+
+    d = ob.tessera.displacement
+    if d.image is None or (d.mode == "VECTOR" and d.space == "GLOBAL"):
+        return None
+    import gpu
+
+    return Displacement(gpu.texture.from_image(d.image), d.mode, d.mid_level, d.strength)
+
+
+def _draw():
+    import gpu
+
+    context = bpy.context
+    region, rv3d = context.region, context.region_data
+    if region is None or rv3d is None:
+        return
+    view, proj = np.array(rv3d.view_matrix), np.array(rv3d.window_matrix)
+    shading = context.space_data.shading.type if context.space_data else "SOLID"
+    gpu.state.depth_test_set("LESS_EQUAL")
+    gpu.state.depth_mask_set(True)
+    for ob in context.view_layer.objects:
+        if ob.type != "MESH" or not ob.tessera.tessellate.preview:
+            continue
+        entry = entry_for(ob)
+        if entry is None:
+            continue
+        update_levels(ob, entry, view, proj, region.width, region.height)
+        vp = proj @ view @ np.array(ob.matrix_world)
+        disp = displacement_for(ob)
+        if shading != "WIREFRAME":
+            entry["draw"].draw(vp, displacement=disp)
+        if shading == "WIREFRAME" or context.space_data.overlay.show_wireframes:
+            entry["draw"].draw(vp, color=(0.05, 0.05, 0.05, 1.0), lit=False, displacement=disp, wireframe=True)
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+
+
+def register():
+    bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph)
+    if not bpy.app.background:
+        _state["handler"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+
+
+def unregister():
+    if _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
+    if _state["handler"] is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_state["handler"], "WINDOW")
+        _state["handler"] = None
+    _state["cache"].clear()
+    _state["errors"].clear()
