@@ -13,6 +13,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   ``tessera.displacement_stroke``; the map is also written as ``out/demo_map.exr`` (32-bit float);
 - ``out/demo_terrain.png``: a synthetic ridged terrain (1025², written as a 16-bit PNG height map) added with
   ``tessera.terrain_add`` and meshed adaptively for the scene camera, wireframe on top;
+- ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
+  refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
@@ -283,6 +285,61 @@ def _synth():
     return importlib.import_module("bl_ext.tessera_demo.tessera.kernels.terrain_synth")
 
 
+def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
+    """The live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced patterns (left: lit,
+    middle: with the output wireframe, right: a height map sampled in the vertex shader). Returns triangles."""
+    import gpu
+
+    package = "bl_ext.tessera_demo.tessera"
+    mods = {n: __import__(f"{package}.{n}", fromlist=["x"]) for n in (
+        "addon.gpu_context", "addon.bridge", "kernels.adaptive", "kernels.camera", "kernels.tessellate",
+        "gpu_shaders.patch_preview", "gpu_shaders.offscreen")}
+    mods["addon.gpu_context"].ensure_gpu_context()
+    clear_scene()
+    bpy.ops.mesh.primitive_monkey_add()
+    ob = bpy.context.active_object
+    for poly in ob.data.polygons:
+        poly.use_smooth = True
+    arrays, _ = mods["addon.bridge"].read_mesh(ob.data)
+    tess, adaptive, preview = mods["kernels.tessellate"], mods["kernels.adaptive"], mods["gpu_shaders.patch_preview"]
+    cam = mods["kernels.camera"].Camera.looking_at((0.0, -6.4, 0.7), (0.0, 0.0, 0.0), fov_deg=40, width=size[0],
+                                                   height=size[1], far=100)
+    settings = adaptive.AdaptiveSettings(metrics=("PROJECTED",), max_level=10, edge_pixels=16.0)
+    v, u = np.mgrid[0:512, 0:512] / 512.0
+    bumps = np.zeros((512, 512, 4), np.float32)
+    bumps[..., :3] = (0.5 + 0.5 * np.sin(40 * u) * np.sin(40 * v))[..., None]
+    bumps[..., 3] = 1.0
+    texture = gpu.types.GPUTexture((512, 512), format="RGBA32F", data=gpu.types.Buffer("FLOAT", bumps.size,
+                                                                                        bumps.ravel()))
+    draws, total = [], 0
+    for x, mode in ((-2.9, "LIT"), (0.0, "WIRE"), (2.9, "DISPLACED")):
+        model = np.eye(4)
+        model[0, 3] = x
+        world = arrays.positions.astype(np.float64) + (x, 0.0, 0.0)
+        edge, inner = adaptive.adaptive_levels(world, arrays.triangles, settings, cam)
+        inputs = tess.surface_inputs(arrays, edge, "PN", tess.SurfaceOptions())
+        data = preview.PatchDrawData(inputs, "PN", uvs=arrays.corner_attributes.get("UVMap"))
+        data.set_levels(inputs.edge_levels, inner, "FRACTIONAL_EVEN")
+        total += data.triangle_count
+        draws.append((data, cam.projection @ cam.view @ model, mode))
+
+    def draw():
+        for data, vp, mode in draws:
+            disp = preview.Displacement(texture, "HEIGHT", 0.5, 0.1) if mode == "DISPLACED" else None
+            data.draw(vp, color=(0.8, 0.55, 0.35, 1.0), displacement=disp)
+            if mode == "WIRE":
+                data.draw(vp, color=(0.05, 0.05, 0.08, 1.0), lit=False, wireframe=True)
+
+    pixels = mods["gpu_shaders.offscreen"].render(draw, size, background=(0.9, 0.9, 0.92, 1.0))
+    image = bpy.data.images.new("demo_gpu_preview", size[0], size[1], alpha=True)
+    image.pixels.foreach_set((pixels.astype(np.float32) / 255.0).ravel())
+    image.filepath_raw = str(OUT / name)
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.objects.remove(ob)
+    return total
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -328,8 +385,10 @@ def main():
     tris, full = build_terrain_scene()
     render("demo_terrain.png")
     print(f"demo: terrain for the camera: {tris:,} triangles ({100 * tris / full:.2f}% of the {full:,}-triangle grid)")
+    tris = build_gpu_preview_picture()
+    print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr", "demo_terrain.png"):
+                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
