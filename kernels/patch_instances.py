@@ -21,6 +21,7 @@ from data both triangles hold bit for bit, so shared edges have the same vertice
 """
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -45,9 +46,11 @@ def interior_codes(m):
     return np.array(rows, np.float32).reshape(-1, 4)
 
 
+@lru_cache(maxsize=4096)
 def pattern(n0, n1, n2, m):
     """Pattern of class ``(n0, n1, n2, m)``: ``(codes (P, 4) float32, triangles (Q, 3) int32)``, counter-clockwise
-    like the input triangle, vertices numbered as `kernels.refine` numbers them for a lone triangle."""
+    like the input triangle, vertices numbered as `kernels.refine` numbers them for a lone triangle. Cached:
+    the arrays are read-only."""
     tris, n_vertices, edge_levels, _ = single_triangle_levels((n1, n2, n0), m)  # OpenGL order: OL0 = v1-v2
     ref = refine(tris, n_vertices, edge_levels, np.array([float(m)]), "EQUAL")
     codes = [(KIND_CORNER, c, 0, 0) for c in range(3)]
@@ -59,8 +62,12 @@ def pattern(n0, n1, n2, m):
         codes.extend((KIND_EDGE, e, n - j if flip else j, 0) for j in range(1, n))
     inner = int(ref.inner_segments[0])
     codes = np.concatenate([np.array(codes, np.float32).reshape(-1, 4), interior_codes(inner)])
-    assert len(codes) == ref.n_vertices
-    return codes, ref.triangles.astype(np.int32)
+    if len(codes) != ref.n_vertices:
+        raise AssertionError(f"pattern {(n0, n1, n2, m)}: {len(codes)} codes for {ref.n_vertices} vertices")
+    tris = ref.triangles.astype(np.int32)
+    codes.setflags(write=False)
+    tris.setflags(write=False)
+    return codes, tris
 
 
 @dataclass
