@@ -23,6 +23,7 @@ _modules = (
     "addon.tube_preview",
     "addon.terrain_preview",
     "addon.patch_preview",
+    "addon.brush_cursor",
     "addon.brush_tool",
 )
 

@@ -31,6 +31,7 @@ class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
     bl_label = "Displacement Brush"
     bl_description = "Paint the active object's displacement map (Tessera)"
     bl_icon = "brush.sculpt.draw"
+    bl_widget = "TESSERA_GGT_brush_cursor"  # the ring follows the mouse before and between strokes
     bl_keymap = (
         ("tessera.displacement_stroke", {"type": "LEFTMOUSE", "value": "PRESS"}, None),
         ("wm.radial_control", {"type": "F", "value": "PRESS"},

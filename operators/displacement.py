@@ -6,16 +6,13 @@ surface, dabs along the stroke, a brush circle while painting) and the headless 
 ``map_space`` is set). Both go through one `StrokeSession`, so a replay reproduces the stroke.
 """
 
-import math
 import time
 
 import bpy
-import gpu
 import mathutils
 import numpy as np
-from bpy_extras import view3d_utils
-from gpu_extras.batch import batch_for_shader
 
+from ..addon.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement_maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement_settings import MODE_ITEMS, SPACE_ITEMS
 from ..kernels.errors import TesseraError
@@ -137,29 +134,6 @@ class TESSERA_OT_displacement_export(bpy.types.Operator):
         return {"FINISHED"}
 
 
-def _texel(mesh, poly_index, co, uv_name, size):
-    """Map texel coordinates of the object-space point ``co`` on polygon ``poly_index`` of ``mesh``."""
-    poly = mesh.polygons[poly_index]
-    weights = mathutils.interpolate.poly_3d_calc([mesh.vertices[i].co for i in poly.vertices], co)
-    layer = mesh.uv_layers.get(uv_name) if uv_name else mesh.uv_layers.active
-    if layer is None:
-        raise TesseraError(f"The mesh has no UV map {uv_name!r}")
-    u = sum(w * layer.uv[li].vector.x for w, li in zip(weights, poly.loop_indices, strict=True))
-    v = sum(w * layer.uv[li].vector.y for w, li in zip(weights, poly.loop_indices, strict=True))
-    return u * size[0] - 0.5, v * size[1] - 0.5
-
-
-def _texel_world_size(ob, mesh, poly_index, uv_name, size):
-    """World length of one texel on a polygon (from its area in the world and in texel space)."""
-    poly = mesh.polygons[poly_index]
-    layer = mesh.uv_layers.get(uv_name) if uv_name else mesh.uv_layers.active
-    uv = [layer.uv[li].vector for li in poly.loop_indices]
-    uv_area = 0.5 * abs(sum(uv[i].x * uv[i - 1].y - uv[i - 1].x * uv[i].y for i in range(len(uv))))
-    scale = ob.matrix_world.to_scale()
-    world_area = poly.area * abs(scale.x * scale.y)  # close enough for a cursor
-    return math.sqrt(world_area / max(uv_area * size[0] * size[1], 1e-30))
-
-
 def _new_session(context):
     """A stroke on the active object's map with the scene's brush."""
     settings = context.active_object.tessera.displacement
@@ -223,7 +197,7 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
             co, _normal, index, _dist = tree.find_nearest(e.location)
             if index is None:
                 raise TesseraError("A stroke location found no surface")
-            out.append((*_texel(mesh, index, co, settings.uv_map, (shape[1], shape[0])), e.pressure))
+            out.append((*texel(mesh, index, co, settings.uv_map, (shape[1], shape[0])), e.pressure))
         return out
 
     # -- interactive --------------------------------------------------------------------------------------
@@ -265,23 +239,17 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
 
     def _sample(self, context, event, first=False):
         ob = context.active_object
-        region, rv3d = context.region, context.region_data
         mouse = (event.mouse_region_x, event.mouse_region_y)
-        origin = view3d_utils.region_2d_to_origin_3d(region, rv3d, mouse)
-        direction = view3d_utils.region_2d_to_vector_3d(region, rv3d, mouse)
-        depsgraph = context.evaluated_depsgraph_get()
-        ob_eval = ob.evaluated_get(depsgraph)
-        inv = ob.matrix_world.inverted()
-        hit, co, normal, index = ob_eval.ray_cast(inv @ origin, (inv.to_3x3() @ direction).normalized(),
-                                                  depsgraph=depsgraph)
-        if not hit:
+        hit = mouse_hit(context, ob, mouse)
+        if hit is None:
             self._cursor = None
             context.area.tag_redraw()
             return
+        co, index = hit.co, hit.index
         settings = ob.tessera.displacement
         shape = self._session.state.host.shape
         size = (shape[1], shape[0])
-        x, y = _texel(ob_eval.data, index, co, settings.uv_map, size)
+        x, y = texel(hit.evaluated.data, index, co, settings.uv_map, size)
         pressure = event.pressure if event.pressure > 0 else 1.0
         try:
             self._session.add(x, y, pressure)
@@ -291,8 +259,7 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         element = self.stroke.add()
         element.location, element.mouse, element.pressure = co, mouse, pressure
         element.is_start, element.time = first, time.monotonic()
-        world_r = _texel_world_size(ob_eval, ob_eval.data, index, settings.uv_map, size) * self._session.brush.radius
-        self._cursor = (ob.matrix_world @ co, (ob.matrix_world.to_3x3() @ normal).normalized(), world_r)
+        self._cursor = hit.ring(self._session.brush.radius, size, settings.uv_map)
         now = time.monotonic()
         if now - self._last_write > _LIVE_INTERVAL:
             self._session.state.to_image(self._session.image)
@@ -300,19 +267,8 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         context.area.tag_redraw()
 
     def _draw_cursor(self):
-        if self._cursor is None:
-            return
-        centre, normal, radius = self._cursor
-        t = normal.orthogonal().normalized()
-        b = normal.cross(t)
-        ring = [centre + radius * (math.cos(a) * t + math.sin(a) * b)
-                for a in np.linspace(0, 2 * math.pi, 49)]
-        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
-        batch = batch_for_shader(shader, "LINE_STRIP", {"pos": [tuple(p) for p in ring]})
-        shader.uniform_float("color", (1.0, 0.55, 0.1, 1.0))
-        gpu.state.line_width_set(2.0)
-        batch.draw(shader)
-        gpu.state.line_width_set(1.0)
+        if self._cursor is not None:
+            draw_ring(self._cursor)
 
 
 classes = (TESSERA_OT_displacement_add, TESSERA_OT_displacement_export, TESSERA_OT_displacement_stroke)

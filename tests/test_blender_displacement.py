@@ -184,3 +184,26 @@ def test_save_reload_is_exact_and_custom_kernels_need_trust(clean_scene, bpy_mod
         bpy.ops.tessera.displacement_custom()
     assert state_of(addon_module, ob).host.tobytes() == before.tobytes()
     prefs.use_scripts_auto_execute = False
+
+
+def test_brush_cursor_sits_on_the_surface_with_the_brush_radius(clean_scene, bpy_module, addon_module):
+    """The hover cursor's ring (the tool's gizmo and the stroke share it): centred where the ray meets the
+    displaced surface, facing along its normal, radius = brush radius in texels × a texel's world size."""
+    bpy = bpy_module
+    cursor = addon_module("addon.brush_cursor")
+    ob = make_plane(bpy)
+    ob.location = (0.0, 0.0, 0.5)
+    ob.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    brush(bpy, radius=4.0)
+    hit = cursor.surface_hit(bpy.context, ob, (0.3, -0.7, 10.0), (0.0, 0.0, -1.0))
+    centre, normal, radius = hit.ring(4.0, (SIZE, SIZE), "")
+    assert np.allclose(centre, (0.3, -0.7, 0.5), atol=1e-5)
+    assert np.allclose(normal, (0, 0, 1), atol=1e-6)
+    assert radius == pytest.approx(4.0 * 4.0 / SIZE, rel=1e-4)  # the plane is 4 m wide in the world: 32 texels
+    points = cursor.ring_points(centre, normal, radius)
+    assert np.allclose(np.linalg.norm(points - np.array(centre), axis=1), radius, rtol=1e-5)
+    assert cursor.surface_hit(bpy.context, ob, (5.0, 5.0, 10.0), (0.0, 0.0, -1.0)) is None  # off the plane
+    tool = addon_module("addon.brush_tool").TESSERA_TL_displacement_brush
+    assert tool.bl_widget == cursor.TESSERA_GGT_brush_cursor.bl_idname
+    assert all("bl_rna" in c.__dict__ for c in cursor.classes)  # registered with Blender
