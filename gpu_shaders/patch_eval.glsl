@@ -76,16 +76,13 @@ vec3 face_position(vec3 p[3], vec3 n[3], float a[3], vec3 b)
 /* The normal field (PN quadratic, or linear) at barycentrics b from corner normals s: unit. */
 vec3 face_normal(vec3 p[3], vec3 s[3], vec3 b)
 {
-  vec3 n = b.x * b.x * s[0] + b.y * b.y * s[1] + b.z * b.z * s[2];
   if (method == 2 && pn_quadratic != 0) {
-    n += b.x * b.y * reflected_mid_normal(p[0], p[1], s[0], s[1]) +
-         b.y * b.z * reflected_mid_normal(p[1], p[2], s[1], s[2]) +
-         b.z * b.x * reflected_mid_normal(p[2], p[0], s[2], s[0]);
+    return safe_normalize(b.x * b.x * s[0] + b.y * b.y * s[1] + b.z * b.z * s[2] +
+                          b.x * b.y * reflected_mid_normal(p[0], p[1], s[0], s[1]) +
+                          b.y * b.z * reflected_mid_normal(p[1], p[2], s[1], s[2]) +
+                          b.z * b.x * reflected_mid_normal(p[2], p[0], s[2], s[0]));
   }
-  else {
-    n = b.x * s[0] + b.y * s[1] + b.z * s[2];
-  }
-  return safe_normalize(n);
+  return safe_normalize(b.x * s[0] + b.y * s[1] + b.z * s[2]);
 }
 
 /* Evaluate pattern vertex `code` of triangle `tri` with its levels `lev` (f0, f1, f2, f_inner) and segment
