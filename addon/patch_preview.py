@@ -18,8 +18,9 @@ from ..kernels.errors import TesseraError
 from ..kernels.tessellate import surface_inputs, uniform_levels
 from . import bridge
 from .settings import SETTING_NAMES, adaptive_settings, surface_options
+from .viewport import add_handlers, drop_stale, new_state, remove_handlers
 
-_state = {"handler": None, "cache": {}, "errors": {}}
+_state = new_state()
 #: Settings that change what is uploaded per mesh (the rest only change levels).
 SURFACE_NAMES = ("method", "alpha", "alpha_attribute", "normal_mode", "pn_normals")
 
@@ -30,18 +31,7 @@ def _key(settings, names):
 
 @bpy.app.handlers.persistent  # survive file loads
 def _on_depsgraph(scene, depsgraph):
-    cache = _state["cache"]
-    if not cache:
-        return
-    for update in depsgraph.updates:
-        obj = update.id.original if hasattr(update.id, "original") else update.id
-        if isinstance(obj, bpy.types.Object) and obj.name in cache and update.is_updated_geometry:
-            forget(obj)
-        elif isinstance(obj, bpy.types.Mesh):
-            for name, entry in list(cache.items()):
-                if entry["data"] == obj.name:
-                    cache.pop(name, None)
-                    _state["errors"].pop(name, None)
+    drop_stale(_state, depsgraph, bpy.types.Mesh)
 
 
 def forget(ob):
@@ -114,17 +104,8 @@ def displacement_for(ob):
     return Displacement(gpu.texture.from_image(d.image), d.mode, d.mid_level, d.strength)
 
 
-def _draw():
-    import gpu
-
-    context = bpy.context
-    region, rv3d = context.region, context.region_data
-    if region is None or rv3d is None:
-        return
-    view, proj = np.array(rv3d.view_matrix), np.array(rv3d.window_matrix)
+def _draw(context, region, view, proj):
     shading = context.space_data.shading.type if context.space_data else "SOLID"
-    gpu.state.depth_test_set("LESS_EQUAL")
-    gpu.state.depth_mask_set(True)
     for ob in context.view_layer.objects:
         if ob.type != "MESH" or not ob.tessera.tessellate.preview:
             continue
@@ -138,21 +119,11 @@ def _draw():
             entry["draw"].draw(vp, displacement=disp)
         if shading == "WIREFRAME" or context.space_data.overlay.show_wireframes:
             entry["draw"].draw(vp, color=(0.05, 0.05, 0.05, 1.0), lit=False, displacement=disp, wireframe=True)
-    gpu.state.depth_test_set("NONE")
-    gpu.state.depth_mask_set(False)
 
 
 def register():
-    bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph)
-    if not bpy.app.background:
-        _state["handler"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+    add_handlers(_state, _draw, _on_depsgraph)
 
 
 def unregister():
-    if _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
-    if _state["handler"] is not None:
-        bpy.types.SpaceView3D.draw_handler_remove(_state["handler"], "WINDOW")
-        _state["handler"] = None
-    _state["cache"].clear()
-    _state["errors"].clear()
+    remove_handlers(_state, _on_depsgraph)

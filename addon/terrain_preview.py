@@ -14,9 +14,9 @@ from ..kernels.errors import TesseraError
 from ..kernels.terrain_lod import select
 from . import terrain_data
 from .terrain_settings import lod_settings, source_key
-from .viewport import tag_view3d_redraw
+from .viewport import add_handlers, new_state, remove_handlers, tag_view3d_redraw
 
-_state = {"handler": None, "cache": {}, "errors": {}}
+_state = new_state()
 
 
 def settings_changed(ob):
@@ -60,16 +60,7 @@ def update_view(ob, entry, view, projection, width, height):
     return True
 
 
-def _draw():
-    import gpu
-
-    context = bpy.context
-    region, rv3d = context.region, context.region_data
-    if region is None or rv3d is None:
-        return
-    view, proj = np.array(rv3d.view_matrix), np.array(rv3d.window_matrix)
-    gpu.state.depth_test_set("LESS_EQUAL")
-    gpu.state.depth_mask_set(True)
+def _draw(context, region, view, proj):
     for ob in context.view_layer.objects:
         s = ob.tessera.terrain
         if not (s.is_terrain and s.preview):
@@ -79,19 +70,12 @@ def _draw():
             continue
         update_view(ob, entry, view, proj, region.width, region.height)
         entry["draw"].draw(proj @ view @ np.array(ob.matrix_world))
-    gpu.state.depth_test_set("NONE")
-    gpu.state.depth_mask_set(False)
 
 
 def register():
-    if not bpy.app.background:
-        _state["handler"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+    add_handlers(_state, _draw)
 
 
 def unregister():
-    if _state["handler"] is not None:
-        bpy.types.SpaceView3D.draw_handler_remove(_state["handler"], "WINDOW")
-        _state["handler"] = None
-    _state["cache"].clear()
-    _state["errors"].clear()
+    remove_handlers(_state)
     terrain_data.forget()

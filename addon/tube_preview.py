@@ -14,9 +14,9 @@ from ..kernels.errors import TesseraError
 from ..kernels.tubes import lod_sides, tube_sections
 from .tube_settings import kernel_settings
 from .tube_sources import SOURCE_TYPES, read_lines
-from .viewport import tag_view3d_redraw
+from .viewport import add_handlers, drop_stale, new_state, remove_handlers, tag_view3d_redraw
 
-_state = {"handler": None, "cache": {}, "errors": {}}
+_state = new_state()
 
 
 def settings_changed(ob):
@@ -29,17 +29,7 @@ def settings_changed(ob):
 
 @bpy.app.handlers.persistent  # survive file loads
 def _on_depsgraph(scene, depsgraph):
-    cache = _state["cache"]
-    if not cache:
-        return
-    for update in depsgraph.updates:
-        obj = update.id.original if hasattr(update.id, "original") else update.id
-        if isinstance(obj, bpy.types.Object) and obj.name in cache and update.is_updated_geometry:
-            cache.pop(obj.name, None)
-        elif isinstance(obj, (bpy.types.Curve, bpy.types.Mesh, bpy.types.Curves)):
-            for name, entry in list(cache.items()):
-                if entry["data"] == obj.name:
-                    cache.pop(name, None)
+    drop_stale(_state, depsgraph, (bpy.types.Curve, bpy.types.Mesh, bpy.types.Curves))
 
 
 def _entry(ob):
@@ -60,16 +50,7 @@ def _entry(ob):
     return cache.get(ob.name)
 
 
-def _draw():
-    import gpu
-
-    context = bpy.context
-    region, rv3d = context.region, context.region_data
-    if region is None or rv3d is None:
-        return
-    view, proj = np.array(rv3d.view_matrix), np.array(rv3d.window_matrix)
-    gpu.state.depth_test_set("LESS_EQUAL")
-    gpu.state.depth_mask_set(True)
+def _draw(context, region, view, proj):
     for ob in context.visible_objects:
         if ob.type not in SOURCE_TYPES or not ob.tessera.tubes.preview:
             continue
@@ -84,21 +65,11 @@ def _draw():
             entry["draw"].set_sides(lod_sides(entry["lines"], kernel_settings(s), cam))
             entry["view"] = key
         entry["draw"].draw(proj @ view @ model, region.width, clamp=s.aa_clamp, max_radius=s.max_radius)
-    gpu.state.depth_test_set("NONE")
-    gpu.state.depth_mask_set(False)
 
 
 def register():
-    bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph)
-    if not bpy.app.background:
-        _state["handler"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+    add_handlers(_state, _draw, _on_depsgraph)
 
 
 def unregister():
-    if _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
-    if _state["handler"] is not None:
-        bpy.types.SpaceView3D.draw_handler_remove(_state["handler"], "WINDOW")
-        _state["handler"] = None
-    _state["cache"].clear()
-    _state["errors"].clear()
+    remove_handlers(_state, _on_depsgraph)
