@@ -12,6 +12,7 @@ import numpy as np
 
 from ..kernels.errors import InvalidInputError
 from ..kernels.mesh_arrays import MeshArrays
+from ..kernels.tangent_space import triangle_tangents
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
 # the number of channels.
@@ -96,6 +97,27 @@ def read_mesh(mesh):
             continue
         arrays.attribute_types[name] = dtype
     return arrays, info
+
+
+def corner_tangents(mesh, uv_map):
+    """MikkTSpace tangents of UV map ``uv_map`` per loop-triangle corner, as `read_mesh` orders corners:
+    (T, 3, 4) float32, the unit tangent (xyz) and bitangent sign (w). Meshes with n-gons, which
+    `Mesh.calc_tangents` refuses, get per-triangle tangents from the UVs (`kernels.tangent_space`)."""
+    mesh.calc_loop_triangles()
+    n_tris = len(mesh.loop_triangles)
+    tri_loops = _get(mesh.loop_triangles, "loops", n_tris, np.int32, 3)
+    try:
+        mesh.calc_tangents(uvmap=uv_map)
+    except RuntimeError:
+        positions = _get(mesh.attributes["position"].data, "vector", len(mesh.vertices), np.float32, 3)
+        tri_verts = _get(mesh.loop_triangles, "vertices", n_tris, np.int32, 3)
+        uv = _get(mesh.uv_layers[uv_map].data, "uv", len(mesh.loops), np.float32, 2)
+        return triangle_tangents(positions[tri_verts], uv[tri_loops])
+    out = np.empty((len(mesh.loops), 4), np.float32)
+    out[:, :3] = _get(mesh.loops, "tangent", len(mesh.loops), np.float32, 3)
+    out[:, 3] = _get(mesh.loops, "bitangent_sign", len(mesh.loops), np.float32)
+    mesh.free_tangents()
+    return out[tri_loops]
 
 
 def _new_attribute(mesh, name, dtype, domain):

@@ -18,6 +18,7 @@ from ..kernels.errors import InvalidInputError, TesseraError
 from ..kernels.map_buffer import MapBuffer
 from ..kernels.map_strokes import TileUndo, run_stroke, stroke_dabs, union_region
 from ..kernels.opencl_runtime import get_runtime
+from . import displace_nodes
 
 MODIFIER_NAME = "Tessera Displacement"
 _states = {}
@@ -146,22 +147,42 @@ def commit(state, image, undo):
     state.to_image(image)
 
 
+def modifier_kind(settings):
+    """NODES (the tangent-space group) for tangent-space vector maps, else DISPLACE."""
+    return "NODES" if settings.mode == "VECTOR" and settings.space == "TANGENT" else "DISPLACE"
+
+
 def sync_modifier(ob):
-    """Create or update the Displace modifier (and its image texture) that shows the object's map."""
+    """Create or update the modifier that shows the object's map: a Displace modifier (and its image
+    texture), or for tangent-space vector maps the `displace_nodes` group. Returns it, or None when hidden (no
+    map, or tangent space on a Blender without the UV Tangent node)."""
     settings = ob.tessera.displacement
     mod = ob.modifiers.get(MODIFIER_NAME)
-    if settings.image is None:
+    kind = modifier_kind(settings)
+    if settings.image is None or (kind == "NODES" and not displace_nodes.available()):
         if mod is not None:
             mod.show_viewport = mod.show_render = False
         return None
-    if mod is None:
-        mod = ob.modifiers.new(MODIFIER_NAME, "DISPLACE")
+    if mod is not None and mod.type != kind:  # replaced in place, keeping its position in the stack
+        position = ob.modifiers.find(MODIFIER_NAME)
+        ob.modifiers.remove(mod)
+        mod = ob.modifiers.new(MODIFIER_NAME, kind)
+        ob.modifiers.move(len(ob.modifiers) - 1, position)
+    elif mod is None:
+        mod = ob.modifiers.new(MODIFIER_NAME, kind)
+    mod.show_viewport = mod.show_render = True
+    if kind == "NODES":
+        mod.node_group = displace_nodes.node_group()
+        uv_map = settings.uv_map or getattr(ob.data.uv_layers.active, "name", "")
+        displace_nodes.set_inputs(mod, {"Image": settings.image, "UV Map": uv_map,
+                                        "Mid-Level": settings.mid_level, "Strength": settings.strength})
+        ob.update_tag()
+        return mod
     if mod.texture is None:
         mod.texture = bpy.data.textures.new(f"{settings.image.name} Texture", "IMAGE")
     tex = mod.texture
     tex.image = settings.image
     tex.extension = "EXTEND"
-    mod.show_viewport = mod.show_render = True
     mod.texture_coords = "UV"
     mod.uv_layer = settings.uv_map
     mod.mid_level = settings.mid_level

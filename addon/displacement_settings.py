@@ -9,13 +9,14 @@ from .displacement_maps import sync_modifier
 
 MODE_ITEMS = (
     ("HEIGHT", "Height", "One value per texel, displaced along the normal"),
-    ("VECTOR", "Vector", "An XYZ offset per texel (object or world space)"),
+    ("VECTOR", "Vector", "An XYZ offset per texel (object, world or tangent space)"),
 )
-# Blender's Displace modifier offers object and world space for RGB to XYZ (tangent space would need tangents,
-# which neither the modifier nor geometry nodes provide)
+# object and world space are shown by Blender's Displace modifier, tangent space by a geometry-nodes group
 SPACE_ITEMS = (
     ("LOCAL", "Object", "X, Y, Z in the object's own axes"),
     ("GLOBAL", "World", "X, Y, Z in world axes"),
+    ("TANGENT", "Tangent", "X along the UV map's U tangent, Y along the bitangent, Z along the normal "
+                           "(MikkTSpace; Blender 5.0 and newer)"),
 )
 BRUSH_ITEMS = (
     ("DRAW", "Draw", "Raise (or lower, with negative strength) along the brush direction with a falloff"),

@@ -2,6 +2,7 @@
 
 import bpy
 
+from . import displace_nodes
 from .brush_tool import draw_brush_settings
 from .settings import draw_settings
 from .terrain_settings import draw_terrain_settings
@@ -78,6 +79,8 @@ class TESSERA_PT_displacement(_Sidebar, bpy.types.Panel):
         layout.prop(settings, "mode")
         if settings.mode == "VECTOR":
             layout.prop(settings, "space")
+            if settings.space == "TANGENT" and not displace_nodes.available():
+                layout.label(text="Tangent space needs Blender 5.0 or newer: the map is not shown", icon="ERROR")
         layout.prop_search(settings, "uv_map", context.active_object.data, "uv_layers")
         layout.prop(settings, "mid_level")
         layout.prop(settings, "strength")

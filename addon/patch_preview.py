@@ -40,10 +40,19 @@ def forget(ob):
     _state["errors"].pop(ob.name, None)
 
 
-def _uvs(arrays, ob):
-    """Corner UVs (T, 3, 2) of the UV map the displacement uses (its own, else the active one), or None."""
-    name = ob.tessera.displacement.uv_map or getattr(ob.data.uv_layers.active, "name", None)
-    return arrays.corner_attributes.get(name) if name else None
+def _uv_name(ob):
+    """The UV map the displacement uses (its own, else the active one), or None."""
+    return ob.tessera.displacement.uv_map or getattr(ob.data.uv_layers.active, "name", None)
+
+
+def _tangent_space(ob):
+    d = ob.tessera.displacement
+    return d.mode == "VECTOR" and d.space == "TANGENT"
+
+
+def _surface_key(ob):
+    """What the uploaded control data depends on: surface settings, the UV map, tangents or not."""
+    return _key(ob.tessera.tessellate, SURFACE_NAMES) + (_uv_name(ob), _tangent_space(ob))
 
 
 def entry_for(ob):
@@ -51,7 +60,7 @@ def entry_for(ob):
     from ..gpu_shaders.patch_preview import PatchDrawData
 
     s = ob.tessera.tessellate
-    cache, surface = _state["cache"], _key(s, SURFACE_NAMES)
+    cache, surface = _state["cache"], _surface_key(ob)
     entry = cache.get(ob.name)
     if entry is not None and entry["surface"] != surface:
         forget(ob)
@@ -61,7 +70,10 @@ def entry_for(ob):
             method = s.method
             inputs = surface_inputs(arrays, uniform_levels(arrays, 1), method if method != "LINEAR" else "PN",
                                     surface_options(s))
-            draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=_uvs(arrays, ob))
+            uv_name = _uv_name(ob)
+            uvs = arrays.corner_attributes.get(uv_name) if uv_name else None
+            tangents = bridge.corner_tangents(ob.data, uv_name) if uvs is not None and _tangent_space(ob) else None
+            draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=uvs, tangents=tangents)
         except TesseraError as err:
             _state["errors"][ob.name] = str(err)
             return None
@@ -93,7 +105,7 @@ def update_levels(ob, entry, view, projection, width, height):
 
 def displacement_for(ob):
     """The object's displacement map as a preview `Displacement`, or None (no map, or world-space vectors,
-    which the preview does not show)."""
+    which the preview does not show). Tangent-space maps use the tangents uploaded with the mesh."""
     from ..gpu_shaders.patch_preview import Displacement
 
     d = ob.tessera.displacement
@@ -101,7 +113,8 @@ def displacement_for(ob):
         return None
     import gpu
 
-    return Displacement(gpu.texture.from_image(d.image), d.mode, d.mid_level, d.strength)
+    mode = "TANGENT" if _tangent_space(ob) else d.mode
+    return Displacement(gpu.texture.from_image(d.image), mode, d.mid_level, d.strength)
 
 
 def _draw(context, region, view, proj):

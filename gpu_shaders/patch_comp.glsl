@@ -14,10 +14,9 @@ void main()
   if (texel.x >= tex_width || v >= vertex_count) {
     return;
   }
-  vec3 pos, nor;
-  vec2 uv;
+  vec3 pos, nor, bary;
   evaluate(int(vertex_row(4 * v + 3).x), vertex_row(4 * v), vertex_row(4 * v + 1), vertex_row(4 * v + 2), false,
-           pos, nor, uv);
+           pos, nor, bary);
   imageStore(out_positions, texel, vec4(pos, 1.0));
   imageStore(out_normals, texel, vec4(nor, 0.0));
 }

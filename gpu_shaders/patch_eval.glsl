@@ -4,7 +4,7 @@
  * and `fractional`. Edge points are evaluated along their edge's canonical direction from the two endpoints
  * only, so both triangles of a shared edge compute the same vertex. */
 
-#define CONTROL_ROWS 11
+#define CONTROL_ROWS 14
 
 vec4 control_row(int tri, int row)
 {
@@ -89,7 +89,7 @@ vec3 face_normal(vec3 p[3], vec3 s[3], vec3 b)
  * counts `counts` (n0, n1, n2, m). Normals from the shading normals (`shading_normals`, split corners kept)
  * or the one-per-vertex geometry normals. */
 void evaluate(int tri, vec4 code, vec4 lev, vec4 counts, bool shading_normals, out vec3 pos, out vec3 nor,
-              out vec2 uv)
+              out vec3 b)
 {
   vec3 p[3], n[3], s[3];
   float a[3], flip[3];
@@ -104,7 +104,7 @@ void evaluate(int tri, vec4 code, vec4 lev, vec4 counts, bool shading_normals, o
   }
   bool frac = fractional != 0;
   int kind = int(code.x);
-  vec3 b = vec3(0.0);
+  b = vec3(0.0);
   if (kind == 0) {
     int c = int(code.y);
     b[c] = 1.0;
@@ -141,7 +141,17 @@ void evaluate(int tri, vec4 code, vec4 lev, vec4 counts, bool shading_normals, o
     pos = face_position(p, n, a, b);
   }
   nor = face_normal(p, s, b);
+}
+
+/* Corner UVs of `tri` interpolated at barycentric `b`. */
+vec2 uv_at(int tri, vec3 b)
+{
   vec4 uv01 = control_row(tri, 9);
-  vec2 uv2 = control_row(tri, 10).xy;
-  uv = b.x * uv01.xy + b.y * uv01.zw + b.z * uv2;
+  return b.x * uv01.xy + b.y * uv01.zw + b.z * control_row(tri, 10).xy;
+}
+
+/* Corner tangents (xyz) and bitangent signs (w) of `tri` interpolated at barycentric `b`. */
+vec4 tangent_at(int tri, vec3 b)
+{
+  return b.x * control_row(tri, 11) + b.y * control_row(tri, 12) + b.z * control_row(tri, 13);
 }

@@ -14,7 +14,7 @@ from .offscreen import set_shading, shaded_create_info
 from .textures import TEX_WIDTH, rgba_texture
 
 METHOD_CODES = {"LINEAR": 0, "PHONG": 1, "PN": 2}
-DISPLACE_CODES = {"HEIGHT": 1, "VECTOR": 2}
+DISPLACE_CODES = {"HEIGHT": 1, "VECTOR": 2, "TANGENT": 3}
 
 
 def _surface_constants(info):
@@ -79,7 +79,8 @@ def _set_surface(shader, method, pn_quadratic, fractional, control):
 
 class Displacement:
     """A displacement map for the preview: ``texture`` (a `gpu.types.GPUTexture`), ``mode`` HEIGHT (along the
-    normal, mean of R, G, B) or VECTOR (RGB in object space), ``mid_level``, ``strength``; sampled at the UVs."""
+    normal, mean of R, G, B), VECTOR (RGB in object space) or TANGENT (RGB in the tangent frame: needs the
+    draw data's tangents), ``mid_level``, ``strength``; sampled at the UVs."""
 
     def __init__(self, texture, mode="HEIGHT", mid_level=0.5, strength=1.0):
         if mode not in DISPLACE_CODES:
@@ -91,12 +92,13 @@ class PatchDrawData:
     """GPU resources of one tessellated mesh.
 
     inputs: `kernels.tessellate.SurfaceInputs`; method: LINEAR, PHONG or PN; alpha: the constant Phong factor;
-    pn_quadratic: quadratic PN normals; uvs: (T, 3, 2) corner UVs or None (needed for displacement).
+    pn_quadratic: quadratic PN normals; uvs: (T, 3, 2) corner UVs or None (needed for displacement);
+    tangents: (T, 3, 4) corner tangents and bitangent signs or None (needed for tangent-space displacement).
     """
 
-    def __init__(self, inputs, method="PN", alpha=0.75, pn_quadratic=True, uvs=None):
+    def __init__(self, inputs, method="PN", alpha=0.75, pn_quadratic=True, uvs=None, tangents=None):
         self.inputs, self.method, self.pn_quadratic = inputs, method, pn_quadratic
-        rows = pi.control_rows(inputs, alpha, uvs)
+        rows = pi.control_rows(inputs, alpha, uvs, tangents)
         self.control = rgba_texture(rows.reshape(-1, 4))
         self.control_bytes = rows.nbytes
         self.buckets, self.instance_bytes, self.fractional, self.classes = {}, 0, False, None

@@ -15,7 +15,8 @@ from a texture and places the pattern vertex on the curved surface. This module 
 
 Control texels of triangle ``t`` (rows ``CONTROL_ROWS * t ...``): 0-2 corner position and Phong shape factor;
 3-5 geometry normal (one per vertex: watertight) and whether the local edge runs against the canonical
-``lo -> hi`` direction; 6-8 shading normal (split corner normals where the mesh has them); 9-10 corner UVs.
+``lo -> hi`` direction; 6-8 shading normal (split corner normals where the mesh has them); 9-10 corner UVs;
+11-13 corner tangent and bitangent sign (tangent-space displacement).
 Edge points are evaluated from the canonical direction of their edge,
 from data both triangles hold bit for bit, so shared edges have the same vertices.
 """
@@ -29,7 +30,7 @@ from .partition import clamp_levels
 from .refine import _face_levels, refine, single_triangle_levels
 from .topology import ragged, triangle_edges
 
-CONTROL_ROWS = 11
+CONTROL_ROWS = 14
 KIND_CORNER, KIND_EDGE, KIND_INTERIOR = 0, 1, 2
 
 
@@ -100,11 +101,11 @@ def patch_classes(triangles, n_vertices, edge_levels, inner_levels=None, spacing
     return PatchClasses(classes, counts, levels)
 
 
-def control_rows(inputs, alpha=0.75, uvs=None):
+def control_rows(inputs, alpha=0.75, uvs=None, tangents=None):
     """Control texels of every triangle, independent of the levels: (T, CONTROL_ROWS, 4) float32.
 
     inputs: a `kernels.tessellate.SurfaceInputs`; alpha: the constant shape factor where ``inputs.alpha`` is
-    None; uvs: (T, 3, 2) per corner, or None.
+    None; uvs: (T, 3, 2) per corner, or None; tangents: (T, 3, 4) per corner (xyz, bitangent sign), or None.
     """
     tris = np.asarray(inputs.mesh.triangles, np.int64)
     _, _, flipped = triangle_edges(tris)
@@ -117,6 +118,8 @@ def control_rows(inputs, alpha=0.75, uvs=None):
     if uvs is not None:
         uv = np.asarray(uvs, np.float32)
         rows[:, 9, :2], rows[:, 9, 2:], rows[:, 10, :2] = uv[:, 0], uv[:, 1], uv[:, 2]
+    if tangents is not None:
+        rows[:, 11:14] = tangents
     return rows
 
 

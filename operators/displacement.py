@@ -12,6 +12,7 @@ import bpy
 import mathutils
 import numpy as np
 
+from ..addon import displace_nodes
 from ..addon.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement_maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement_settings import MODE_ITEMS, SPACE_ITEMS
@@ -83,6 +84,9 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
     def execute(self, context):
         ob = context.active_object
         channels = 1 if self.mode == "HEIGHT" else 3
+        if self.mode == "VECTOR" and self.space == "TANGENT" and not displace_nodes.available():
+            self.report({"ERROR"}, "Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)")
+            return {"CANCELLED"}
         data = None
         try:
             if self.filepath:

@@ -207,3 +207,103 @@ def test_brush_cursor_sits_on_the_surface_with_the_brush_radius(clean_scene, bpy
     tool = addon_module("addon.brush_tool").TESSERA_TL_displacement_brush
     assert tool.bl_widget == cursor.TESSERA_GGT_brush_cursor.bl_idname
     assert all("bl_rna" in c.__dict__ for c in cursor.classes)  # registered with Blender
+
+
+def evaluated_positions(bpy, ob):
+    dg = bpy.context.evaluated_depsgraph_get()
+    me = ob.evaluated_get(dg).to_mesh()
+    co = np.empty(len(me.vertices) * 3)
+    me.vertices.foreach_get("co", co)
+    ob.evaluated_get(dg).to_mesh_clear()
+    return co.reshape(-1, 3)
+
+
+def tangent_reference(ob, values, mid, strength, ts):
+    """Numpy reference of a tangent-space map on ``ob``'s mesh: each vertex's first corner gives the UV, the
+    MikkTSpace tangent and bitangent sign (`Mesh.calc_tangents`, Blender's own entry point)."""
+    me = ob.data
+    me.calc_tangents(uvmap=me.uv_layers.active.name)
+    n_loops = len(me.loops)
+    loop_vert, tangent, sign = np.empty(n_loops, np.int64), np.empty(n_loops * 3), np.empty(n_loops)
+    me.loops.foreach_get("vertex_index", loop_vert)
+    me.loops.foreach_get("tangent", tangent)
+    me.loops.foreach_get("bitangent_sign", sign)
+    uv = np.empty(n_loops * 2)
+    me.uv_layers.active.data.foreach_get("uv", uv)
+    starts = np.empty(len(me.polygons), np.int64)
+    me.polygons.foreach_get("loop_start", starts)
+    first = np.full(len(me.vertices), n_loops)
+    np.minimum.at(first, loop_vert, np.arange(n_loops))
+    co, normals = np.empty(len(me.vertices) * 3), np.empty(len(me.vertices) * 3)
+    me.vertices.foreach_get("co", co)
+    me.vertices.foreach_get("normal", normals)
+    uv = uv.reshape(-1, 2)
+    # the group's sign (the face's UV orientation) is MikkTSpace's
+    face_sign = ts.uv_orientation(uv, starts)
+    loop_face = np.repeat(np.arange(len(starts)), np.diff(np.append(starts, n_loops)))
+    assert np.array_equal(face_sign[loop_face], sign)
+    sampled = ts.sample_linear(values, uv[first])
+    offsets = ts.tangent_offsets(sampled, normals.reshape(-1, 3), tangent.reshape(-1, 3)[first], sign[first],
+                                 mid, strength)
+    return co.reshape(-1, 3) + offsets, sign
+
+
+def set_map(image, values):
+    rgba = np.ones((*values.shape[:2], 4), np.float32)
+    rgba[..., :3] = values
+    image.pixels.foreach_set(rgba.ravel())
+    image.update()
+
+
+def test_tangent_space_maps_displace_in_the_uv_frame(clean_scene, bpy_module, addon_module):
+    """Tangent-space vector maps go through the geometry-nodes group: on a flat grid x, y, z of the map are
+    the U tangent, bitangent and normal (mirrored UVs flip x only); on a UV sphere the group equals the numpy
+    reference built on Blender's MikkTSpace (`calc_tangents`) for every vertex."""
+    bpy = bpy_module
+    ts = addon_module("kernels.tangent_space")
+    nodes = addon_module("addon.displace_nodes")
+    if not nodes.available():
+        pytest.skip("this Blender has no UV Tangent node")
+    rng = np.random.default_rng(7)
+    values = rng.uniform(-0.2, 0.2, (SIZE, SIZE, 3)).astype(np.float32)
+    ob = make_plane(bpy, mode="VECTOR")
+    settings = ob.tessera.displacement
+    settings.space = "TANGENT"
+    mod = ob.modifiers["Tessera Displacement"]
+    assert mod.type == "NODES" and mod.node_group.name == nodes.GROUP_NAME and ob.modifiers[0] == mod
+    settings.mid_level, settings.strength = 0.05, 2.0
+    set_map(settings.image, values)
+    expected, sign = tangent_reference(ob, values, 0.05, 2.0, ts)
+    assert np.all(sign == 1.0)
+    rest = np.array([v.co for v in ob.data.vertices])
+    got = evaluated_positions(bpy, ob)
+    assert np.allclose(got, expected, atol=1e-5)
+    uv = np.array([d.uv for d in ob.data.uv_layers.active.data])
+    first_uv = {}
+    for loop in ob.data.loops:
+        first_uv.setdefault(loop.vertex_index, uv[loop.index])
+    plain = (ts.sample_linear(values, np.array([first_uv[i] for i in range(len(rest))])) - 0.05) * 2.0
+    assert np.allclose(got - rest, plain, atol=1e-5)  # flat grid: (x, y, z) are X, Y, Z
+    for d in ob.data.uv_layers.active.data:  # mirror the UVs in U
+        d.uv = (1.0 - d.uv[0], d.uv[1])
+    ob.data.update()
+    expected, sign = tangent_reference(ob, values, 0.05, 2.0, ts)
+    assert np.all(sign == -1.0)
+    got = evaluated_positions(bpy, ob)
+    assert np.allclose(got, expected, atol=1e-5)
+    mirrored = (ts.sample_linear(values, np.array([(1.0 - first_uv[i][0], first_uv[i][1])
+                                                    for i in range(len(rest))])) - 0.05) * 2.0
+    assert np.allclose(got - rest, mirrored * [-1.0, 1.0, 1.0], atol=1e-5)
+    settings.space = "LOCAL"  # back to the Displace modifier, in the same place in the stack
+    assert ob.modifiers["Tessera Displacement"].type == "DISPLACE"
+
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=24, ring_count=12, radius=1.0)
+    sphere = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    assert bpy.ops.tessera.displacement_add(width=SIZE, height=SIZE, mode="VECTOR", space="TANGENT") == {"FINISHED"}
+    set_map(sphere.tessera.displacement.image, values)
+    sphere.tessera.displacement.strength = 0.5
+    expected, _ = tangent_reference(sphere, values, 0.0, 0.5, ts)
+    got = evaluated_positions(bpy, sphere)
+    assert np.allclose(got, expected, atol=2e-5)
+    assert np.abs(got - np.array([v.co for v in sphere.data.vertices])).max() > 0.05

@@ -83,3 +83,55 @@ def test_operator_compute_path_equals_cpu(gpu_renderer, addon_module, clean_scen
     assert np.array_equal(cpu.triangles, gpu.triangles)
     assert np.abs(cpu.positions - gpu.positions).max() <= 1e-5 * np.abs(cpu.positions).max()
     assert np.abs(cpu.corner_normals - gpu.corner_normals).max() <= 1e-4
+
+
+def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, addon_module, clean_scene,
+                                                                   bpy_module):
+    """A tangent-space vector map on a wavy grid: the preview (MikkTSpace corner tangents in the control data,
+    the frame built in the vertex shader) draws the surface the geometry-nodes group displaces, pixel for pixel
+    (linear method, level 1: the preview's vertices are the mesh's)."""
+    bpy = bpy_module
+    preview = addon_module("addon.patch_preview")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    bridge = addon_module("addon.bridge")
+    if not addon_module("addon.displace_nodes").available():
+        pytest.skip("this Blender has no UV Tangent node")
+    Camera = addon_module("kernels.camera").Camera
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=24, y_subdivisions=24, size=2, rotation=(0.4, 0.2, 0.0))
+    ob = bpy.context.active_object
+    for v in ob.data.vertices:
+        v.co.z = 0.3 * np.sin(2.5 * v.co.x) * np.cos(2.0 * v.co.y)
+    for poly in ob.data.polygons:
+        poly.use_smooth = True
+    ob.data.update()
+    size = 64
+    assert bpy.ops.tessera.displacement_add(width=size, height=size, mode="VECTOR", space="TANGENT") == {"FINISHED"}
+    v, u = (np.mgrid[0:size, 0:size] + 0.5) / size
+    rgba = np.ones((size, size, 4), np.float32)
+    rgba[..., 0] = 0.5 + 0.5 * np.sin(5 * u) * np.cos(4 * v)
+    rgba[..., 1] = 0.5 + 0.5 * np.cos(3 * u + 1)
+    rgba[..., 2] = 0.5 + 0.4 * np.sin(4 * v)
+    d = ob.tessera.displacement
+    d.image.pixels.foreach_set(rgba.ravel())
+    d.image.update()
+    d.mid_level, d.strength = 0.5, 0.3
+    s = ob.tessera.tessellate
+    s.method, s.level_mode, s.level, s.preview = "LINEAR", "UNIFORM", 1, True
+    cam = Camera.looking_at((3.0, -3.5, 2.5), (0.0, 0.0, 0.0), fov_deg=45, width=200, height=200, far=100)
+    entry = preview.entry_for(ob)
+    preview.update_levels(ob, entry, cam.view, cam.projection, 200, 200)
+    vp = cam.projection @ cam.view @ np.array(ob.matrix_world)
+    disp = preview.displacement_for(ob)
+    assert disp.mode == "TANGENT"
+    gpu_img = offscreen.render(lambda: entry["draw"].draw(vp, displacement=disp), size=(200, 200))
+    plain = offscreen.render(lambda: entry["draw"].draw(vp), size=(200, 200))
+    rest, _ = bridge.read_mesh(ob.data)
+    dg = bpy.context.evaluated_depsgraph_get()
+    moved, _ = bridge.read_mesh(ob.evaluated_get(dg).to_mesh())
+    ob.evaluated_get(dg).to_mesh_clear()
+    assert np.abs(moved.positions - rest.positions).max() > 0.05
+    cpu = offscreen.render_triangles(moved.positions, moved.triangles, vp, size=(200, 200),
+                                     normals=rest.corner_normals)
+    close = np.all(np.abs(cpu.astype(int) - gpu_img.astype(int)) <= 2, axis=-1)
+    assert close.mean() >= 0.995, close.mean()
+    assert np.mean(np.any(plain != gpu_img, axis=-1)) > 0.02

@@ -119,25 +119,15 @@ def test_adaptive_pn_preview_has_no_cracks(gpu_renderer, addon_module):
         assert not (inside & (img[..., 0] <= 127)).any(), int((inside & (img[..., 0] <= 127)).sum())
 
 
-def _bilinear(image, uv):
-    """Sample (h, w, 4) texels at (..., 2) UVs like GL_LINEAR with clamp-to-edge (texel centres at +0.5)."""
-    h, w = image.shape[:2]
-    x = np.clip(uv[..., 0] * w - 0.5, 0, w - 1)
-    y = np.clip(uv[..., 1] * h - 0.5, 0, h - 1)
-    x0, y0 = np.minimum(np.floor(x).astype(int), w - 2), np.minimum(np.floor(y).astype(int), h - 2)
-    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
-    top = image[y0, x0] * (1 - fx) + image[y0, x0 + 1] * fx
-    bottom = image[y0 + 1, x0] * (1 - fx) + image[y0 + 1, x0 + 1] * fx
-    return top * (1 - fy) + bottom * fy
-
-
-@pytest.mark.parametrize("mode", ["HEIGHT", "VECTOR"])
+@pytest.mark.parametrize("mode", ["HEIGHT", "VECTOR", "TANGENT"])
 def test_displacement_hook_moves_the_preview_like_the_cpu(gpu_renderer, addon_module, suzanne, mode):
     """A smooth map sampled at the UVs in the vertex shader displaces the preview as the same map applied to the
-    CPU mesh per corner ((value - mid) * strength along the shading normal, or as an object-space vector)."""
+    CPU mesh per corner ((value - mid) * strength along the shading normal, as an object-space vector, or in the
+    tangent frame of corner tangents interpolated like the UVs)."""
     import gpu
 
     tess = addon_module("kernels.tessellate")
+    ts = addon_module("kernels.tangent_space")
     preview = addon_module("gpu_shaders.patch_preview")
     offscreen = addon_module("gpu_shaders.offscreen")
     Camera = addon_module("kernels.camera").Camera
@@ -151,18 +141,25 @@ def test_displacement_hook_moves_the_preview_like_the_cpu(gpu_renderer, addon_mo
     texture = gpu.types.GPUTexture((size, size), format="RGBA32F", data=gpu.types.Buffer("FLOAT", image.size,
                                                                                            image.ravel()))
     levels = tess.uniform_levels(suzanne, 4)
+    uvs = suzanne.corner_attributes["UVMap"]
+    tangents = ts.triangle_tangents(suzanne.positions[suzanne.triangles], uvs)
+    suzanne.corner_attributes["tangent"] = tangents
     out = tess.tessellate(suzanne, levels, method="PN", backend="numpy").mesh
     inputs = tess.surface_inputs(suzanne, levels, "PN", tess.SurfaceOptions())
-    data = preview.PatchDrawData(inputs, "PN", uvs=suzanne.corner_attributes["UVMap"])
+    data = preview.PatchDrawData(inputs, "PN", uvs=uvs, tangents=tangents)
     data.set_levels(inputs.edge_levels)
     disp = preview.Displacement(texture, mode, mid_level=0.5, strength=0.3)
     corners = out.positions[out.triangles].astype(np.float64)  # (M, 3, 3), per corner: UV seams stay apart
     normals = out.corner_normals if out.corner_normals is not None else out.point_normals[out.triangles]
-    value = _bilinear(image, out.corner_attributes["UVMap"].astype(np.float64))[..., :3]
+    value = ts.sample_linear(image, out.corner_attributes["UVMap"])[..., :3]
     if mode == "HEIGHT":
         moved = corners + normals * ((value.mean(axis=-1) - 0.5) * 0.3)[..., None]
-    else:
+    elif mode == "VECTOR":
         moved = corners + (value - 0.5) * 0.3
+    else:
+        tg = out.corner_attributes["tangent"].reshape(-1, 4)
+        moved = corners + ts.tangent_offsets(value.reshape(-1, 3), normals.reshape(-1, 3), tg[:, :3],
+                                             np.where(tg[:, 3] < 0, -1.0, 1.0), 0.5, 0.3).reshape(corners.shape)
     flat = np.arange(moved.size // 3).reshape(-1, 3)
     changed = 0.0
     for cam in _cameras(Camera, np.random.default_rng(8), 3):
