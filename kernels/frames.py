@@ -169,30 +169,32 @@ def _seam_correction(lines, t, r, q):
     return per_curve[curve] * arc
 
 
-def rotation_minimizing_frames_opencl(runtime, lines, arc, total):
+def rotation_minimizing_frames_opencl(runtime, lines, arc, total, out=None):
     """The same frames from ``kernels/cl/tube_frames.cl`` (one work item per curve): t, n, b (P, 3) float32.
 
-    arc, total: from `polylines.arc_lengths`. Needs double precision on the device.
+    arc, total: from `polylines.arc_lengths`; out: three contiguous (P, 3) float32 arrays to write into, or
+    None. Needs double precision on the device. Host memory is shared with the device (``USE_HOST_PTR``: no
+    copies on a CPU device such as PoCL).
     """
     cl = runtime.cl
     mf = cl.mem_flags
     n_pts, n_curves = len(lines.points), lines.n_curves
-    out = [np.empty((n_pts, 3), np.float32) for _ in range(3)]
+    if out is None:
+        out = [np.empty((n_pts, 3), np.float32) for _ in range(3)]
     if n_pts == 0:
         return tuple(out)
     ctx = runtime.context
-
-    def buf(a):
-        return cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a))
-
-    args = [buf(lines.points.astype(np.float64)), buf(lines.offsets.astype(np.int64)),
-            buf(lines.cyclic.astype(np.uint8)), buf(lines.tilt.astype(np.float64)), buf(arc.astype(np.float64)),
-            buf(total.astype(np.float64))]
-    outs = [cl.Buffer(ctx, mf.WRITE_ONLY, o.nbytes) for o in out]
+    inputs = [np.ascontiguousarray(a, dtype) for a, dtype in (
+        (lines.points, np.float64), (lines.offsets, np.int64), (lines.cyclic, np.uint8), (lines.tilt, np.float64),
+        (arc, np.float64), (total, np.float64))]
+    args = [cl.Buffer(ctx, mf.READ_ONLY | mf.USE_HOST_PTR, hostbuf=a) for a in inputs]
+    outs = [cl.Buffer(ctx, mf.WRITE_ONLY | mf.USE_HOST_PTR, hostbuf=o) for o in out]
     kernel = runtime.kernel("tube_frames", "tube_frames")
     kernel(runtime.queue, (n_curves,), None, *args, *outs, np.int32(n_curves))
     for host, dev in zip(out, outs, strict=True):
-        cl.enqueue_copy(runtime.queue, host, dev)
+        mapped, _ = cl.enqueue_map_buffer(runtime.queue, dev, cl.map_flags.READ, 0, host.shape, host.dtype)
+        mapped.base.release(runtime.queue)
+    runtime.queue.finish()
     return tuple(out)
 
 

@@ -104,10 +104,8 @@ def drop_duplicates(lines):
     if len(pts) == 0:
         return lines
     extent = float(np.max(np.abs(pts))) + 1.0
-    nxt = next_index(lines)
-    has_next = nxt >= 0
-    seg = np.zeros(len(pts))
-    seg[has_next] = np.linalg.norm(pts[nxt[has_next]] - pts[has_next], axis=1)
+    has_next = next_index(lines) >= 0
+    seg = segment_lengths(lines)
     # a point is dropped when the segment leaving it has zero length; on an open curve the last point stays
     # and its predecessor goes instead
     dup = has_next & (seg <= DUPLICATE_REL * extent)
@@ -124,10 +122,17 @@ def drop_duplicates(lines):
 
 def segment_lengths(lines):
     """Length of the segment leaving each point (0 at open ends): (P,) float64."""
-    nxt = next_index(lines)
-    seg = np.zeros(len(lines.points))
-    ok = nxt >= 0
-    seg[ok] = np.linalg.norm(lines.points[nxt[ok]] - lines.points[ok], axis=1)
+    pts = np.asarray(lines.points, np.float64)
+    seg = np.zeros(len(pts))
+    if len(pts) < 2:
+        return seg
+    d = pts[1:] - pts[:-1]  # contiguous differences; the ends of curves are fixed below
+    np.sqrt(np.einsum("ij,ij->i", d, d), out=seg[:-1])
+    nonempty = lines.counts > 0
+    ends = lines.offsets[1:][nonempty] - 1
+    starts = lines.offsets[:-1][nonempty]
+    closing = pts[starts] - pts[ends]
+    seg[ends] = np.where(lines.cyclic[nonempty], np.sqrt(np.einsum("ij,ij->i", closing, closing)), 0.0)
     return seg
 
 

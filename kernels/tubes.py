@@ -208,10 +208,9 @@ def _frames(lines, settings, camera, runtime=None):
         arc, total = arc_lengths(sub)
         out["arc"][p0:p1], out["total"][c0:c1] = arc, total
         if runtime is not None:
-            t, nrm, bin_ = rotation_minimizing_frames_opencl(runtime, sub, arc, total)
+            rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out[k][p0:p1] for k in ("t", "n", "b")])
         else:
-            t, nrm, bin_ = rotation_minimizing_frames(sub)
-        out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = t, nrm, bin_
+            out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = rotation_minimizing_frames(sub)
     return out
 
 
@@ -309,7 +308,7 @@ def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=N
     unit = _unit_topology(lines, curves)
     u_ends = _segment_u(frames, curves, unit) if settings.uvs else None
     if device is not None:
-        device.write_body(lines, frames, n, curves, unit, cursor, u_ends)
+        device.write_body(lines, frames, n, curves, unit, cursor, u_ends, np.stack(_ring(n), axis=1))
     else:
         _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends)
     if settings.caps != "NONE":

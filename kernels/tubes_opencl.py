@@ -51,8 +51,9 @@ class TubeDevice:
             a = np.zeros(1, dtype)
         return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=a)
 
-    def write_body(self, lines, frames, n, curves, unit, cursor, u_ends):
-        """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None."""
+    def write_body(self, lines, frames, n, curves, unit, cursor, u_ends, ring):
+        """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None;
+        ring: (n, 2) float32 cos, sin of the side angles."""
         pick, n_pts = unit["pick"], unit["n_pts"]
         seg_of = np.full(n_pts, -1, np.int32)
         seg_of[unit["seg"]] = np.arange(len(unit["seg"]), dtype=np.int32)
@@ -69,7 +70,7 @@ class TubeDevice:
                self._in(lines.points[pick], np.float32), self._in(frames["n"][pick], np.float32),
                self._in(frames["b"][pick], np.float32), self._in(frames["radius"][pick], np.float32),
                self._in(seg_of, np.int32), self._in(nxt, np.int32), self._in(u0, np.float32),
-               self._in(u1, np.float32), self._in(material, np.int32),
+               self._in(u1, np.float32), self._in(material, np.int32), self._in(ring, np.float32),
                np.int32(n), np.int32(n_pts), np.int32(len(unit["seg"])), np.int64(cursor["v"]), np.int64(cursor["e"]),
                np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(u_ends is not None),
                b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
