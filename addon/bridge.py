@@ -217,12 +217,11 @@ def write_polygons(name, poly):
     starts = poly.face_offsets[:-1]  # a cumulative sum: computed once
     mesh = bpy.data.meshes.new(name)
     try:
-        _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts.astype(np.int32))
+        _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts)
         if poly.edges is not None:
             mesh.edges.add(len(poly.edges))
             mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(poly.edges).ravel())
             mesh.attributes[".corner_edge"].data.foreach_set("value", poly.corner_edges)
-            mesh.update()
         else:
             mesh.update(calc_edges=True)
         if poly.corner_normals is not None:

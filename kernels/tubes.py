@@ -85,7 +85,11 @@ class PolygonMesh:
 
     @property
     def face_offsets(self):
-        return np.concatenate(([0], np.cumsum(self.face_sizes, dtype=np.int64)))
+        """First corner of every face and the corner count: (F + 1,) int32 (corner ids fit, as corner_verts)."""
+        out = np.empty(len(self.face_sizes) + 1, np.int32)
+        out[0] = 0
+        np.cumsum(self.face_sizes, dtype=np.int32, out=out[1:])
+        return out
 
 
 def pixel_world_size(points, camera):
