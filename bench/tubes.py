@@ -7,6 +7,8 @@ Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M ve
   its own minimum-twist normals, multithreaded). Ratio > 1: Tessera is faster.
 - ``operator``: ``tessera.tubes`` end to end (read the hair, build, write a new mesh object) against the
   same modifier evaluation plus copying its mesh into a new object (what applying the modifier costs).
+- ``mesh_write``: the operator's share that is Blender's Python mesh API: `bridge.write_polygons` of the
+  kernel's output (element allocation, face offsets, bulk attribute writes), against the same baseline.
 - ``preview_bytes``: what the GPU preview uploads (section texture: 48 B per section; patch tables: 16 B per
   patch of up to 63 segments) against uploading the tube mesh for drawing (position + normal per vertex,
   two triangles of 32-bit indices per quad): the seed's Table 4.2 argument.
@@ -118,6 +120,23 @@ def operator_case(bpy, ob):
     return best_of(run, REPEAT)
 
 
+def write_case(bpy, pts):
+    from tessera.addon.bridge import write_polygons
+    from tessera.kernels.polylines import Polylines
+    from tessera.kernels.tubes import TubeSettings, build_tubes
+
+    lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
+    poly = build_tubes(lines, TubeSettings(sides=SIDES, caps="NONE", uvs=False))
+
+    def run():
+        mesh = write_polygons("bench_write", poly)
+        n = len(mesh.vertices)
+        bpy.data.meshes.remove(mesh)
+        return n
+
+    return best_of(run, REPEAT)
+
+
 def preview_case(pts):
     from tessera.gpu_shaders.tube_preview import patch_table, section_order
     from tessera.kernels.polylines import Polylines
@@ -181,6 +200,10 @@ def main():
                       "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object",
                       "seconds": round(op, 3),
                       "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / op, 2)}))
+    write, _ = write_case(bpy, pts)
+    print(json.dumps({"case": "mesh_write", "seconds": round(write, 3), "share_of_operator": round(write / op, 2),
+                      "baseline": "Curve to Mesh evaluation + copy of its mesh into a new object",
+                      "baseline_seconds": round(gn_copy, 3), "speed_ratio": round(gn_copy / write, 2)}))
     print(json.dumps(preview_case(pts)))
     print(json.dumps(memory_case()))
 

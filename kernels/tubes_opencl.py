@@ -36,7 +36,7 @@ class TubeDevice:
         self.runtime, self.mesh = runtime, mesh
         cl = runtime.cl
         flags = cl.mem_flags.READ_WRITE | cl.mem_flags.USE_HOST_PTR
-        self.buffers = {}
+        self.buffers, self._inputs = {}, []
         for name in self.OUTPUTS:
             host = getattr(mesh, name)
             if host is None or host.size == 0:
@@ -45,11 +45,13 @@ class TubeDevice:
             self.buffers[name] = cl.Buffer(runtime.context, flags, hostbuf=host)
 
     def _in(self, array, dtype):
+        """An input buffer sharing host memory; the array is kept alive until `finish`."""
         cl = self.runtime.cl
         a = np.ascontiguousarray(array, dtype=dtype)
         if a.size == 0:
             a = np.zeros(1, dtype)
-        return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=a)
+        self._inputs.append(a)
+        return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.USE_HOST_PTR, hostbuf=a)
 
     def write_body(self, lines, frames, n, curves, unit, cursor, u_ends, ring):
         """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None;
@@ -87,3 +89,4 @@ class TubeDevice:
             mapped, _ = cl.enqueue_map_buffer(queue, buf, cl.map_flags.READ, 0, host.shape, host.dtype)
             mapped.base.release(queue)
         queue.finish()
+        self._inputs.clear()
