@@ -151,12 +151,20 @@ def _add_geometry(mesh, positions, corner_verts, loop_starts):
     mesh.polygons.foreach_set("loop_start", loop_starts)
 
 
-def write_mesh(name, arrays, info=None):
+def _add_edges(mesh, edges, corner_edges):
+    """Add edges (K, 2) and the edge of every corner (L,) or (T, 3), int32, as they are."""
+    mesh.edges.add(len(edges))
+    mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(edges, np.int32).ravel())
+    mesh.attributes[".corner_edge"].data.foreach_set("value", np.ascontiguousarray(corner_edges, np.int32).ravel())
+
+
+def write_mesh(name, arrays, info=None, edges=None):
     """Create a new `bpy.types.Mesh` from triangle `MeshArrays` and return it.
 
     Writes positions, triangles, point / corner / face attributes with the data types recorded in
-    ``arrays.attribute_types``, and corner (or else point) normals as custom normals. If anything fails the
-    half-built mesh is removed before the error propagates.
+    ``arrays.attribute_types``, and corner (or else point) normals as custom normals. edges: ``(edges (K, 2),
+    corner_edges (T, 3))`` int32 when known (`Refinement.output_edges`): written as they are, so Blender does
+    not compute them; else None. If anything fails the half-built mesh is removed before the error propagates.
     """
     positions = np.ascontiguousarray(arrays.positions, dtype=np.float32)
     tris = np.ascontiguousarray(arrays.triangles, dtype=np.int32)
@@ -164,7 +172,10 @@ def write_mesh(name, arrays, info=None):
     mesh = bpy.data.meshes.new(name)
     try:
         _add_geometry(mesh, positions, tris.ravel(), np.arange(0, 3 * n_tris, 3, dtype=np.int32))
-        mesh.update(calc_edges=True)
+        if edges is not None:
+            _add_edges(mesh, *edges)
+        else:
+            mesh.update(calc_edges=True)
 
         domains = (
             ("POINT", arrays.point_attributes),
@@ -219,9 +230,7 @@ def write_polygons(name, poly):
     try:
         _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts)
         if poly.edges is not None:
-            mesh.edges.add(len(poly.edges))
-            mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(poly.edges).ravel())
-            mesh.attributes[".corner_edge"].data.foreach_set("value", poly.corner_edges)
+            _add_edges(mesh, poly.edges, poly.corner_edges)
         else:
             mesh.update(calc_edges=True)
         if poly.corner_normals is not None:

@@ -97,6 +97,11 @@ class Refinement:
     def corner_bary(self):
         return self._get("corner_bary")
 
+    def output_edges(self):
+        """``(edges (K, 2) int32, corner_edges (M, 3) int32)`` of the output mesh (the edge from corner k to
+        corner k + 1 of every output triangle) when built per pattern class, else None (writers compute them)."""
+        return self._get("output_edges") if "output_edges" in self.lazy else None
+
     @property
     def n_vertices(self):
         return self.n_corners + len(self.edge_point_edge) + int(self.interior_counts.sum())

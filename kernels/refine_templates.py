@@ -64,6 +64,86 @@ def _lone_pattern(outer_f, outer_n, inner_f, inner_n, spacing):
     return ref, slot_edge, slot_j
 
 
+def _template_edges(pat, outer_n, slot_edge, slot_j):
+    """The edges of a class pattern in "edge slot" space.
+
+    Columns of a face's edge slots: the segments of local edges 0, 1, 2 (``n_e`` each, counted from the local
+    edge's first corner), then the pattern's interior edges. Returns ``(corner_cols (Mt, 3) column of the edge
+    leaving each corner of each pattern triangle, interior_pairs (Ei, 2) vertex slots of each interior edge)``.
+    """
+    n = np.asarray(outer_n, np.int64)
+    n_slots = 3 + len(slot_edge) + len(pat.interior_bary)
+    # position of every vertex slot along each local edge (-1: not on it); local edge e runs corner e -> e + 1
+    pos = np.full((n_slots, 3), -1, np.int64)
+    for c in range(3):
+        pos[c, c] = 0
+        pos[c, (c + 2) % 3] = n[(c + 2) % 3]
+    pos[3 + np.arange(len(slot_edge)), slot_edge] = slot_j
+    a = pat.triangles.astype(np.int64)
+    b = np.roll(a, -1, axis=1)
+    both = (pos[a] >= 0) & (pos[b] >= 0)  # (Mt, 3, 3): both ends on local edge e
+    on_boundary = both.any(axis=2)
+    e = both.argmax(axis=2)
+    pa = np.take_along_axis(pos[a], e[..., None], axis=2)[..., 0]
+    pb = np.take_along_axis(pos[b], e[..., None], axis=2)[..., 0]
+    if np.any(on_boundary & (np.abs(pa - pb) != 1)):
+        raise AssertionError("a pattern edge on a triangle side skips a point")
+    cols = np.empty(a.shape, np.int64)
+    offsets = np.concatenate(([0], np.cumsum(n)))
+    cols[on_boundary] = offsets[e[on_boundary]] + np.minimum(pa, pb)[on_boundary]
+    lo, hi = np.minimum(a, b)[~on_boundary], np.maximum(a, b)[~on_boundary]
+    pairs, local = np.unique(lo * n_slots + hi, return_inverse=True)
+    cols[~on_boundary] = offsets[3] + local.reshape(-1)
+    return cols, np.column_stack((pairs // n_slots, pairs % n_slots))
+
+
+def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, tables, triangles, tri_start):
+    """Edges of the refined mesh and the edge leaving each output corner, from the class patterns.
+
+    tables: per class ``(faces, vertex table (F, slots), corner_cols, interior_pairs)``. Returns ``(edges (K, 2)
+    int32, corner_edges (M, 3) int32)``: the segments of every input edge (in edge order, canonical direction)
+    then each face's interior edges.
+    """
+    seg_e, seg_k, seg_start = ragged(edge_n)
+    n_seg = len(seg_e)
+    ends = edges.astype(np.int64)
+
+    def vertex_at(e, q):  # vertex at canonical position q along input edge e
+        inner = n_vertices + point_start[e] + q - 1
+        return np.where(q == 0, ends[e, 0], np.where(q == edge_n[e], ends[e, 1], inner))
+
+    face_interior = np.zeros(len(tris), np.int64)
+    for faces, _, _, pairs in tables:
+        face_interior[faces] = len(pairs)
+    interior_start = n_seg + np.cumsum(face_interior) - face_interior
+    out_edges = np.empty((n_seg + int(face_interior.sum()), 2), np.int32)
+    out_edges[:n_seg, 0], out_edges[:n_seg, 1] = vertex_at(seg_e, seg_k), vertex_at(seg_e, seg_k + 1)
+    corner_edges = np.empty(triangles.shape, np.int32)
+    outer_n = edge_n[face_edges]
+    for faces, table, cols, pairs in tables:
+        n = outer_n[faces[0]]
+        slot_cols = np.empty((len(faces), int(n.sum()) + len(pairs)), np.int32)
+        start = 0
+        for e in range(3):
+            q = np.arange(int(n[e]))
+            fe = face_edges[faces, e][:, None]
+            canonical = np.where(flipped[faces, e][:, None], n[e] - 1 - q, q)
+            slot_cols[:, start:start + n[e]] = seg_start[fe] + canonical
+            start += int(n[e])
+        ids = interior_start[faces][:, None] + np.arange(len(pairs))
+        slot_cols[:, start:] = ids
+        if len(pairs):
+            out_edges[ids.ravel()] = table[:, pairs].reshape(-1, 2)
+        mt = len(cols)
+        if faces[-1] - faces[0] + 1 == len(faces):  # consecutive faces: one block of output triangles
+            lo = int(tri_start[faces[0]])
+            block = corner_edges[lo:lo + len(faces) * mt].reshape(len(faces), mt, 3)
+            np.take(slot_cols, cols, axis=1, out=block)
+        else:
+            corner_edges[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = slot_cols[:, cols].reshape(-1, 3)
+    return out_edges, corner_edges
+
+
 def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing):
     """Same contract as `kernels.refine.refine`, built per pattern class. Returns a `Refinement`."""
     edge_f, edge_n, inner_f, inner_n = levels
@@ -79,11 +159,13 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     tri_counts = outer_n.sum(axis=1) + 2 * interior_counts - 2
     tri_start = np.cumsum(tri_counts) - tri_counts
     triangles = np.empty((int(tri_counts.sum()), 3), np.int32)
+    tables = []
 
-    patterns, groups = [], group_by_class(inverse, len(first))
+    patterns, groups, slots = [], group_by_class(inverse, len(first)), []
     for f0, faces in zip(first, groups, strict=True):
         pat, slot_edge, slot_j = _lone_pattern(outer_f[f0], outer_n[f0], inner_f[f0], inner_n[f0], spacing)
         patterns.append(pat)
+        slots.append((slot_edge, slot_j))
         n_edge_slots = len(slot_edge)
         table = np.empty((len(faces), 3 + n_edge_slots + int(interior_counts[f0])), np.int64)
         table[:, :3] = tris[faces]
@@ -94,6 +176,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
             table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
         table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(
             int(interior_counts[f0]))
+        tables.append(table)
         stamped = table[:, pat.triangles]  # (F, Mt, 3)
         mt = len(pat.triangles)
         if faces[-1] - faces[0] + 1 == len(faces):
@@ -118,6 +201,12 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
             out[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = np.tile(pat.corner_bary, (len(faces), 1, 1))
         return out
 
+    def output_edges():
+        per_class = [(faces, table, *_template_edges(pat, outer_n[faces[0]], *slot))
+                     for faces, table, pat, slot in zip(groups, tables, patterns, slots, strict=True)]
+        return _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, per_class,
+                             triangles, tri_start)
+
     n_faces = len(tris)
     return core.Refinement(
         n_corners=int(n_vertices), faces=tris, edges=edges,
@@ -126,7 +215,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
         spacing=spacing, edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
         interior_counts=interior_counts,
         lazy={"interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
-              "interior_bary": interior_bary, "corner_bary": corner_bary},
+              "interior_bary": interior_bary, "corner_bary": corner_bary, "output_edges": output_edges},
         face_class=inverse, class_interior_bary=tuple(p.interior_bary for p in patterns),
         class_corner_bary=tuple(p.corner_bary for p in patterns),
     )

@@ -111,7 +111,8 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             options=surface_options(self), progress=lambda f: progress(0.1 + 0.7 * f),
             surface=self._gpu_surface(notes),
         )
-        mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result.mesh, info)
+        mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result.mesh, info,
+                                 edges=result.refinement.output_edges())
         for material in ob.data.materials:
             mesh.materials.append(material)
         progress(1.0)

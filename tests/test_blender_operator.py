@@ -118,3 +118,32 @@ def test_exported_obj_has_the_tessellated_faces(clean_scene, bpy_module, tmp_pat
     assert bpy.ops.wm.obj_export(filepath=str(path), export_selected_objects=True) == {"FINISHED"}
     faces = sum(1 for line in path.read_text().splitlines() if line.startswith("f "))
     assert faces == n
+
+
+@pytest.mark.parametrize("level", [1, 5])
+def test_written_edges_are_the_ones_blender_computes(clean_scene, bpy_module, level):
+    """The operator hands Blender the refinement's own edges (no edge computation): the mesh validates clean
+    and its edges and corner edges are those Blender derives from the faces alone."""
+    bpy = bpy_module
+    add_suzanne(bpy)
+    assert bpy.ops.tessera.tessellate(method="PN", level=level) == {"FINISHED"}
+    me = bpy.context.active_object.data
+    assert not me.validate(verbose=False)  # nothing to correct
+
+    def edge_data(mesh):
+        ev = np.empty(2 * len(mesh.edges), np.int32)
+        mesh.attributes[".edge_verts"].data.foreach_get("value", ev)
+        ce = np.empty(len(mesh.loops), np.int32)
+        mesh.attributes[".corner_edge"].data.foreach_get("value", ce)
+        ev = np.sort(ev.reshape(-1, 2), axis=1)
+        return {tuple(e) for e in ev}, [tuple(ev[i]) for i in ce]
+
+    ours = edge_data(me)
+    rebuilt = me.copy()
+    rebuilt.edges.foreach_set("vertices", np.zeros(2 * len(rebuilt.edges), np.int32))  # forget them
+    rebuilt.update(calc_edges=True)
+    rebuilt.validate(verbose=False)
+    theirs = edge_data(rebuilt)
+    bpy.data.meshes.remove(rebuilt)
+    assert ours[0] == theirs[0] and ours[1] == theirs[1]
+    assert len(ours[0]) == len(me.edges)

@@ -141,3 +141,35 @@ def test_class_path_equals_general_path(spacing, levels, monkeypatch):
         assert np.array_equal(getattr(by_class, name), getattr(general, name)), name
     np.testing.assert_allclose(by_class.interior_bary, general.interior_bary, rtol=0, atol=1e-15)
     np.testing.assert_allclose(by_class.corner_bary, general.corner_bary, rtol=0, atol=1e-15)
+
+
+def _check_output_edges(ref):
+    out_edges, corner_edges = ref.output_edges()
+    tris = ref.triangles.astype(np.int64)
+    nxt = np.roll(tris, -1, axis=1)
+    got = np.sort(out_edges[corner_edges].astype(np.int64), axis=-1)  # (M, 3, 2)
+    assert np.array_equal(got, np.sort(np.stack((tris, nxt), axis=-1), axis=-1))  # every corner's edge
+    keys = np.sort(out_edges.astype(np.int64), axis=1) @ np.array([ref.n_vertices, 1])
+    half = np.sort(np.stack((tris, nxt), axis=-1), axis=-1).reshape(-1, 2) @ np.array([ref.n_vertices, 1])
+    assert len(np.unique(keys)) == len(keys) == len(np.unique(half))  # each edge once, none missing
+    assert np.array_equal(np.bincount(corner_edges.ravel(), minlength=len(out_edges)) > 0,
+                          np.ones(len(out_edges), bool))
+
+
+@pytest.mark.parametrize("spacing", SPACINGS)
+@pytest.mark.parametrize("levels", ["uniform", "pow2", "random"])
+def test_output_edges_from_the_patterns(spacing, levels, monkeypatch):
+    """The class path names the output mesh's edges (so writers skip edge computation): every triangle
+    corner's edge joins that corner and the next, each edge is listed once, none is missing; closed and open
+    meshes."""
+    from tessera.kernels import refine_templates
+
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: True)
+    rng = np.random.default_rng(5)
+    for v, f in (random_closed(3, 6, 5), grid(4)):
+        edges, _, _ = triangle_edges(f)
+        lv = {"uniform": np.full(len(edges), 6.0), "pow2": 2.0 ** rng.integers(0, 4, len(edges)),
+              "random": rng.uniform(1, 9, len(edges))}[levels]
+        _check_output_edges(refine(f, len(v), lv, spacing=spacing))
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
+    assert refine(f, len(v), lv, spacing=spacing).output_edges() is None
