@@ -121,13 +121,13 @@ def _corner_values_by_class(ref, values):
             continue
         weights = template.reshape(-1, 3)  # (Mt * 3, 3)
         k = len(weights)
-        vals = (weights @ flat[faces].transpose(1, 0, 2).reshape(3, -1)).reshape(k, len(faces), channels)
+        vals = np.matmul(weights, flat[faces])  # (F, k, channels), face by face: contiguous writes
         rows = (3 * starts[faces][:, None] + np.arange(k)).ravel()
         if faces[-1] - faces[0] + 1 == len(faces):
             lo = int(rows[0])
-            out[lo : lo + len(rows)].reshape(len(faces), k, channels)[...] = vals.transpose(1, 0, 2)
+            out[lo : lo + len(rows)].reshape(len(faces), k, channels)[...] = vals
         else:
-            out[rows] = vals.transpose(1, 0, 2).reshape(-1, channels)
+            out[rows] = vals.reshape(-1, channels)
     return out.reshape((len(ref.triangles), 3) + values.shape[2:])
 
 
