@@ -5,6 +5,7 @@ and typed ``foreach_get``; writing allocates elements once and fills attributes 
 ``foreach_set`` (``from_pydata`` is about 10x slower). Arrays are float32 / int32, contiguous.
 """
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import bpy
@@ -151,8 +152,24 @@ def _add_geometry(mesh, positions, corner_verts, loop_starts):
     mesh.polygons.foreach_set("loop_start", loop_starts)
 
 
-def _add_edges(mesh, edges, corner_edges):
-    """Add edges (K, 2) and the edge of every corner (L,) or (T, 3), int32, as they are."""
+@contextmanager
+def _new_mesh(name):
+    """A new `bpy.types.Mesh`, removed again if the block raises (nothing half-built is left behind)."""
+    mesh = bpy.data.meshes.new(name)
+    try:
+        yield mesh
+    except Exception:
+        bpy.data.meshes.remove(mesh)
+        raise
+
+
+def _set_edges(mesh, edges):
+    """Edges from ``(edges (K, 2), corner_edges (L,) or (T, 3))`` int32, written as they are; or, for None,
+    computed by Blender from the faces."""
+    if edges is None:
+        mesh.update(calc_edges=True)
+        return
+    edges, corner_edges = edges
     mesh.edges.add(len(edges))
     mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(edges, np.int32).ravel())
     mesh.attributes[".corner_edge"].data.foreach_set("value", np.ascontiguousarray(corner_edges, np.int32).ravel())
@@ -169,13 +186,9 @@ def write_mesh(name, arrays, info=None, edges=None):
     positions = np.ascontiguousarray(arrays.positions, dtype=np.float32)
     tris = np.ascontiguousarray(arrays.triangles, dtype=np.int32)
     n_tris = len(tris)
-    mesh = bpy.data.meshes.new(name)
-    try:
+    with _new_mesh(name) as mesh:
         _add_geometry(mesh, positions, tris.ravel(), np.arange(0, 3 * n_tris, 3, dtype=np.int32))
-        if edges is not None:
-            _add_edges(mesh, *edges)
-        else:
-            mesh.update(calc_edges=True)
+        _set_edges(mesh, edges)
 
         domains = (
             ("POINT", arrays.point_attributes),
@@ -195,9 +208,6 @@ def write_mesh(name, arrays, info=None, edges=None):
         if info is not None:
             _restore_active(mesh, info)
         mesh.update()
-    except Exception:
-        bpy.data.meshes.remove(mesh)
-        raise
     return mesh
 
 
@@ -226,13 +236,9 @@ def write_polygons(name, poly):
     """
     n_f = len(poly.face_sizes)
     starts = poly.face_offsets[:-1]  # a cumulative sum: computed once
-    mesh = bpy.data.meshes.new(name)
-    try:
+    with _new_mesh(name) as mesh:
         _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts)
-        if poly.edges is not None:
-            _add_edges(mesh, poly.edges, poly.corner_edges)
-        else:
-            mesh.update(calc_edges=True)
+        _set_edges(mesh, None if poly.edges is None else (poly.edges, poly.corner_edges))
         if poly.corner_normals is not None:
             corner_face = np.repeat(np.arange(n_f), poly.face_sizes)
             first = poly.corner_normals[starts]
@@ -246,9 +252,6 @@ def write_polygons(name, poly):
             mat = _new_attribute(mesh, "material_index", "INT", "FACE")
             mat.data.foreach_set("value", np.ascontiguousarray(poly.face_material))
         mesh.update()
-    except Exception:
-        bpy.data.meshes.remove(mesh)
-        raise
     return mesh
 
 

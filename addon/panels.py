@@ -11,21 +11,22 @@ from .tube_sources import SOURCE_TYPES
 
 
 class _Sidebar:
-    """Where Tessera's panels live: View3D > Sidebar > Tessera."""
+    """Where Tessera's panels live: View3D > Sidebar > Tessera. Shown for active objects of ``object_types``."""
 
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = "Tessera"
+    object_types = frozenset({"MESH"})
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.type in cls.object_types
 
 
 class TESSERA_PT_tessellate(_Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_tessellate"
     bl_label = "Tessellate"
-
-    @classmethod
-    def poll(cls, context):
-        ob = context.active_object
-        return ob is not None and ob.type == "MESH"
 
     def draw(self, context):
         settings = context.active_object.tessera.tessellate
@@ -40,11 +41,7 @@ class TESSERA_PT_tessellate(_Sidebar, bpy.types.Panel):
 class TESSERA_PT_tubes(_Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_tubes"
     bl_label = "Tubes"
-
-    @classmethod
-    def poll(cls, context):
-        ob = context.active_object
-        return ob is not None and ob.type in SOURCE_TYPES
+    object_types = frozenset(SOURCE_TYPES)
 
     def draw_header(self, context):
         self.layout.prop(context.active_object.tessera.tubes, "preview", text="")
@@ -61,11 +58,6 @@ class TESSERA_PT_tubes(_Sidebar, bpy.types.Panel):
 class TESSERA_PT_displacement(_Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_displacement"
     bl_label = "Displacement Map"
-
-    @classmethod
-    def poll(cls, context):
-        ob = context.active_object
-        return ob is not None and ob.type == "MESH"
 
     def draw(self, context):
         layout = self.layout

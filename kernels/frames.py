@@ -176,25 +176,19 @@ def rotation_minimizing_frames_opencl(runtime, lines, arc, total, out=None):
     None. Needs double precision on the device. Host memory is shared with the device (``USE_HOST_PTR``: no
     copies on a CPU device such as PoCL).
     """
-    cl = runtime.cl
-    mf = cl.mem_flags
     n_pts, n_curves = len(lines.points), lines.n_curves
     if out is None:
         out = [np.empty((n_pts, 3), np.float32) for _ in range(3)]
     if n_pts == 0:
         return tuple(out)
-    ctx = runtime.context
     inputs = [np.ascontiguousarray(a, dtype) for a, dtype in (
         (lines.points, np.float64), (lines.offsets, np.int64), (lines.cyclic, np.uint8), (lines.tilt, np.float64),
         (arc, np.float64), (total, np.float64))]
-    args = [cl.Buffer(ctx, mf.READ_ONLY | mf.USE_HOST_PTR, hostbuf=a) for a in inputs]
-    outs = [cl.Buffer(ctx, mf.WRITE_ONLY | mf.USE_HOST_PTR, hostbuf=o) for o in out]
+    outs = [runtime.shared(o) for o in out]
     kernel = runtime.kernel("tube_frames", "tube_frames")
-    kernel(runtime.queue, (n_curves,), None, *args, *outs, np.int32(n_curves))
-    for host, dev in zip(out, outs, strict=True):
-        mapped, _ = cl.enqueue_map_buffer(runtime.queue, dev, cl.map_flags.READ, 0, host.shape, host.dtype)
-        mapped.base.release(runtime.queue)
-    runtime.queue.finish()
+    kernel(runtime.queue, (n_curves,), None, *(runtime.shared(a, read_only=True) for a in inputs), *outs,
+           np.int32(n_curves))
+    runtime.sync_to_host(zip(outs, out, strict=True))
     return tuple(out)
 
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InvalidInputError, TesseraError
-from .map_io import oiio_module
+from .map_io import read_pixels
 
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
 RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
@@ -145,25 +145,14 @@ def read_raw(path, width, height, dtype=None, texel_size=1.0, scale=1.0, offset=
 
 def read_image(path, texel_size=1.0, scale=1.0, offset=0.0):
     """Read a PNG/TIFF/EXR height map with OpenImageIO, keeping its precision (channel 0 is the height)."""
-    if not os.path.isfile(path):
-        raise TesseraError(f"No such height map file: {path}")
-    oiio = oiio_module()
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        raise TesseraError(f"Cannot read {path}: {oiio.geterror()}")
-    try:
-        spec = inp.spec()
-        fmt = str(spec.format)
+    def pixel_type(fmt):
         kind = {"uint8": "uint8", "uint16": "uint16", "float": "float", "half": "float", "double": "float"}.get(fmt)
         if kind is None:
             raise InvalidInputError(f"{path} stores {fmt} samples; use 8/16-bit integer or float height maps")
-        data = inp.read_image(0, 0, 0, 1, kind)
-    finally:
-        inp.close()
-    if data is None:
-        raise TesseraError(f"Reading {path} failed: {oiio.geterror()}")
-    data = np.asarray(data).reshape(spec.height, spec.width)[::-1]
-    return from_array(np.ascontiguousarray(data), texel_size, scale, offset, path)
+        return kind
+
+    data, _ = read_pixels(path, "height map", pixel_type, n_channels=1)
+    return from_array(np.ascontiguousarray(data[..., 0]), texel_size, scale, offset, path)
 
 
 def read_heightmap(path, texel_size=1.0, scale=1.0, offset=0.0, raw_size=None, raw_dtype=None, raw_bottom_up=False):

@@ -16,6 +16,9 @@ FLOAT_EXTENSIONS = (".exr",)
 INT16_EXTENSIONS = (".png", ".tif", ".tiff")
 
 
+_FLOAT_FORMATS = ("float", "half", "double")
+
+
 def oiio_module():
     """The OpenImageIO module, or a `TesseraError` saying it is missing (a broken install)."""
     try:
@@ -23,6 +26,31 @@ def oiio_module():
     except ImportError as err:  # a dependency of the package; only a broken install lacks it
         raise TesseraError(f"OpenImageIO is not available ({err})") from err
     return oiio
+
+
+def read_pixels(path, what, pixel_type, n_channels=None):
+    """Pixels of an image file through OpenImageIO: ``(data (H, W, C) with row 0 at the bottom, the file's
+    sample format name)``.
+
+    what: the kind of file, for messages; pixel_type(format) -> the type to read as ("float", "uint16",
+    "uint8"), raising for formats the caller refuses; n_channels: read only the first ones (None: all).
+    """
+    if not os.path.isfile(path):
+        raise TesseraError(f"No such {what} file: {path}")
+    oiio = oiio_module()
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise TesseraError(f"Cannot read {path}: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        fmt = str(spec.format)
+        n = n_channels or spec.nchannels
+        data = inp.read_image(0, 0, 0, n, pixel_type(fmt))
+    finally:
+        inp.close()
+    if data is None:
+        raise TesseraError(f"Reading {path} failed: {oiio.geterror()}")
+    return np.asarray(data).reshape(spec.height, spec.width, n)[::-1], fmt
 
 
 def write_map(path, dmap, low=0.0, high=1.0):
@@ -61,29 +89,12 @@ def read_map(path, channels=None, low=0.0, high=1.0):
     ``channels`` (1, 3 or 4) selects/pads channels: a grey file read as 3 channels repeats its value; extra
     channels are dropped. Raises `TesseraError` for unreadable files and `InvalidInputError` for NaN.
     """
-    oiio = oiio_module()
-    if not os.path.isfile(path):
-        raise TesseraError(f"No such map file: {path}")
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        raise TesseraError(f"Cannot read {path}: {oiio.geterror()}")
-    try:
-        spec = inp.spec()
-        fmt = str(spec.format)
-        if fmt in ("float", "half", "double"):
-            data = inp.read_image(0, 0, 0, spec.nchannels, "float")
-            scale = None
-        else:
-            data = inp.read_image(0, 0, 0, spec.nchannels, "uint16" if fmt != "uint8" else "uint8")
-            scale = 65535.0 if fmt != "uint8" else 255.0
-    finally:
-        inp.close()
-    if data is None:
-        raise TesseraError(f"Reading {path} failed: {oiio.geterror()}")
-    data = np.asarray(data).reshape(spec.height, spec.width, spec.nchannels)
-    if scale is not None:
+    data, fmt = read_pixels(path, "map", lambda f: "float" if f in _FLOAT_FORMATS else
+                            "uint8" if f == "uint8" else "uint16")
+    if fmt not in _FLOAT_FORMATS:
+        scale = 255.0 if fmt == "uint8" else 65535.0
         data = (low + data.astype(np.float64) / scale * (high - low)).astype(np.float32)
-    data = np.ascontiguousarray(data[::-1], np.float32)
+    data = np.ascontiguousarray(data, np.float32)
     if not np.isfinite(data).all():
         raise InvalidInputError(f"{path} contains NaN or infinite values")
     return _channels(data, channels or (data.shape[2] if data.shape[2] in (1, 3, 4) else 3))

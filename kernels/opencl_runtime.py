@@ -58,6 +58,20 @@ class Runtime:
             self._programs[key] = prg
         return self._programs[key]
 
+    def shared(self, host, read_only=False):
+        """A buffer on ``host`` memory (``USE_HOST_PTR``: no copy on a CPU device such as PoCL); ``host`` must
+        stay alive and contiguous until `sync_to_host` (or the queue finishes)."""
+        mf = self.cl.mem_flags
+        return self.cl.Buffer(self.context, (mf.READ_ONLY if read_only else mf.READ_WRITE) | mf.USE_HOST_PTR,
+                              hostbuf=host)
+
+    def sync_to_host(self, pairs):
+        """Wait for the device and make its writes to shared buffers visible: pairs of (buffer, host array)."""
+        for buf, host in pairs:
+            mapped, _ = self.cl.enqueue_map_buffer(self.queue, buf, self.cl.map_flags.READ, 0, host.shape, host.dtype)
+            mapped.base.release(self.queue)
+        self.queue.finish()
+
     def kernel(self, program, name, options=()):
         """A kernel object of a program, created once and reused (kernels are not free to retrieve)."""
         key = (program, name, tuple(options))

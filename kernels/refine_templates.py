@@ -69,7 +69,8 @@ def _template_edges(pat, outer_n, slot_edge, slot_j):
 
     Columns of a face's edge slots: the segments of local edges 0, 1, 2 (``n_e`` each, counted from the local
     edge's first corner), then the pattern's interior edges. Returns ``(corner_cols (Mt, 3) column of the edge
-    leaving each corner of each pattern triangle, interior_pairs (Ei, 2) vertex slots of each interior edge)``.
+    leaving each corner of each pattern triangle, interior_at (Ei,) one pattern corner (flat index into
+    ``(Mt, 3)``) whose leaving edge is each interior edge)``.
     """
     n = np.asarray(outer_n, np.int64)
     n_slots = 3 + len(slot_edge) + len(pat.interior_bary)
@@ -92,15 +93,15 @@ def _template_edges(pat, outer_n, slot_edge, slot_j):
     offsets = np.concatenate(([0], np.cumsum(n)))
     cols[on_boundary] = offsets[e[on_boundary]] + np.minimum(pa, pb)[on_boundary]
     lo, hi = np.minimum(a, b)[~on_boundary], np.maximum(a, b)[~on_boundary]
-    pairs, local = np.unique(lo * n_slots + hi, return_inverse=True)
+    _, first, local = np.unique(lo * n_slots + hi, return_index=True, return_inverse=True)
     cols[~on_boundary] = offsets[3] + local.reshape(-1)
-    return cols, np.column_stack((pairs // n_slots, pairs % n_slots))
+    return cols, np.flatnonzero(~on_boundary)[first]
 
 
-def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, tables, triangles, tri_start):
+def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, classes, triangles, tri_start):
     """Edges of the refined mesh and the edge leaving each output corner, from the class patterns.
 
-    tables: per class ``(faces, vertex table (F, slots), corner_cols, interior_pairs)``. Returns ``(edges (K, 2)
+    classes: per class ``(faces, corner_cols, interior_at)`` (`_template_edges`). Returns ``(edges (K, 2)
     int32, corner_edges (M, 3) int32)``: the segments of every input edge (in edge order, canonical direction)
     then each face's interior edges.
     """
@@ -113,16 +114,16 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
         return np.where(q == 0, ends[e, 0], np.where(q == edge_n[e], ends[e, 1], inner))
 
     face_interior = np.zeros(len(tris), np.int64)
-    for faces, _, _, pairs in tables:
-        face_interior[faces] = len(pairs)
+    for faces, _, interior_at in classes:
+        face_interior[faces] = len(interior_at)
     interior_start = n_seg + np.cumsum(face_interior) - face_interior
     out_edges = np.empty((n_seg + int(face_interior.sum()), 2), np.int32)
     out_edges[:n_seg, 0], out_edges[:n_seg, 1] = vertex_at(seg_e, seg_k), vertex_at(seg_e, seg_k + 1)
     corner_edges = np.empty(triangles.shape, np.int32)
     outer_n = edge_n[face_edges]
-    for faces, table, cols, pairs in tables:
+    for faces, cols, interior_at in classes:
         n = outer_n[faces[0]]
-        slot_cols = np.empty((len(faces), int(n.sum()) + len(pairs)), np.int32)
+        slot_cols = np.empty((len(faces), int(n.sum()) + len(interior_at)), np.int32)
         start = 0
         for e in range(3):
             q = np.arange(int(n[e]))
@@ -130,10 +131,13 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
             canonical = np.where(flipped[faces, e][:, None], n[e] - 1 - q, q)
             slot_cols[:, start:start + n[e]] = seg_start[fe] + canonical
             start += int(n[e])
-        ids = interior_start[faces][:, None] + np.arange(len(pairs))
+        ids = interior_start[faces][:, None] + np.arange(len(interior_at))
         slot_cols[:, start:] = ids
-        if len(pairs):
-            out_edges[ids.ravel()] = table[:, pairs].reshape(-1, 2)
+        if len(interior_at):  # an interior edge's ends: the corner it leaves and the next, in the output triangles
+            tri = tri_start[faces][:, None] + interior_at // 3
+            k = interior_at % 3
+            out_edges[ids.ravel(), 0] = triangles[tri, k].ravel()
+            out_edges[ids.ravel(), 1] = triangles[tri, (k + 1) % 3].ravel()
         mt = len(cols)
         if faces[-1] - faces[0] + 1 == len(faces):  # consecutive faces: one block of output triangles
             lo = int(tri_start[faces[0]])
@@ -159,7 +163,6 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     tri_counts = outer_n.sum(axis=1) + 2 * interior_counts - 2
     tri_start = np.cumsum(tri_counts) - tri_counts
     triangles = np.empty((int(tri_counts.sum()), 3), np.int32)
-    tables = []
 
     patterns, groups, slots = [], group_by_class(inverse, len(first)), []
     for f0, faces in zip(first, groups, strict=True):
@@ -176,7 +179,6 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
             table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
         table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(
             int(interior_counts[f0]))
-        tables.append(table)
         stamped = table[:, pat.triangles]  # (F, Mt, 3)
         mt = len(pat.triangles)
         if faces[-1] - faces[0] + 1 == len(faces):
@@ -202,8 +204,8 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
         return out
 
     def output_edges():
-        per_class = [(faces, table, *_template_edges(pat, outer_n[faces[0]], *slot))
-                     for faces, table, pat, slot in zip(groups, tables, patterns, slots, strict=True)]
+        per_class = [(faces, *_template_edges(pat, outer_n[faces[0]], *slot))
+                     for faces, pat, slot in zip(groups, patterns, slots, strict=True)]
         return _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, per_class,
                              triangles, tri_start)
 

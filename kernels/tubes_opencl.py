@@ -34,24 +34,21 @@ class TubeDevice:
 
     def __init__(self, runtime, mesh):
         self.runtime, self.mesh = runtime, mesh
-        cl = runtime.cl
-        flags = cl.mem_flags.READ_WRITE | cl.mem_flags.USE_HOST_PTR
         self.buffers, self._inputs = {}, []
         for name in self.OUTPUTS:
             host = getattr(mesh, name)
             if host is None or host.size == 0:
                 host = np.zeros(1, np.float32)  # a placeholder argument (e.g. no UVs)
                 setattr(self, f"_{name}_dummy", host)
-            self.buffers[name] = cl.Buffer(runtime.context, flags, hostbuf=host)
+            self.buffers[name] = runtime.shared(host)
 
     def _in(self, array, dtype):
         """An input buffer sharing host memory; the array is kept alive until `finish`."""
-        cl = self.runtime.cl
         a = np.ascontiguousarray(array, dtype=dtype)
         if a.size == 0:
             a = np.zeros(1, dtype)
         self._inputs.append(a)
-        return cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.USE_HOST_PTR, hostbuf=a)
+        return self.runtime.shared(a, read_only=True)
 
     def write_body(self, lines, frames, n, curves, unit, cursor, u_ends, ring):
         """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None;
@@ -80,13 +77,6 @@ class TubeDevice:
 
     def finish(self):
         """Wait for the device and make its writes visible in the host arrays."""
-        cl = self.runtime.cl
-        queue = self.runtime.queue
-        for name, buf in self.buffers.items():
-            host = getattr(self.mesh, name)
-            if host is None or host.size == 0:
-                continue
-            mapped, _ = cl.enqueue_map_buffer(queue, buf, cl.map_flags.READ, 0, host.shape, host.dtype)
-            mapped.base.release(queue)
-        queue.finish()
+        hosts = ((buf, getattr(self.mesh, name)) for name, buf in self.buffers.items())
+        self.runtime.sync_to_host([(buf, host) for buf, host in hosts if host is not None and host.size])
         self._inputs.clear()

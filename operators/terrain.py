@@ -12,6 +12,7 @@ from ..addon.terrain_settings import copy_terrain_settings, draw_terrain_setting
 from ..kernels.errors import BudgetError, InvalidInputError, TesseraError
 from ..kernels.terrain_lod import select
 from ..kernels.terrain_mesh import bake, triangle_count
+from .selection import select_only
 
 #: Blender memory per output triangle (vertex share, 3 corners, edges, face, UVs), for the memory guard.
 _BYTES_PER_TRIANGLE = 80
@@ -102,10 +103,7 @@ class TESSERA_OT_terrain_add(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
-        for other in context.selected_objects:
-            other.select_set(False)
-        ob.select_set(True)
-        context.view_layer.objects.active = ob
+        select_only(context, [ob])
         return {"FINISHED"}
 
 

@@ -18,6 +18,7 @@ from ..addon.settings import (
 from ..kernels.adaptive import adaptive_levels
 from ..kernels.errors import GPUContextError, TesseraError
 from ..kernels.tessellate import check_budget, estimate, tessellate, uniform_levels
+from .selection import select_only
 
 
 def _world_positions(positions, matrix):
@@ -150,10 +151,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
             if src_slot.link == "OBJECT":
                 dst_slot.link = "OBJECT"
                 dst_slot.material = src_slot.material
-        for other in context.selected_objects:
-            other.select_set(False)
-        new.select_set(True)
-        context.view_layer.objects.active = new
+        select_only(context, [new])
         return new
 
 

@@ -9,6 +9,7 @@ from ..addon.tube_settings import copy_tube_settings, draw_tube_settings, kernel
 from ..addon.tube_sources import SOURCE_TYPES, read_lines
 from ..kernels.errors import BudgetError, TesseraError
 from ..kernels.tubes import build_tubes
+from .selection import select_only
 
 # output bytes per vertex (position, normal) and per corner (vertex, edge, UV) plus per edge, for the memory guard
 _BYTES_PER_VERTEX, _BYTES_PER_CORNER, _BYTES_PER_EDGE = 24, 16, 8
@@ -73,12 +74,7 @@ class TESSERA_OT_tubes(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
-        for other in context.selected_objects:
-            other.select_set(False)
-        for ob in made:
-            ob.select_set(True)
-        if made:
-            context.view_layer.objects.active = made[-1]
+        select_only(context, made)
         return {"FINISHED"}
 
     def _check_budget(self, context, lines, settings):

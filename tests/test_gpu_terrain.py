@@ -16,6 +16,16 @@ def terrain(addon_module, size=193):
     return hio.from_array(h.astype(np.float32), texel_size=1.0)
 
 
+def _scene(addon_module):
+    """Modules, the test terrain, its tile table and preview data."""
+    ta, tl, tm = (addon_module(f"kernels.terrain_{m}") for m in ("analysis", "lod", "mesh"))
+    hm = terrain(addon_module)
+    table = ta.tile_table(hm, 32, backend="numpy")
+    data = addon_module("gpu_shaders.terrain_preview").TerrainDrawData(hm, table)
+    return (tl, tm, addon_module("gpu_shaders.offscreen"), addon_module("kernels.camera").Camera, hm, table,
+            data)
+
+
 def cameras(Camera, rng, n):
     for _ in range(n):
         a = rng.uniform(0, 2 * np.pi)
@@ -26,13 +36,7 @@ def cameras(Camera, rng, n):
 
 @pytest.mark.parametrize("levels", ["POW2", "FRACTIONAL"])
 def test_preview_draws_the_baked_mesh(gpu_renderer, addon_module, levels):
-    ta, tl, tm = (addon_module(f"kernels.terrain_{m}") for m in ("analysis", "lod", "mesh"))
-    preview = addon_module("gpu_shaders.terrain_preview")
-    offscreen = addon_module("gpu_shaders.offscreen")
-    Camera = addon_module("kernels.camera").Camera
-    hm = terrain(addon_module)
-    table = ta.tile_table(hm, 32, backend="numpy")
-    data = preview.TerrainDrawData(hm, table)
+    tl, tm, offscreen, Camera, hm, table, data = _scene(addon_module)
     for cam in cameras(Camera, np.random.default_rng(2), 3):
         sel = tl.select(hm, table, cam, tl.TerrainLod(levels=levels))
         mesh = tm.bake(hm, table, sel)
@@ -50,13 +54,7 @@ def test_preview_draws_the_baked_mesh(gpu_renderer, addon_module, levels):
 def test_preview_has_no_cracks_from_random_cameras(gpu_renderer, addon_module):
     """Flat white terrain over black, seen from above: no black pixel where the baked mesh (welded, shown
     watertight by the kernel tests) covers the view, eroded by a pixel so outline rasterisation does not count."""
-    ta, tl, tm = (addon_module(f"kernels.terrain_{m}") for m in ("analysis", "lod", "mesh"))
-    preview = addon_module("gpu_shaders.terrain_preview")
-    offscreen = addon_module("gpu_shaders.offscreen")
-    Camera = addon_module("kernels.camera").Camera
-    hm = terrain(addon_module)
-    table = ta.tile_table(hm, 32, backend="numpy")
-    data = preview.TerrainDrawData(hm, table)
+    tl, tm, offscreen, Camera, hm, table, data = _scene(addon_module)
     rng = np.random.default_rng(5)
     for levels in ("FRACTIONAL", "INTEGER"):
         for _ in range(10):
