@@ -10,11 +10,13 @@ import numpy as np
 
 from .errors import TesseraError
 from .opencl_runtime import get_runtime
-from .topology import group_by_class
+from .refine_templates import scatter_rows, stamp
 
 #: Below this many output rows the numpy path is used even when OpenCL is available (launch overhead).
 OPENCL_MIN_ROWS = 1 << 15
 BACKENDS = ("auto", "numpy", "opencl")
+#: Faces per float64 product in `_slot_values` (keeps the temporary in cache).
+CHUNK_FACES = 256
 
 
 def gather_weighted_numpy(values, idx, weights):
@@ -107,28 +109,56 @@ def corner_values(ref, values, backend="auto"):
     return out.reshape((len(ref.triangles), 3) + values.shape[2:])
 
 
+def _slot_values(ref, cls, values):
+    """One class's corner attribute at every vertex slot of its faces (see `refine_templates.PatternClass`).
+
+    values: (T, 3, C) float64. Returns (F, slots, C) float32. A corner copies its value; an edge point is
+    ``(1 - t) a + t b`` along the mesh edge's canonical direction, so faces that agree at an edge's ends
+    (no UV seam) get bit-identical values all along it; interior points are one matrix product.
+    """
+    v = values[cls.faces]  # (F, 3, C)
+    n_faces, _, channels = v.shape
+    e, j = cls.slot_edge, cls.slot_j
+    p = len(cls.interior_bary)
+    out = np.empty((n_faces, 3 + len(e) + p, channels), np.float32)
+    out[:, :3] = v
+    if len(e):
+        flip = ref.flipped[cls.faces][:, e]  # (F, S)
+        canonical = np.where(flip, cls.outer_n[e] - j, j)
+        t = ref.edge_point_t[ref.edge_point_start[ref.face_edges[cls.faces][:, e]] + canonical - 1]
+        # (1 - t) start + t end along the canonical direction, written as weights of the local edge's first and
+        # second corner: the same two products and one (commutative) sum, so the same bits from either face.
+        w_first, w_second = np.where(flip, t, 1.0 - t), np.where(flip, 1.0 - t, t)
+        for c in range(channels):
+            vc = v[:, :, c]
+            out[:, 3 : 3 + len(e), c] = w_first * vc[:, e] + w_second * vc[:, (e + 1) % 3]
+    if p:  # (F, 3C) @ (3C, pC): weights expanded per channel, so the product lands in (F, p, C) order
+        expanded = np.zeros((3, channels, p, channels))
+        for c in range(channels):
+            expanded[:, c, :, c] = cls.interior_bary.T
+        expanded = expanded.reshape(3 * channels, -1)
+        flat = v.reshape(n_faces, -1)
+        for lo in range(0, n_faces, CHUNK_FACES):  # a small float64 product, rounded into place
+            hi = min(n_faces, lo + CHUNK_FACES)
+            out[lo:hi, 3 + len(e) :] = (flat[lo:hi] @ expanded).reshape(hi - lo, p, channels)
+    return out
+
+
 def _corner_values_by_class(ref, values):
-    """`corner_values` for a refinement built per pattern class: one matrix product per class."""
+    """`corner_values` for a refinement built per pattern class: each class's slot values stamped by its pattern."""
     n_faces = len(ref.faces)
     flat = values.reshape(n_faces, 3, -1).astype(np.float64)
-    channels = flat.shape[2]
+    tail = values.shape[2:]
+    if len(ref.classes) == 1:
+        cls = ref.classes[0]
+        return stamp(_slot_values(ref, cls, flat), cls.triangles.ravel()).reshape((len(ref.triangles), 3) + tail)
     counts = np.bincount(ref.triangle_face, minlength=n_faces)
     starts = np.cumsum(counts) - counts
-    out = np.empty((len(ref.triangles) * 3, channels), dtype=np.float32)
-    groups = group_by_class(ref.face_class, len(ref.class_corner_bary))
-    for template, faces in zip(ref.class_corner_bary, groups, strict=True):
-        if len(faces) == 0:
-            continue
-        weights = template.reshape(-1, 3)  # (Mt * 3, 3)
-        k = len(weights)
-        vals = np.matmul(weights, flat[faces])  # (F, k, channels), face by face: contiguous writes
-        rows = (3 * starts[faces][:, None] + np.arange(k)).ravel()
-        if faces[-1] - faces[0] + 1 == len(faces):
-            lo = int(rows[0])
-            out[lo : lo + len(rows)].reshape(len(faces), k, channels)[...] = vals
-        else:
-            out[rows] = vals.reshape(-1, channels)
-    return out.reshape((len(ref.triangles), 3) + values.shape[2:])
+    out = np.empty((len(ref.triangles), 3, flat.shape[2]), dtype=np.float32)
+    for cls in ref.classes:
+        block = stamp(_slot_values(ref, cls, flat), cls.triangles.ravel())
+        scatter_rows(out, cls, starts, block.reshape(len(cls.faces), -1, 3, flat.shape[2]))
+    return out.reshape((len(ref.triangles), 3) + tail)
 
 
 def face_values(ref, values):
@@ -147,5 +177,13 @@ def normalized(vectors):
     v = np.asarray(vectors)
     if v.dtype != np.float32:
         v = v.astype(np.float64)
-    length = np.sqrt(np.einsum("...i,...i->...", v, v))[..., None]
-    return np.divide(v, length, out=np.zeros_like(v), where=length > 0).astype(np.float32, copy=False)
+    length = v[..., 0] * v[..., 0]
+    length += v[..., 1] * v[..., 1]
+    length += v[..., 2] * v[..., 2]
+    np.sqrt(length, out=length)
+    bad = ~(length > 0)  # zero (or NaN) length: the vector becomes zero
+    length[bad] = 1.0
+    out = v / length[..., None]
+    if bad.any():
+        out[bad] = 0.0
+    return out.astype(np.float32, copy=False)

@@ -74,10 +74,12 @@ class Refinement:
     interior_counts: np.ndarray
     #: ``interior_face``, ``interior_bary``, ``corner_bary``: arrays, or callables that build them on first use.
     lazy: dict = field(default_factory=dict, repr=False, compare=False)
-    #: Class of each face, and the interior and corner barycentrics of each class (set when built per class).
+    #: (T, 3) int32 mesh edge and (T, 3) bool direction flag of each face's local edges (`triangle_edges`).
+    face_edges: np.ndarray | None = None
+    flipped: np.ndarray | None = None
+    #: Class of each face (T,) int64 and the `refine_templates.PatternClass` of each class (set when built per class).
     face_class: np.ndarray | None = None
-    class_interior_bary: tuple = ()
-    class_corner_bary: tuple = ()
+    classes: tuple = ()
 
     def _get(self, name):
         value = self.lazy[name]
@@ -103,13 +105,19 @@ class Refinement:
         return self._get("output_edges") if "output_edges" in self.lazy else None
 
     @property
+    def edge_point_start(self):
+        """(E,) int64 offset of each edge's first point in ``edge_point_edge`` / ``edge_point_t``."""
+        counts = np.maximum(self.edge_segments - 1, 0)
+        return np.cumsum(counts) - counts
+
+    @property
     def n_vertices(self):
         return self.n_corners + len(self.edge_point_edge) + int(self.interior_counts.sum())
 
     def interior_template(self, face, start):
         """Barycentrics (P, 3) of the interior points of ``face``, stored from offset ``start``."""
         if self.face_class is not None:
-            return self.class_interior_bary[self.face_class[face]]
+            return self.classes[self.face_class[face]].interior_bary
         return self.interior_bary[start : start + int(self.interior_counts[face])]
 
 
@@ -234,6 +242,8 @@ def _refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacin
         inner_level=inner_f,
         inner_segments=inner_n,
         interior_counts=_interior_counts(inner_n),
+        face_edges=face_edges,
+        flipped=flipped,
         lazy={"interior_face": vertex_face[interior].astype(np.int32), "interior_bary": vertex_bary[interior],
               "corner_bary": vertex_bary[tri_rv]},
     )
@@ -275,12 +285,13 @@ def _ring_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t,
     canonical = np.where(flip, n_e - j, j)
     point = np.where(is_corner, 0, edge_first[edge] + canonical - 1)
     ids[o] = np.where(is_corner, tris[fo, e], point)
-    t_local = np.zeros(len(o))
-    inside = np.flatnonzero(~is_corner)
-    t_canon = edge_point_t[point[inside] - n_vertices]
-    t_local[inside] = np.where(flip[inside], 1.0 - t_canon, t_canon)
-    bary[o, e] = 1.0 - t_local
-    bary[o, (e + 1) % 3] = t_local
+    # An edge point weighs the edge's canonical ends (1 - t, t) whichever way the face runs, so the two faces
+    # of an edge interpolate corner attributes with the same weights (bit-identical where they agree at the ends).
+    t = np.zeros(len(o))
+    t[~is_corner] = edge_point_t[point[~is_corner] - n_vertices]
+    w_lo, w_hi = 1.0 - t, t  # weights of the edge's lower and higher vertex
+    bary[o, e] = np.where(is_corner, 1.0, np.where(flip, w_hi, w_lo))
+    bary[o, (e + 1) % 3] = np.where(is_corner, 0.0, np.where(flip, w_lo, w_hi))
 
     # Interior rings: numbered consecutively after the edge points, in table order.
     q = np.flatnonzero(k >= 1)

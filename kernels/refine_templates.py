@@ -9,6 +9,8 @@ ids with one gather. Vertex numbering, triangle order and barycentrics are those
 (the tests compare both bit for bit for the topology).
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from . import refine as core
@@ -64,7 +66,7 @@ def _lone_pattern(outer_f, outer_n, inner_f, inner_n, spacing):
     return ref, slot_edge, slot_j
 
 
-def _template_edges(pat, outer_n, slot_edge, slot_j):
+def _template_edges(pat):
     """The edges of a class pattern in "edge slot" space.
 
     Columns of a face's edge slots: the segments of local edges 0, 1, 2 (``n_e`` each, counted from the local
@@ -72,7 +74,8 @@ def _template_edges(pat, outer_n, slot_edge, slot_j):
     leaving each corner of each pattern triangle, interior_at (Ei,) one pattern corner (flat index into
     ``(Mt, 3)``) whose leaving edge is each interior edge)``.
     """
-    n = np.asarray(outer_n, np.int64)
+    n = pat.outer_n
+    slot_edge, slot_j = pat.slot_edge, pat.slot_j
     n_slots = 3 + len(slot_edge) + len(pat.interior_bary)
     # position of every vertex slot along each local edge (-1: not on it); local edge e runs corner e -> e + 1
     pos = np.full((n_slots, 3), -1, np.int64)
@@ -148,6 +151,54 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
     return out_edges, corner_edges
 
 
+@dataclass(frozen=True)
+class PatternClass:
+    """One refinement pattern and the faces it is stamped onto.
+
+    A face's vertices are addressed by *slot*: its corners 0, 1, 2; then its edge points (``slot_edge`` and
+    ``slot_j``: local edge ``e`` and index ``j`` counted from corner ``e``, ``outer_n[e]`` segments); then its
+    interior points, in order. faces: (F,) int64 ascending; triangles: (Mt, 3) int32 slot of each corner of the
+    pattern's triangles; slot_edge, slot_j: (S,) int64; interior_bary: (P, 3) float64; corner_bary: (Mt, 3, 3)
+    float64; outer_n: (3,) int64.
+    """
+
+    faces: np.ndarray
+    triangles: np.ndarray
+    slot_edge: np.ndarray
+    slot_j: np.ndarray
+    interior_bary: np.ndarray
+    corner_bary: np.ndarray
+    outer_n: np.ndarray
+
+    @property
+    def consecutive(self):
+        """True when the faces are one run ``faces[0] .. faces[-1]`` (their output rows form one block)."""
+        return int(self.faces[-1]) - int(self.faces[0]) + 1 == len(self.faces)
+
+
+def stamp(table, slots):
+    """Per-face slot values gathered at pattern slots: ``table`` (F, ns, ...) , slots (k,) -> (F, k, ...).
+
+    Each slot's row is moved as whole 64-bit (or 32-bit) words, in one `np.take` pass."""
+    f, ns = table.shape[:2]
+    item = table.dtype.itemsize * int(np.prod(table.shape[2:], dtype=np.int64))
+    word = np.int64 if item % 8 == 0 else np.int32 if item % 4 == 0 else np.uint8
+    width = item // np.dtype(word).itemsize
+    words = np.ascontiguousarray(table).view(word).reshape(f, ns * width)
+    index = slots if width == 1 else (np.asarray(slots, np.int64)[:, None] * width + np.arange(width)).ravel()
+    return np.take(words, index, axis=1).view(table.dtype).reshape((f, len(slots)) + table.shape[2:])
+
+
+def scatter_rows(out, cls, starts, block):
+    """Write per-face blocks (F, k, ...) of class ``cls`` into ``out`` rows ``starts[face] ...``."""
+    f, k = block.shape[:2]
+    if cls.consecutive:
+        lo = int(starts[cls.faces[0]])
+        out[lo : lo + f * k] = block.reshape((f * k,) + out.shape[1:])
+    else:
+        out[(starts[cls.faces][:, None] + np.arange(k)).ravel()] = block.reshape((f * k,) + out.shape[1:])
+
+
 def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing):
     """Same contract as `kernels.refine.refine`, built per pattern class. Returns a `Refinement`."""
     edge_f, edge_n, inner_f, inner_n = levels
@@ -162,50 +213,49 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     interior_first = n_vertices + len(point_edge)
     tri_counts = outer_n.sum(axis=1) + 2 * interior_counts - 2
     tri_start = np.cumsum(tri_counts) - tri_counts
-    triangles = np.empty((int(tri_counts.sum()), 3), np.int32)
+    n_out = int(tri_counts.sum())
 
-    patterns, groups, slots = [], group_by_class(inverse, len(first)), []
-    for f0, faces in zip(first, groups, strict=True):
+    pattern_classes_, triangles = [], None
+    for f0, faces in zip(first, group_by_class(inverse, len(first)), strict=True):
         pat, slot_edge, slot_j = _lone_pattern(outer_f[f0], outer_n[f0], inner_f[f0], inner_n[f0], spacing)
-        patterns.append(pat)
-        slots.append((slot_edge, slot_j))
-        n_edge_slots = len(slot_edge)
-        table = np.empty((len(faces), 3 + n_edge_slots + int(interior_counts[f0])), np.int64)
+        cls = PatternClass(faces=faces, triangles=pat.triangles.astype(np.int32), slot_edge=slot_edge,
+                           slot_j=slot_j, interior_bary=pat.interior_bary, corner_bary=pat.corner_bary,
+                           outer_n=outer_n[f0].astype(np.int64))
+        pattern_classes_.append(cls)
+        n_edge_slots, n_interior = len(slot_edge), int(interior_counts[f0])
+        table = np.empty((len(faces), 3 + n_edge_slots + n_interior), np.int32)  # vertex id of each slot
         table[:, :3] = tris[faces]
         if n_edge_slots:
             e = face_edges[faces][:, slot_edge]  # (F, slots) mesh edge of each slot
-            n_e = outer_n[f0][slot_edge]
+            n_e = cls.outer_n[slot_edge]
             canonical = np.where(flipped[faces][:, slot_edge], n_e - slot_j, slot_j)
             table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
-        table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(
-            int(interior_counts[f0]))
-        stamped = table[:, pat.triangles]  # (F, Mt, 3)
-        mt = len(pat.triangles)
-        if faces[-1] - faces[0] + 1 == len(faces):
-            lo = int(tri_start[faces[0]])
-            triangles[lo : lo + len(faces) * mt] = stamped.reshape(-1, 3)
+        table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(n_interior)
+        stamped = stamp(table, cls.triangles.ravel())  # (F, Mt * 3)
+        if len(faces) == len(tris):  # one class: the stamped block is the output
+            triangles = stamped.reshape(-1, 3)
         else:
-            triangles[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = stamped.reshape(-1, 3)
+            triangles = np.empty((n_out, 3), np.int32) if triangles is None else triangles
+            scatter_rows(triangles, cls, tri_start, stamped.reshape(len(faces), -1, 3))
+    pattern_classes_ = tuple(pattern_classes_)
 
     def interior_bary():
         out = np.empty((int(interior_counts.sum()), 3))
-        for pat, faces in zip(patterns, groups, strict=True):
-            p = len(pat.interior_bary)
-            if p:
-                rows = (interior_start[faces][:, None] + np.arange(p)).ravel()
-                out[rows] = np.tile(pat.interior_bary, (len(faces), 1))
+        for cls in pattern_classes_:
+            if len(cls.interior_bary):
+                scatter_rows(out, cls, interior_start, np.broadcast_to(cls.interior_bary, (len(cls.faces),)
+                                                                       + cls.interior_bary.shape))
         return out
 
     def corner_bary():
-        out = np.empty((len(triangles), 3, 3))
-        for pat, faces in zip(patterns, groups, strict=True):
-            mt = len(pat.triangles)
-            out[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = np.tile(pat.corner_bary, (len(faces), 1, 1))
+        out = np.empty((n_out, 3, 3))
+        for cls in pattern_classes_:
+            scatter_rows(out, cls, tri_start, np.broadcast_to(cls.corner_bary, (len(cls.faces),)
+                                                              + cls.corner_bary.shape))
         return out
 
     def output_edges():
-        per_class = [(faces, *_template_edges(pat, outer_n[faces[0]], *slot))
-                     for faces, pat, slot in zip(groups, patterns, slots, strict=True)]
+        per_class = [(cls.faces, *_template_edges(cls)) for cls in pattern_classes_]
         return _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, per_class,
                              triangles, tri_start)
 
@@ -215,9 +265,8 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
         edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t,
         triangles=triangles, triangle_face=np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts),
         spacing=spacing, edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
-        interior_counts=interior_counts,
+        interior_counts=interior_counts, face_edges=face_edges, flipped=flipped,
         lazy={"interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
               "interior_bary": interior_bary, "corner_bary": corner_bary, "output_edges": output_edges},
-        face_class=inverse, class_interior_bary=tuple(p.interior_bary for p in patterns),
-        class_corner_bary=tuple(p.corner_bary for p in patterns),
+        face_class=inverse, classes=pattern_classes_,
     )

@@ -19,19 +19,43 @@ from .topology import group_by_class, ragged
 MAX_CLASSES = 256
 #: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
 CHUNK = 1 << 16
+#: Values per float64 product on the class path (keeps the temporary in cache before it is rounded).
+CHUNK_VALUES = 1 << 17
 
 
 def _class_path(n_classes, n_owners):
     return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
 
 
-def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis):
+def _unit_rows(values, channels):
+    """Normalise (n, p * C) float64 rows in place, C channels per point (zero vectors stay zero)."""
+    v = values.reshape(-1, channels)
+    length = v[:, 0] * v[:, 0]
+    for c in range(1, channels):
+        length += v[:, c] * v[:, c]
+    np.sqrt(length, out=length)
+    length[~(length > 0)] = np.inf  # zero length: 0 / inf = 0
+    v /= length[:, None]
+
+
+def _expanded(b, channels):
+    """Basis (p, k) -> (k C, p C) float64 with ``[j C + c, i C + c] = b[i, j]``: control rows (k C,) in
+    (k, C) order times it give values in (p, C) order, so products land contiguously."""
+    p, k = b.shape
+    out = np.zeros((k, channels, p, channels))
+    for c in range(channels):
+        out[:, c, :, c] = b.T
+    return out.reshape(k * channels, p * channels)
+
+
+def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis, unit=False):
     """Evaluate points owned by rows of ``control``; writes ``out[first + ...]``.
 
     counts: (K,) points per owner, stored contiguously in owner order from ``first``; keys: (K,) class
     of each owner (same key -> same parameters); template_of: ``(owner, start) -> (P, ...)`` parameters
     of one owner's points; all_params: ``() -> (N, ...)`` every point's parameters (the point path);
-    control: (K, k, C); basis: callable ``params (P, ...) -> (P, k)``.
+    control: (K, k, C); basis: callable ``params (P, ...) -> (P, k)``; unit: normalise each value (in
+    float64, before rounding).
     """
     n = int(counts.sum())
     if n == 0:
@@ -47,22 +71,30 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
             p = int(counts[owners[0]])
             if p == 0:
                 continue
-            b = basis(template_of(owners[0], int(starts[owners[0]])))  # (p, k)
-            ctrl = np.ascontiguousarray(control[owners].transpose(1, 0, 2)).reshape(b.shape[1], -1)
-            vals = (b @ ctrl).reshape(p, len(owners), channels).transpose(1, 0, 2)  # (owners, p, C) view
-            if owners[-1] - owners[0] + 1 == len(owners):  # consecutive owners: one contiguous block
-                lo = first + int(starts[owners[0]])
-                out[lo : lo + len(owners) * p].reshape(len(owners), p, channels)[...] = vals
-            else:
-                rows = first + starts[owners][:, None] + np.arange(p)
-                out[rows.ravel()] = vals.reshape(-1, channels)
+            expanded = _expanded(basis(template_of(owners[0], int(starts[owners[0]]))), channels)
+            rows = control.reshape(len(control), -1)
+            consecutive = owners[-1] - owners[0] + 1 == len(owners)
+            step = max(1, CHUNK_VALUES // (p * channels))
+            for lo in range(0, len(owners), step):
+                chunk = owners[lo : lo + step]
+                vals = (rows[chunk[0] : chunk[-1] + 1] if consecutive else rows[chunk]) @ expanded  # (n, p C)
+                if unit:
+                    _unit_rows(vals, channels)
+                if consecutive:
+                    at = first + int(starts[chunk[0]])
+                    out[at : at + len(chunk) * p] = vals.reshape(-1, channels)
+                else:
+                    out[(first + starts[chunk][:, None] + np.arange(p)).ravel()] = vals.reshape(-1, channels)
         return
     owner, _, _ = ragged(counts)
     params = all_params()
     for lo in range(0, n, CHUNK):
         hi = min(n, lo + CHUNK)
         b = basis(params[lo:hi])
-        out[first + lo : first + hi] = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
+        vals = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
+        if unit:
+            _unit_rows(vals, channels)
+        out[first + lo : first + hi] = vals
 
 
 def _edge_keys(ref):
@@ -73,12 +105,13 @@ def _inner_keys(ref):
     return ref.inner_level if ref.spacing != "EQUAL" else ref.inner_segments.astype(np.float64)
 
 
-def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control, face_basis):
+def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control, face_basis, unit=False):
     """Values of a patch surface at every output vertex.
 
     corner_values: (V, C) values at the input vertices (the patches interpolate them);
     edge_control: (E, ke, C) per mesh edge, for the direction ``edges[e, 0] -> edges[e, 1]``;
     edge_basis: ``t (P,) -> (P, ke)``; face_control: (T, kf, C); face_basis: ``bary (P, 3) -> (P, kf)``.
+    unit: normalise every value (a normal field); the corner values must then be unit already.
     Returns (n_vertices, C) float32 (evaluated in float64, rounded once).
     """
     channels = face_control.shape[2]
@@ -87,9 +120,9 @@ def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control,
     edge_counts = np.maximum(ref.edge_segments - 1, 0)
     _evaluate_group(out, ref.n_corners, edge_counts, _edge_keys(ref),
                     lambda e, start: ref.edge_point_t[start : start + int(edge_counts[e])],
-                    lambda: ref.edge_point_t, edge_control, edge_basis)
+                    lambda: ref.edge_point_t, edge_control, edge_basis, unit)
     _evaluate_group(out, ref.n_corners + len(ref.edge_point_edge), ref.interior_counts, _inner_keys(ref),
-                    ref.interior_template, lambda: ref.interior_bary, face_control, face_basis)
+                    ref.interior_template, lambda: ref.interior_bary, face_control, face_basis, unit)
     return out
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import patches
+from . import patches, workers
 from .errors import BudgetError, InvalidInputError
 from .interpolate import corner_values, face_values, normalized, point_values
 from .mesh_arrays import MeshArrays
@@ -233,9 +233,8 @@ def _shading_normals(ref, method, options, positions, vertex_normals, corner_nor
     edge_fn, edge_basis, face_fn, face_basis = _normal_field(method, options)
     if points is None:
         pa, pb, na, nb = _edge_data(ref, positions, vertex_normals)
-        points = evaluate_surface(ref, vertex_normals, edge_fn(pa, pb, na, nb), edge_basis,
-                                  face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis)
-        points = normalized(points)
+        points = evaluate_surface(ref, normalized(vertex_normals), edge_fn(pa, pb, na, nb), edge_basis,
+                                  face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis, unit=True)
     if split is None or not split.any():
         return points, None
     corners = points[ref.triangles]
@@ -263,11 +262,17 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
     options = options or SurfaceOptions()
     _check_options(method, options)
     mesh.validate()
-    report = progress or (lambda fraction: None)
+    with workers.parallel_section():
+        return _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend,
+                           progress or (lambda fraction: None), options, surface)
+
+
+def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, report, options, surface):
     result = Tessellation(mesh=None, refinement=None)
     if method == "LINEAR":
         ref = refine(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
         report(0.4)
+        attributes = workers.submit(_attributes, ref, mesh, backend)
         out = MeshArrays(positions=point_values(ref, mesh.positions, backend), triangles=ref.triangles,
                          attribute_types=dict(mesh.attribute_types))
         if mesh.corner_normals is not None:
@@ -281,25 +286,32 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
             result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
         ref = refine(source.triangles, len(source.positions), edge_levels, inner_levels, spacing)
         report(0.4)
-        points = None
+        attributes = workers.submit(_attributes, ref, source, backend)
+        corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
+        shading = (positions, vertex_normals, corner_normals, split)
         if surface is not None:
             out_positions, points = surface(ref, inputs)
-        elif method == "PN":
-            out_positions = _pn_positions(ref, positions, vertex_normals)
+            normals = workers.submit(_shading_normals, ref, method, options, *shading, points)
         else:
-            out_positions = _phong_positions(ref, positions, vertex_normals,
-                                             options.alpha if alpha is None else alpha)
+            normals = workers.submit(_shading_normals, ref, method, options, *shading)
+            if method == "PN":
+                out_positions = _pn_positions(ref, positions, vertex_normals)
+            else:
+                out_positions = _phong_positions(ref, positions, vertex_normals,
+                                                 options.alpha if alpha is None else alpha)
         report(0.6)
         out = MeshArrays(positions=out_positions, triangles=ref.triangles, attribute_types=dict(mesh.attribute_types))
-        corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
-        out.point_normals, out.corner_normals = _shading_normals(
-            ref, method, options, positions, vertex_normals, corner_normals, split, points)
-        mesh = source
-    report(0.7)
-    out.point_attributes = {k: point_values(ref, v, backend) for k, v in mesh.point_attributes.items()}
-    report(0.85)
-    out.corner_attributes = {k: corner_values(ref, v, backend) for k, v in mesh.corner_attributes.items()}
-    out.face_attributes = {k: face_values(ref, v) for k, v in mesh.face_attributes.items()}
+        out.point_normals, out.corner_normals = normals.result()
+    report(0.8)
+    out.point_attributes, out.corner_attributes, out.face_attributes = attributes.result()
     report(1.0)
     result.mesh, result.refinement = out, ref
     return result
+
+
+def _attributes(ref, mesh, backend):
+    """The mesh's point, corner and face attributes on the refinement: three dicts of arrays."""
+    return ({k: point_values(ref, v, backend) for k, v in mesh.point_attributes.items()},
+            {k: corner_values(ref, v, backend) for k, v in mesh.corner_attributes.items()},
+            {k: face_values(ref, v) for k, v in mesh.face_attributes.items()})
+

@@ -33,6 +33,19 @@ def test_refined_positions_match_numpy(opencl):
     assert np.array_equal(a[: ref.n_corners], b[: ref.n_corners])  # input vertices are copied exactly
 
 
+def test_opencl_corner_values_agree_bit_for_bit_at_shared_vertices(opencl):
+    from test_tessellate import continuous_uvs, one_value_per_vertex
+
+    v, f, uv = continuous_uvs(5)
+    levels = np.random.default_rng(3).uniform(1, 12, len(triangle_edges(f)[0]))
+    ref = refine(f, len(v), levels, spacing="FRACTIONAL_EVEN")
+    assert ref.face_class is None and len(ref.triangles) * 3 >= interpolate.OPENCL_MIN_ROWS  # the gather path
+    out = interpolate.corner_values(ref, uv[f], backend="opencl")
+    assert one_value_per_vertex(ref.triangles, out)
+    reference = interpolate.corner_values(ref, uv[f], backend="numpy")
+    np.testing.assert_allclose(out, reference, rtol=FLOAT32_PATH_RTOL, atol=FLOAT32_PATH_ATOL)
+
+
 def test_empty_gather(opencl):
     out = interpolate.gather_weighted_opencl(opencl, np.zeros((3, 2), np.float32), np.zeros((0, 3), int),
                                              np.zeros((0, 3)))

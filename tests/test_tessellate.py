@@ -113,10 +113,48 @@ def test_corner_values_by_class_equal_the_gather(monkeypatch):
     levels[::3] = 2.0  # a few classes, faces of a class not consecutive
     monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: True)
     ref = refine(mesh.triangles, len(mesh.positions), levels)
-    assert ref.face_class is not None and len(ref.class_corner_bary) > 1
+    assert ref.face_class is not None and len(ref.classes) > 1
     by_class = corner_values(ref, mesh.corner_attributes["uv"], backend="numpy")
     flat = mesh.corner_attributes["uv"].reshape(-1, 2)
     source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)
     from tessera.kernels.interpolate import gather_weighted_numpy
     gathered = gather_weighted_numpy(flat, np.repeat(source, 3, axis=0), ref.corner_bary.reshape(-1, 3))
     np.testing.assert_allclose(by_class.reshape(-1, 2), gathered, rtol=1e-6, atol=1e-6)
+
+
+def one_value_per_vertex(triangles, corner):
+    """True when every output vertex has bit-identical corner values in all the triangles that use it."""
+    ids = triangles.ravel()
+    words = np.ascontiguousarray(corner.reshape(len(ids), -1)).view(np.uint32)
+    order = np.lexsort(words.T[::-1].tolist() + [ids])
+    same_vertex = ids[order][1:] == ids[order][:-1]
+    same_value = (words[order][1:] == words[order][:-1]).all(axis=1)
+    return bool(same_value[same_vertex].all())
+
+
+def continuous_uvs(seed):
+    """A closed mesh and per-vertex UVs given per corner: values that agree across every edge (no seams)."""
+    v, f = random_closed(seed, 7, 6)
+    uv = np.random.default_rng(seed).random((len(v), 2)).astype(np.float32) * 9.3 - 4.1
+    return v, f, uv
+
+
+@pytest.mark.parametrize("spacing", ["EQUAL", "FRACTIONAL_EVEN"])
+@pytest.mark.parametrize("levels_kind, by_class", [("uniform", True), ("power_of_two", True), ("random", False)])
+def test_corner_values_agree_bit_for_bit_at_shared_vertices(monkeypatch, spacing, levels_kind, by_class):
+    """Both faces of an edge interpolate its points from the same ends with the same weights (an exporter that
+    splits vertices on differing UVs must not split a seamless mesh)."""
+    from tessera.kernels import refine_templates
+
+    v, f, uv = continuous_uvs(4)
+    n_edges = len(triangle_edges(f)[0])
+    rng = np.random.default_rng(9)
+    levels = {"uniform": np.full(n_edges, 7.0), "power_of_two": 2.0 ** rng.integers(0, 4, n_edges),
+              "random": rng.uniform(1, 9, n_edges)}[levels_kind]
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: by_class)
+    ref = refine(f, len(v), levels, spacing=spacing)
+    assert (ref.face_class is not None) == by_class
+    out = corner_values(ref, uv[f], backend="numpy")
+    assert one_value_per_vertex(ref.triangles, out)
+    corners = ref.triangles < len(v)  # input vertices keep their value exactly
+    assert np.array_equal(out[corners], uv[ref.triangles[corners]])

@@ -110,6 +110,43 @@ def test_results_are_deterministic(method):
         assert (a is None and b is None) or a.tobytes() == b.tobytes(), name
 
 
+@pytest.mark.parametrize("method", ["PN", "PHONG", "LINEAR"])
+def test_worker_threads_do_not_change_the_bytes(method, monkeypatch):
+    """Positions, normals and attributes are computed side by side; run one after another, the same bytes."""
+    from concurrent.futures import Future
+
+    from tessera.kernels import workers
+
+    mesh = sharp_mesh(4)
+    levels = uniform_levels(mesh, 6)
+    parallel = tessellate(mesh, levels, method=method, backend="numpy").mesh
+
+    def inline(fn, *args):
+        done = Future()
+        done.set_result(fn(*args))
+        return done
+
+    monkeypatch.setattr(workers, "submit", inline)
+    serial = tessellate(mesh, levels, method=method, backend="numpy").mesh
+    for name in ("positions", "triangles", "corner_normals", "point_normals"):
+        a, b = getattr(parallel, name), getattr(serial, name)
+        assert (a is None and b is None) or a.tobytes() == b.tobytes(), name
+    assert parallel.corner_attributes["uv"].tobytes() == serial.corner_attributes["uv"].tobytes()
+
+
+def test_parallel_section_holds_blas_to_one_thread():
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from tessera.kernels import workers
+
+    def blas_threads():
+        return [i["num_threads"] for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]
+
+    before = blas_threads()
+    with workers.parallel_section():
+        assert blas_threads() and set(blas_threads()) == {1}
+    assert blas_threads() == before
+
+
 @pytest.mark.parametrize("method", ["PN", "PHONG"])
 def test_class_path_equals_point_path(method, monkeypatch):
     mesh = sharp_mesh(2)

@@ -26,7 +26,7 @@ PLATFORMS = {
     "macos-x64": ["macosx_15_0_x86_64"],
 }
 BINARY = ("pyopencl", "siphash24")
-PURE = ("pytools", "platformdirs", "typing_extensions")
+PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl")
 IGNORE = shutil.ignore_patterns(".git", ".venv", "out", "dist", "wheels", "__pycache__", ".pytest_cache",
                                 ".ruff_cache", ".hypothesis", "*.zip")
 

@@ -1,6 +1,9 @@
 // Weighted gather: out[r, c] = sum_q w[r, q] * values[idx[r, q], c]
 // values: (K, channels) float32; idx: (n, taps) int32; w: (n, taps) float32; out: (n, channels) float32.
 // One work item per output row; the numpy reference is kernels.interpolate.gather_weighted_numpy.
+// No contraction into fused multiply-adds: every product is rounded, so rows whose weights are a permutation of
+// each other over the same values (the two faces of an edge) sum to the same bits.
+#pragma OPENCL FP_CONTRACT OFF
 
 __kernel void gather_weighted(__global const float *values, const int channels,
                               __global const int *idx, __global const float *w, const int taps,
