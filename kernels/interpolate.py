@@ -106,7 +106,7 @@ def corner_values(ref, values, backend="auto"):
     source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)  # (M, 3) source corners
     idx = np.repeat(source, 3, axis=0)  # one row per output corner
     out = gather_weighted(flat, idx, ref.corner_bary.reshape(-1, 3), backend)
-    return out.reshape((len(ref.triangles), 3) + values.shape[2:])
+    return out.reshape((ref.n_triangles, 3) + values.shape[2:])
 
 
 def _slot_values(ref, cls, values):
@@ -151,14 +151,16 @@ def _corner_values_by_class(ref, values):
     tail = values.shape[2:]
     if len(ref.classes) == 1:
         cls = ref.classes[0]
-        return stamp(_slot_values(ref, cls, flat), cls.triangles.ravel()).reshape((len(ref.triangles), 3) + tail)
-    counts = np.bincount(ref.triangle_face, minlength=n_faces)
+        return stamp(_slot_values(ref, cls, flat), cls.triangles.ravel()).reshape((ref.n_triangles, 3) + tail)
+    counts = np.zeros(n_faces, np.int64)
+    for cls in ref.classes:
+        counts[cls.faces] = len(cls.triangles)
     starts = np.cumsum(counts) - counts
-    out = np.empty((len(ref.triangles), 3, flat.shape[2]), dtype=np.float32)
+    out = np.empty((ref.n_triangles, 3, flat.shape[2]), dtype=np.float32)
     for cls in ref.classes:
         block = stamp(_slot_values(ref, cls, flat), cls.triangles.ravel())
         scatter_rows(out, cls, starts, block.reshape(len(cls.faces), -1, 3, flat.shape[2]))
-    return out.reshape((len(ref.triangles), 3) + tail)
+    return out.reshape((ref.n_triangles, 3) + tail)
 
 
 def face_values(ref, values):

@@ -26,6 +26,7 @@ OpenGL terms, local edge 0 (v0-v1) is ``gl_TessLevelOuter[2]``, edge 1 (v1-v2) i
 (v2-v0) is ``[1]``.
 """
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +35,8 @@ from . import refine_templates
 from .errors import InvalidInputError
 from .partition import clamp_levels, point_params, segment_counts
 from .topology import ragged, triangle_edges, validate_triangles
+
+_LAZY_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -57,6 +60,7 @@ class Refinement:
     edge_level, edge_segments: (E,) float64 clamped level and int64 segment count of each edge.
     inner_level, inner_segments: (T,) float64 and int64, the same for each face's interior.
     interior_counts: (T,) int64 interior points of each face (they are stored contiguously, face by face).
+    n_triangles: M, the number of output triangles.
     """
 
     n_corners: int
@@ -64,15 +68,15 @@ class Refinement:
     edges: np.ndarray
     edge_point_edge: np.ndarray
     edge_point_t: np.ndarray
-    triangles: np.ndarray
-    triangle_face: np.ndarray
     spacing: str
     edge_level: np.ndarray
     edge_segments: np.ndarray
     inner_level: np.ndarray
     inner_segments: np.ndarray
     interior_counts: np.ndarray
-    #: ``interior_face``, ``interior_bary``, ``corner_bary``: arrays, or callables that build them on first use.
+    n_triangles: int
+    #: ``triangles``, ``triangle_face``, ``interior_face``, ``interior_bary``, ``corner_bary`` (and
+    #: ``output_edges``): arrays, or callables that build them on first use (once, also across threads).
     lazy: dict = field(default_factory=dict, repr=False, compare=False)
     #: (T, 3) int32 mesh edge and (T, 3) bool direction flag of each face's local edges (`triangle_edges`).
     face_edges: np.ndarray | None = None
@@ -84,8 +88,21 @@ class Refinement:
     def _get(self, name):
         value = self.lazy[name]
         if callable(value):
-            value = self.lazy[name] = value()
+            with _LAZY_LOCK:
+                lock = self.lazy.setdefault(("lock", name), threading.Lock())
+            with lock:
+                value = self.lazy[name]
+                if callable(value):
+                    value = self.lazy[name] = value()
         return value
+
+    @property
+    def triangles(self):
+        return self._get("triangles")
+
+    @property
+    def triangle_face(self):
+        return self._get("triangle_face")
 
     @property
     def interior_face(self):
@@ -234,17 +251,18 @@ def _refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacin
         edges=edges,
         edge_point_edge=point_edge.astype(np.int32),
         edge_point_t=edge_point_t,
-        triangles=vertex_id[tri_rv].astype(np.int32),
-        triangle_face=vertex_face[tri_rv[:, 0]].astype(np.int32),
         spacing=spacing,
         edge_level=edge_f,
         edge_segments=edge_n,
         inner_level=inner_f,
         inner_segments=inner_n,
         interior_counts=_interior_counts(inner_n),
+        n_triangles=len(tri_rv),
         face_edges=face_edges,
         flipped=flipped,
-        lazy={"interior_face": vertex_face[interior].astype(np.int32), "interior_bary": vertex_bary[interior],
+        lazy={"triangles": vertex_id[tri_rv].astype(np.int32),
+              "triangle_face": vertex_face[tri_rv[:, 0]].astype(np.int32),
+              "interior_face": vertex_face[interior].astype(np.int32), "interior_bary": vertex_bary[interior],
               "corner_bary": vertex_bary[tri_rv]},
     )
 

@@ -215,29 +215,33 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     tri_start = np.cumsum(tri_counts) - tri_counts
     n_out = int(tri_counts.sum())
 
-    pattern_classes_, triangles = [], None
+    pattern_classes_ = []
     for f0, faces in zip(first, group_by_class(inverse, len(first)), strict=True):
         pat, slot_edge, slot_j = _lone_pattern(outer_f[f0], outer_n[f0], inner_f[f0], inner_n[f0], spacing)
-        cls = PatternClass(faces=faces, triangles=pat.triangles.astype(np.int32), slot_edge=slot_edge,
-                           slot_j=slot_j, interior_bary=pat.interior_bary, corner_bary=pat.corner_bary,
-                           outer_n=outer_n[f0].astype(np.int64))
-        pattern_classes_.append(cls)
-        n_edge_slots, n_interior = len(slot_edge), int(interior_counts[f0])
-        table = np.empty((len(faces), 3 + n_edge_slots + n_interior), np.int32)  # vertex id of each slot
-        table[:, :3] = tris[faces]
-        if n_edge_slots:
-            e = face_edges[faces][:, slot_edge]  # (F, slots) mesh edge of each slot
-            n_e = cls.outer_n[slot_edge]
-            canonical = np.where(flipped[faces][:, slot_edge], n_e - slot_j, slot_j)
-            table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
-        table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(n_interior)
-        stamped = stamp(table, cls.triangles.ravel())  # (F, Mt * 3)
-        if len(faces) == len(tris):  # one class: the stamped block is the output
-            triangles = stamped.reshape(-1, 3)
-        else:
-            triangles = np.empty((n_out, 3), np.int32) if triangles is None else triangles
-            scatter_rows(triangles, cls, tri_start, stamped.reshape(len(faces), -1, 3))
+        pattern_classes_.append(PatternClass(
+            faces=faces, triangles=pat.triangles.astype(np.int32), slot_edge=slot_edge, slot_j=slot_j,
+            interior_bary=pat.interior_bary, corner_bary=pat.corner_bary, outer_n=outer_n[f0].astype(np.int64)))
     pattern_classes_ = tuple(pattern_classes_)
+
+    def triangles():
+        out = None
+        for cls in pattern_classes_:
+            faces, n_edge_slots = cls.faces, len(cls.slot_edge)
+            n_interior = int(interior_counts[faces[0]])
+            table = np.empty((len(faces), 3 + n_edge_slots + n_interior), np.int32)  # vertex id of each slot
+            table[:, :3] = tris[faces]
+            if n_edge_slots:
+                e = face_edges[faces][:, cls.slot_edge]  # (F, slots) mesh edge of each slot
+                n_e = cls.outer_n[cls.slot_edge]
+                canonical = np.where(flipped[faces][:, cls.slot_edge], n_e - cls.slot_j, cls.slot_j)
+                table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
+            table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(n_interior)
+            stamped = stamp(table, cls.triangles.ravel())  # (F, Mt * 3)
+            if len(faces) == len(tris):  # one class: the stamped block is the output
+                return stamped.reshape(-1, 3)
+            out = np.empty((n_out, 3), np.int32) if out is None else out
+            scatter_rows(out, cls, tri_start, stamped.reshape(len(faces), -1, 3))
+        return out
 
     def interior_bary():
         out = np.empty((int(interior_counts.sum()), 3))
@@ -257,16 +261,18 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     def output_edges():
         per_class = [(cls.faces, *_template_edges(cls)) for cls in pattern_classes_]
         return _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, per_class,
-                             triangles, tri_start)
+                             ref.triangles, tri_start)
 
     n_faces = len(tris)
-    return core.Refinement(
+    ref = core.Refinement(
         n_corners=int(n_vertices), faces=tris, edges=edges,
-        edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t,
-        triangles=triangles, triangle_face=np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts),
-        spacing=spacing, edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
-        interior_counts=interior_counts, face_edges=face_edges, flipped=flipped,
-        lazy={"interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
+        edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t, spacing=spacing,
+        edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
+        interior_counts=interior_counts, n_triangles=n_out, face_edges=face_edges, flipped=flipped,
+        lazy={"triangles": triangles,
+              "triangle_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts),
+              "interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
               "interior_bary": interior_bary, "corner_bary": corner_bary, "output_edges": output_edges},
         face_class=inverse, classes=pattern_classes_,
     )
+    return ref

@@ -19,33 +19,23 @@ from .topology import group_by_class, ragged
 MAX_CLASSES = 256
 #: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
 CHUNK = 1 << 16
-#: Values per float64 product on the class path (keeps the temporary in cache before it is rounded).
-CHUNK_VALUES = 1 << 17
+#: Points per chunk on the class path (keeps the float64 temporaries in cache before they are rounded).
+CHUNK_POINTS = 1 << 15
 
 
 def _class_path(n_classes, n_owners):
     return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
 
 
-def _unit_rows(values, channels):
-    """Normalise (n, p * C) float64 rows in place, C channels per point (zero vectors stay zero)."""
-    v = values.reshape(-1, channels)
-    length = v[:, 0] * v[:, 0]
-    for c in range(1, channels):
-        length += v[:, c] * v[:, c]
+def _unit(channels):
+    """Normalise a vector field given as C arrays (one per channel, same shape), in place; zero stays zero."""
+    length = channels[0] * channels[0]
+    for v in channels[1:]:
+        length += v * v
     np.sqrt(length, out=length)
     length[~(length > 0)] = np.inf  # zero length: 0 / inf = 0
-    v /= length[:, None]
-
-
-def _expanded(b, channels):
-    """Basis (p, k) -> (k C, p C) float64 with ``[j C + c, i C + c] = b[i, j]``: control rows (k C,) in
-    (k, C) order times it give values in (p, C) order, so products land contiguously."""
-    p, k = b.shape
-    out = np.zeros((k, channels, p, channels))
-    for c in range(channels):
-        out[:, c, :, c] = b.T
-    return out.reshape(k * channels, p * channels)
+    for v in channels:
+        v /= length
 
 
 def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis, unit=False):
@@ -67,24 +57,28 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         uniq, inverse = np.unique(keys, return_inverse=True)
     channels = control.shape[2]
     if _class_path(len(uniq), len(counts)):
+        planes = [np.ascontiguousarray(control[:, :, c]) for c in range(channels)]  # (K, k) per channel
         for owners in group_by_class(inverse, len(uniq)):
             p = int(counts[owners[0]])
             if p == 0:
                 continue
-            expanded = _expanded(basis(template_of(owners[0], int(starts[owners[0]]))), channels)
-            rows = control.reshape(len(control), -1)
+            basis_t = np.ascontiguousarray(basis(template_of(owners[0], int(starts[owners[0]]))).T)  # (k, p)
             consecutive = owners[-1] - owners[0] + 1 == len(owners)
-            step = max(1, CHUNK_VALUES // (p * channels))
+            step = max(1, CHUNK_POINTS // p)
             for lo in range(0, len(owners), step):
                 chunk = owners[lo : lo + step]
-                vals = (rows[chunk[0] : chunk[-1] + 1] if consecutive else rows[chunk]) @ expanded  # (n, p C)
+                pick = slice(chunk[0], chunk[-1] + 1) if consecutive else chunk
+                vals = [plane[pick] @ basis_t for plane in planes]  # C x (n, p) float64
                 if unit:
-                    _unit_rows(vals, channels)
+                    _unit(vals)
                 if consecutive:
                     at = first + int(starts[chunk[0]])
-                    out[at : at + len(chunk) * p] = vals.reshape(-1, channels)
+                    block = out[at : at + len(chunk) * p].reshape(len(chunk), p, channels)
+                    for c in range(channels):
+                        block[:, :, c] = vals[c]
                 else:
-                    out[(first + starts[chunk][:, None] + np.arange(p)).ravel()] = vals.reshape(-1, channels)
+                    rows = (first + starts[chunk][:, None] + np.arange(p)).ravel()
+                    out[rows] = np.stack([v.ravel() for v in vals], axis=1)
         return
     owner, _, _ = ragged(counts)
     params = all_params()
@@ -93,7 +87,7 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         b = basis(params[lo:hi])
         vals = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
         if unit:
-            _unit_rows(vals, channels)
+            _unit([vals[:, c] for c in range(channels)])
         out[first + lo : first + hi] = vals
 
 

@@ -286,21 +286,26 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
             result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
         ref = refine(source.triangles, len(source.positions), edge_levels, inner_levels, spacing)
         report(0.4)
+        # Four independent parts, longest first, on the two workers (this thread waits).
         attributes = workers.submit(_attributes, ref, source, backend)
         corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
         shading = (positions, vertex_normals, corner_normals, split)
         if surface is not None:
             out_positions, points = surface(ref, inputs)
             normals = workers.submit(_shading_normals, ref, method, options, *shading, points)
+            triangles = workers.submit(lambda: ref.triangles)
         else:
             normals = workers.submit(_shading_normals, ref, method, options, *shading)
+            triangles = workers.submit(lambda: ref.triangles)
             if method == "PN":
-                out_positions = _pn_positions(ref, positions, vertex_normals)
+                out_positions = workers.submit(_pn_positions, ref, positions, vertex_normals)
             else:
-                out_positions = _phong_positions(ref, positions, vertex_normals,
-                                                 options.alpha if alpha is None else alpha)
+                out_positions = workers.submit(_phong_positions, ref, positions, vertex_normals,
+                                               options.alpha if alpha is None else alpha)
+            out_positions = out_positions.result()
         report(0.6)
-        out = MeshArrays(positions=out_positions, triangles=ref.triangles, attribute_types=dict(mesh.attribute_types))
+        out = MeshArrays(positions=out_positions, triangles=triangles.result(),
+                         attribute_types=dict(mesh.attribute_types))
         out.point_normals, out.corner_normals = normals.result()
     report(0.8)
     out.point_attributes, out.corner_attributes, out.face_attributes = attributes.result()
