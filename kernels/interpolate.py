@@ -118,14 +118,13 @@ def _slot_values(ref, cls, values):
     """
     v = values[cls.faces]  # (F, 3, C)
     n_faces, _, channels = v.shape
-    e, j = cls.slot_edge, cls.slot_j
+    e = cls.slot_edge
     p = len(cls.interior_bary)
     out = np.empty((n_faces, 3 + len(e) + p, channels), np.float32)
     out[:, :3] = v
     if len(e):
-        flip = ref.flipped[cls.faces][:, e]  # (F, S)
-        canonical = np.where(flip, cls.outer_n[e] - j, j)
-        t = ref.edge_point_t[ref.edge_point_start[ref.face_edges[cls.faces][:, e]] + canonical - 1]
+        points, flip = cls.edge_points(ref.face_edges, ref.flipped, ref.edge_point_start)  # (F, S) each
+        t = ref.edge_point_t[points]
         # (1 - t) start + t end along the canonical direction, written as weights of the local edge's first and
         # second corner: the same two products and one (commutative) sum, so the same bits from either face.
         w_first, w_second = np.where(flip, t, 1.0 - t), np.where(flip, 1.0 - t, t)
@@ -138,8 +137,8 @@ def _slot_values(ref, cls, values):
             expanded[:, c, :, c] = cls.interior_bary.T
         expanded = expanded.reshape(3 * channels, -1)
         flat = v.reshape(n_faces, -1)
-        for lo in range(0, n_faces, CHUNK_FACES):  # a small float64 product, rounded into place
-            hi = min(n_faces, lo + CHUNK_FACES)
+        for lo in range(0, n_faces, CHUNK_FACES):  # a small float64 product, rounded into place (3x faster than
+            hi = min(n_faces, lo + CHUNK_FACES)  # one product per channel written with a stride)
             out[lo:hi, 3 + len(e) :] = (flat[lo:hi] @ expanded).reshape(hi - lo, p, channels)
     return out
 
@@ -177,15 +176,25 @@ def normalized(vectors):
     float32 input is normalised in float32 (within 2 ulp of unit length); anything else in float64.
     """
     v = np.asarray(vectors)
-    if v.dtype != np.float32:
-        v = v.astype(np.float64)
-    length = v[..., 0] * v[..., 0]
-    length += v[..., 1] * v[..., 1]
-    length += v[..., 2] * v[..., 2]
-    np.sqrt(length, out=length)
-    bad = ~(length > 0)  # zero (or NaN) length: the vector becomes zero
-    length[bad] = 1.0
-    out = v / length[..., None]
-    if bad.any():
-        out[bad] = 0.0
+    out = v.astype(np.float32 if v.dtype == np.float32 else np.float64)  # a copy, normalised in place
+    normalize_channels([out[..., c] for c in range(out.shape[-1])])
     return out.astype(np.float32, copy=False)
+
+
+def normalize_channels(channels):
+    """Normalise a vector field given as one array per component (same shapes), in place.
+
+    Working per component keeps every operation on long runs of memory. Vectors of zero (or NaN) length
+    become zero.
+    """
+    length = channels[0] * channels[0]
+    for v in channels[1:]:
+        length += v * v
+    np.sqrt(length, out=length)
+    bad = ~(length > 0)
+    any_bad = bool(bad.any())
+    length[bad] = 1.0
+    for v in channels:
+        v /= length
+        if any_bad:
+            v[bad] = 0.0

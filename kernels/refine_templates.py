@@ -104,7 +104,7 @@ def _template_edges(pat):
 def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, classes, triangles, tri_start):
     """Edges of the refined mesh and the edge leaving each output corner, from the class patterns.
 
-    classes: per class ``(faces, corner_cols, interior_at)`` (`_template_edges`). Returns ``(edges (K, 2)
+    classes: per class ``(PatternClass, corner_cols, interior_at)`` (`_template_edges`). Returns ``(edges (K, 2)
     int32, corner_edges (M, 3) int32)``: the segments of every input edge (in edge order, canonical direction)
     then each face's interior edges.
     """
@@ -117,14 +117,15 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
         return np.where(q == 0, ends[e, 0], np.where(q == edge_n[e], ends[e, 1], inner))
 
     face_interior = np.zeros(len(tris), np.int64)
-    for faces, _, interior_at in classes:
-        face_interior[faces] = len(interior_at)
+    for cls, _, interior_at in classes:
+        face_interior[cls.faces] = len(interior_at)
     interior_start = n_seg + np.cumsum(face_interior) - face_interior
     out_edges = np.empty((n_seg + int(face_interior.sum()), 2), np.int32)
     out_edges[:n_seg, 0], out_edges[:n_seg, 1] = vertex_at(seg_e, seg_k), vertex_at(seg_e, seg_k + 1)
     corner_edges = np.empty(triangles.shape, np.int32)
     outer_n = edge_n[face_edges]
-    for faces, cols, interior_at in classes:
+    for cls, cols, interior_at in classes:
+        faces = cls.faces
         n = outer_n[faces[0]]
         slot_cols = np.empty((len(faces), int(n.sum()) + len(interior_at)), np.int32)
         start = 0
@@ -141,13 +142,7 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
             k = interior_at % 3
             out_edges[ids.ravel(), 0] = triangles[tri, k].ravel()
             out_edges[ids.ravel(), 1] = triangles[tri, (k + 1) % 3].ravel()
-        mt = len(cols)
-        if faces[-1] - faces[0] + 1 == len(faces):  # consecutive faces: one block of output triangles
-            lo = int(tri_start[faces[0]])
-            block = corner_edges[lo:lo + len(faces) * mt].reshape(len(faces), mt, 3)
-            np.take(slot_cols, cols, axis=1, out=block)
-        else:
-            corner_edges[(tri_start[faces][:, None] + np.arange(mt)).ravel()] = slot_cols[:, cols].reshape(-1, 3)
+        scatter_rows(corner_edges, cls, tri_start, stamp(slot_cols, cols.ravel()).reshape(len(faces), -1, 3))
     return out_edges, corner_edges
 
 
@@ -169,6 +164,17 @@ class PatternClass:
     interior_bary: np.ndarray
     corner_bary: np.ndarray
     outer_n: np.ndarray
+
+    def edge_points(self, face_edges, flipped, point_start):
+        """Where each face's edge slots sit among the refinement's edge points.
+
+        face_edges, flipped: (T, 3) of the mesh; point_start: (E,) offset of each mesh edge's first point.
+        Returns ``(index (F, S) int64 into the edge-point arrays, flip (F, S) bool: the local edge runs against
+        the mesh edge's canonical direction)``.
+        """
+        flip = flipped[self.faces][:, self.slot_edge]
+        canonical = np.where(flip, self.outer_n[self.slot_edge] - self.slot_j, self.slot_j)
+        return point_start[face_edges[self.faces][:, self.slot_edge]] + canonical - 1, flip
 
     @property
     def consecutive(self):
@@ -207,7 +213,6 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     outer_f = edge_f[face_edges]
     point_edge, point_local, point_start = ragged(edge_n - 1)
     edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
-    edge_first = n_vertices + point_start
     interior_counts = core._interior_counts(inner_n)
     interior_start = np.cumsum(interior_counts) - interior_counts
     interior_first = n_vertices + len(point_edge)
@@ -231,10 +236,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
             table = np.empty((len(faces), 3 + n_edge_slots + n_interior), np.int32)  # vertex id of each slot
             table[:, :3] = tris[faces]
             if n_edge_slots:
-                e = face_edges[faces][:, cls.slot_edge]  # (F, slots) mesh edge of each slot
-                n_e = cls.outer_n[cls.slot_edge]
-                canonical = np.where(flipped[faces][:, cls.slot_edge], n_e - cls.slot_j, cls.slot_j)
-                table[:, 3 : 3 + n_edge_slots] = edge_first[e] + canonical - 1
+                table[:, 3 : 3 + n_edge_slots] = n_vertices + cls.edge_points(face_edges, flipped, point_start)[0]
             table[:, 3 + n_edge_slots :] = (interior_first + interior_start[faces])[:, None] + np.arange(n_interior)
             stamped = stamp(table, cls.triangles.ravel())  # (F, Mt * 3)
             if len(faces) == len(tris):  # one class: the stamped block is the output
@@ -259,7 +261,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
         return out
 
     def output_edges():
-        per_class = [(cls.faces, *_template_edges(cls)) for cls in pattern_classes_]
+        per_class = [(cls, *_template_edges(cls)) for cls in pattern_classes_]
         return _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, per_class,
                              ref.triangles, tri_start)
 

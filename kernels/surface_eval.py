@@ -13,6 +13,7 @@ summation order of float64 products (checked in the tests).
 
 import numpy as np
 
+from .interpolate import normalize_channels
 from .topology import group_by_class, ragged
 
 #: Use per-class matrix products when there are at most this many classes, or few per owner.
@@ -25,17 +26,6 @@ CHUNK_POINTS = 1 << 15
 
 def _class_path(n_classes, n_owners):
     return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
-
-
-def _unit(channels):
-    """Normalise a vector field given as C arrays (one per channel, same shape), in place; zero stays zero."""
-    length = channels[0] * channels[0]
-    for v in channels[1:]:
-        length += v * v
-    np.sqrt(length, out=length)
-    length[~(length > 0)] = np.inf  # zero length: 0 / inf = 0
-    for v in channels:
-        v /= length
 
 
 def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis, unit=False):
@@ -70,7 +60,7 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
                 pick = slice(chunk[0], chunk[-1] + 1) if consecutive else chunk
                 vals = [plane[pick] @ basis_t for plane in planes]  # C x (n, p) float64
                 if unit:
-                    _unit(vals)
+                    normalize_channels(vals)
                 if consecutive:
                     at = first + int(starts[chunk[0]])
                     block = out[at : at + len(chunk) * p].reshape(len(chunk), p, channels)
@@ -87,7 +77,7 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         b = basis(params[lo:hi])
         vals = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
         if unit:
-            _unit([vals[:, c] for c in range(channels)])
+            normalize_channels([vals[:, c] for c in range(channels)])
         out[first + lo : first + hi] = vals
 
 

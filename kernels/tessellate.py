@@ -290,19 +290,16 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
         attributes = workers.submit(_attributes, ref, source, backend)
         corner_normals = None if mesh.corner_normals is None else np.asarray(mesh.corner_normals, np.float64)
         shading = (positions, vertex_normals, corner_normals, split)
+        points = None
         if surface is not None:
             out_positions, points = surface(ref, inputs)
-            normals = workers.submit(_shading_normals, ref, method, options, *shading, points)
-            triangles = workers.submit(lambda: ref.triangles)
-        else:
-            normals = workers.submit(_shading_normals, ref, method, options, *shading)
-            triangles = workers.submit(lambda: ref.triangles)
-            if method == "PN":
-                out_positions = workers.submit(_pn_positions, ref, positions, vertex_normals)
-            else:
-                out_positions = workers.submit(_phong_positions, ref, positions, vertex_normals,
-                                               options.alpha if alpha is None else alpha)
-            out_positions = out_positions.result()
+        normals = workers.submit(_shading_normals, ref, method, options, *shading, points)
+        triangles = workers.submit(lambda: ref.triangles)
+        if surface is None and method == "PN":
+            out_positions = workers.submit(_pn_positions, ref, positions, vertex_normals).result()
+        elif surface is None:
+            out_positions = workers.submit(_phong_positions, ref, positions, vertex_normals,
+                                           options.alpha if alpha is None else alpha).result()
         report(0.6)
         out = MeshArrays(positions=out_positions, triangles=triangles.result(),
                          attribute_types=dict(mesh.attribute_types))
