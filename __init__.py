@@ -8,11 +8,11 @@ import importlib
 
 _modules = (
     "addon.preferences",
-    "addon.tube_settings",
-    "addon.displacement_settings",
-    "addon.terrain_settings",
-    "addon.settings",
-    "addon.displacement_maps",
+    "addon.tubes.settings",
+    "addon.displacement.settings",
+    "addon.terrain.settings",
+    "addon.tessellation.settings",
+    "addon.displacement.maps",
     "operators.tessellate",
     "operators.tubes",
     "operators.displacement",
@@ -20,11 +20,11 @@ _modules = (
     "operators.terrain",
     "addon.menus",
     "addon.panels",
-    "addon.tube_preview",
-    "addon.terrain_preview",
-    "addon.patch_preview",
-    "addon.brush_cursor",
-    "addon.brush_tool",
+    "addon.tubes.preview",
+    "addon.terrain.preview",
+    "addon.tessellation.preview",
+    "addon.displacement.brush_cursor",
+    "addon.displacement.brush_tool",
 )
 
 

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from ..kernels.errors import InvalidInputError
-from ..kernels.mesh_arrays import MeshArrays
-from ..kernels.tangent_space import triangle_tangents
+from ..kernels.common.errors import InvalidInputError
+from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.displacement.tangent_space import triangle_tangents
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
 # the number of channels.
@@ -103,7 +103,7 @@ def read_mesh(mesh):
 def corner_tangents(mesh, uv_map):
     """MikkTSpace tangents of UV map ``uv_map`` per loop-triangle corner, as `read_mesh` orders corners:
     (T, 3, 4) float32, the unit tangent (xyz) and bitangent sign (w). Meshes with n-gons, which
-    `Mesh.calc_tangents` refuses, get per-triangle tangents from the UVs (`kernels.tangent_space`)."""
+    `Mesh.calc_tangents` refuses, get per-triangle tangents from the UVs (`kernels.displacement.tangent_space`)."""
     mesh.calc_loop_triangles()
     n_tris = len(mesh.loop_triangles)
     tri_loops = _get(mesh.loop_triangles, "loops", n_tris, np.int32, 3)
@@ -227,7 +227,7 @@ def _restore_active(mesh, info):
 
 
 def write_polygons(name, poly):
-    """Create a `bpy.types.Mesh` from a `kernels.tubes.PolygonMesh` and return it.
+    """Create a `bpy.types.Mesh` from a `kernels.tubes.builder.PolygonMesh` and return it.
 
     Writes edges and corner edges directly when the kernel knows them (no edge computation). Faces are
     smooth except where corner normals differ from the point normal field (FLAT caps: those faces are
@@ -294,7 +294,7 @@ def read_curve_object(ob, radius_scale=1.0):
     radius (x ``radius_scale``) and tilt are the control points' values spread over the evaluated points.
     Returns ``(lines, notes)``.
     """
-    from ..kernels.polylines import Polylines
+    from ..kernels.tubes.polylines import Polylines
 
     data = ob.data.copy()
     probe = bpy.data.objects.new("__tessera_curve_probe", data)
@@ -335,7 +335,7 @@ def read_hair_curves(curves, default_radius):
 
     Radius from the ``radius`` point attribute, or ``default_radius`` where the curves have none.
     """
-    from ..kernels.polylines import Polylines
+    from ..kernels.tubes.polylines import Polylines
 
     n_p, n_c = len(curves.points), len(curves.curves)
     if n_p == 0:

@@ -1,9 +1,9 @@
-"""Cameras from Blender (the scene camera, or the active 3D viewport) as `kernels.camera.Camera`."""
+"""Cameras from Blender (the scene camera, or the active 3D viewport) as `kernels.common.camera.Camera`."""
 
 import numpy as np
 
-from ..kernels.camera import Camera
-from ..kernels.errors import InvalidInputError
+from ..kernels.common.camera import Camera
+from ..kernels.common.errors import InvalidInputError
 
 #: The camera choice of every view-dependent setting (adaptive levels, tube sides, the pixel clamp).
 CAMERA_ITEMS = (

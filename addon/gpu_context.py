@@ -8,7 +8,7 @@ works with Mesa's llvmpipe through EGL on a machine without a GPU.
 
 import bpy
 
-from ..kernels.errors import GPUContextError
+from ..kernels.common.errors import GPUContextError
 
 _ENGINE_ID = "TESSERA_GPU_CONTEXT"
 

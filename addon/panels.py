@@ -2,12 +2,12 @@
 
 import bpy
 
-from . import displace_nodes
-from .brush_tool import draw_brush_settings
-from .settings import draw_settings
-from .terrain_settings import draw_terrain_settings
-from .tube_settings import copy_tube_settings, draw_tube_settings
-from .tube_sources import SOURCE_TYPES
+from .displacement import nodes as displace_nodes
+from .displacement.brush_tool import draw_brush_settings
+from .terrain.settings import draw_terrain_settings
+from .tessellation.settings import draw_settings
+from .tubes.settings import copy_tube_settings, draw_tube_settings
+from .tubes.sources import SOURCE_TYPES
 
 
 class _Sidebar:

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..kernels import opencl_runtime
+from ..kernels.common import opencl_runtime
 
 BASE_PACKAGE = __package__.rpartition(".")[0]
 

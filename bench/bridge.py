@@ -25,7 +25,7 @@ def main():
     import_path()
     import bpy
     from tessera.addon import bridge
-    from tessera.kernels.mesh_arrays import MeshArrays
+    from tessera.kernels.common.mesh_arrays import MeshArrays
 
     pos, tris = grid(708)  # 1,002,528 triangles
     uv = pos[tris][:, :, :2] / 708.0

@@ -17,10 +17,10 @@ import numpy as np
 from _setup import best_of, import_path
 
 import_path()
-from tessera.kernels.map_buffer import MapBuffer  # noqa: E402
-from tessera.kernels.map_edit import apply_dab, smooth_map  # noqa: E402
-from tessera.kernels.map_strokes import Brush, TileUndo, run_stroke  # noqa: E402
-from tessera.kernels.opencl_runtime import get_runtime  # noqa: E402
+from tessera.kernels.common.opencl_runtime import get_runtime  # noqa: E402
+from tessera.kernels.displacement.map_buffer import MapBuffer  # noqa: E402
+from tessera.kernels.displacement.map_edit import apply_dab, smooth_map  # noqa: E402
+from tessera.kernels.displacement.map_strokes import Brush, TileUndo, run_stroke  # noqa: E402
 
 RADII = (16, 64, 256)
 

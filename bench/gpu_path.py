@@ -42,7 +42,8 @@ def measure(mod, base, level, vp, frame):
     """One output size: preview and applied-mesh frames and bytes (see the module docstring)."""
     from gpu_extras.batch import batch_for_shader
 
-    tess, preview, offscreen = mod("kernels.tessellate"), mod("gpu_shaders.patch_preview"), mod("gpu_shaders.offscreen")
+    tess = mod("kernels.tessellation.tessellate")
+    preview, offscreen = mod("gpu_shaders.tessellation.draw"), mod("gpu_shaders.offscreen")
     edge = tess.uniform_levels(base, level)
     inputs = tess.surface_inputs(base, edge, "PN", tess.SurfaceOptions())
     data = preview.PatchDrawData(inputs, "PN")
@@ -86,7 +87,7 @@ def main():
     import gpu
 
     renderer = mod("addon.gpu_context").ensure_gpu_context()
-    tess, camera = mod("kernels.tessellate"), mod("kernels.camera")
+    tess, camera = mod("kernels.tessellation.tessellate"), mod("kernels.common.camera")
     bpy.ops.mesh.primitive_monkey_add()
     ob = bpy.context.active_object
     for poly in ob.data.polygons:

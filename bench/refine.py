@@ -14,9 +14,9 @@ from bench_meshes import grid
 
 def main():
     import_path()
-    from tessera.kernels.interpolate import point_values
-    from tessera.kernels.refine import refine
-    from tessera.kernels.topology import triangle_edges
+    from tessera.kernels.common.topology import triangle_edges
+    from tessera.kernels.tessellation.interpolate import point_values
+    from tessera.kernels.tessellation.refine import refine
 
     pos, tris = grid(224)  # 100,352 triangles
     edges, _, _ = triangle_edges(tris)

@@ -23,14 +23,14 @@ import numpy as np
 from _setup import import_path
 
 import_path()
-from tessera.kernels import heightmap_io as hio  # noqa: E402
-from tessera.kernels import terrain_opencl  # noqa: E402
-from tessera.kernels.camera import Camera  # noqa: E402
-from tessera.kernels.opencl_runtime import get_runtime  # noqa: E402
-from tessera.kernels.terrain_analysis import ham, tile_table  # noqa: E402
-from tessera.kernels.terrain_lod import TerrainLod, select  # noqa: E402
-from tessera.kernels.terrain_mesh import triangle_count  # noqa: E402
-from tessera.kernels.terrain_synth import ridged_terrain  # noqa: E402
+from tessera.kernels.common.camera import Camera  # noqa: E402
+from tessera.kernels.common.opencl_runtime import get_runtime  # noqa: E402
+from tessera.kernels.terrain import heightmap_io as hio  # noqa: E402
+from tessera.kernels.terrain import opencl_path as terrain_opencl  # noqa: E402
+from tessera.kernels.terrain.analysis import ham, tile_table  # noqa: E402
+from tessera.kernels.terrain.lod import TerrainLod, select  # noqa: E402
+from tessera.kernels.terrain.mesh import triangle_count  # noqa: E402
+from tessera.kernels.terrain.synth import ridged_terrain  # noqa: E402
 
 SIZE = 4097
 MODES = {"uniform_64": TerrainLod(mode="UNIFORM", culling=False),

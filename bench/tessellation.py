@@ -1,7 +1,7 @@
 """PN / Phong tessellation against Blender's Subdivision Surface modifier (OpenSubdiv), in one run.
 
 Cases on a smooth-shaded Suzanne (968 triangles):
-- ``kernel``: `kernels.tessellate.tessellate` (refinement, positions, unit normals, welded triangles) at a
+- ``kernel``: `kernels.tessellation.tessellate.tessellate` (refinement, positions, unit normals, welded triangles) at a
   uniform level whose output is about one million triangles, for PN and Phong; baseline: the modifier
   evaluated to about the same triangle count (level 5), rates compared in triangles per second.
 - ``floor``: writing the kernel's output arrays once (positions, normals, triangles, UVs) into preallocated
@@ -88,7 +88,7 @@ def main():
     import_path()
     import bpy
     from tessera.addon import bridge
-    from tessera.kernels.tessellate import tessellate, uniform_levels
+    from tessera.kernels.tessellation.tessellate import tessellate, uniform_levels
 
     ob = suzanne(bpy)
     arrays, _ = bridge.read_mesh(ob.data)

@@ -1,7 +1,7 @@
 """Tubes against geometry nodes Curve to Mesh (circle profile) at the same output size, in one run.
 
 Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M vertices, 24.8 M quads.
-- ``kernel_opencl`` / ``kernel_numpy``: `kernels.tubes.build_tubes` (frames, rings, normals, quads, edges;
+- ``kernel_opencl`` / ``kernel_numpy``: `kernels.tubes.builder.build_tubes` (frames, rings, normals, quads, edges;
   OpenCL on PoCL, or the numpy reference) against evaluating a
   Curve to Mesh modifier on a poly hair-curves object with the same points (Blender builds the mesh with
   its own minimum-twist normals, multithreaded). Ratio > 1: Tessera is faster.
@@ -94,8 +94,8 @@ def geometry_nodes(bpy, ob, copy_mesh):
 
 
 def kernel_case(pts, backend):
-    from tessera.kernels.polylines import Polylines
-    from tessera.kernels.tubes import TubeSettings, build_tubes
+    from tessera.kernels.tubes.builder import TubeSettings, build_tubes
+    from tessera.kernels.tubes.polylines import Polylines
 
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
     settings = TubeSettings(sides=SIDES, caps="NONE", uvs=False)
@@ -122,8 +122,8 @@ def operator_case(bpy, ob):
 
 def write_case(bpy, pts):
     from tessera.addon.bridge import write_polygons
-    from tessera.kernels.polylines import Polylines
-    from tessera.kernels.tubes import TubeSettings, build_tubes
+    from tessera.kernels.tubes.builder import TubeSettings, build_tubes
+    from tessera.kernels.tubes.polylines import Polylines
 
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
     poly = build_tubes(lines, TubeSettings(sides=SIDES, caps="NONE", uvs=False))
@@ -138,8 +138,8 @@ def write_case(bpy, pts):
 
 
 def preview_case(pts):
-    from tessera.gpu_shaders.tube_preview import patch_table, section_order
-    from tessera.kernels.polylines import Polylines
+    from tessera.gpu_shaders.tubes.draw import patch_table, section_order
+    from tessera.kernels.tubes.polylines import Polylines
 
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=RADIUS)
     sections = len(section_order(lines)) * 48
@@ -154,8 +154,8 @@ MEMORY_CHILD = """
 import resource, sys
 sys.path.insert(0, sys.argv[1])
 import numpy as np
-from tessera.kernels.polylines import Polylines
-from tessera.kernels.tubes import TubeSettings, build_tubes
+from tessera.kernels.tubes.polylines import Polylines
+from tessera.kernels.tubes.builder import TubeSettings, build_tubes
 count, points = 1_000_000, 32
 rng = np.random.default_rng(1)
 pts = rng.normal(scale=0.02, size=(count, points, 3)).cumsum(axis=1).reshape(-1, 3)

@@ -12,11 +12,11 @@ import hashlib
 
 import bpy
 
-from ..addon.displacement_maps import channels_for, commit, map_state
-from ..kernels.errors import TesseraError
-from ..kernels.map_edit import apply_custom, compile_custom
-from ..kernels.map_strokes import TileUndo
-from ..kernels.opencl_runtime import get_runtime
+from ..addon.displacement.maps import channels_for, commit, map_state
+from ..kernels.common.errors import TesseraError
+from ..kernels.common.opencl_runtime import get_runtime
+from ..kernels.displacement.map_edit import apply_custom, compile_custom
+from ..kernels.displacement.map_strokes import TileUndo
 
 _trusted_sources = set()  # sha256 of sources the user confirmed in this session
 stats = {"compiled": 0}  # how many custom kernels were compiled in this session (tests check load runs none)

@@ -12,13 +12,13 @@ import bpy
 import mathutils
 import numpy as np
 
-from ..addon import displace_nodes
-from ..addon.brush_cursor import draw_ring, mouse_hit, texel
-from ..addon.displacement_maps import StrokeSession, channels_for, map_state, sync_modifier
-from ..addon.displacement_settings import MODE_ITEMS, SPACE_ITEMS
-from ..kernels.errors import TesseraError
-from ..kernels.map_io import read_map, write_map
-from ..kernels.map_strokes import Brush
+from ..addon.displacement import nodes as displace_nodes
+from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
+from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
+from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS
+from ..kernels.common.errors import TesseraError
+from ..kernels.displacement.map_io import read_map, write_map
+from ..kernels.displacement.map_strokes import Brush
 
 _LIVE_INTERVAL = 0.05  # seconds between image updates while painting
 
@@ -31,7 +31,7 @@ def _map_object(context):
 
 
 def kernel_brush(b, channels):
-    """`kernels.map_strokes.Brush` from ``Scene.tessera_brush``."""
+    """`kernels.displacement.map_strokes.Brush` from ``Scene.tessera_brush``."""
     vector = (*b.direction, 0.0) if channels > 1 else (0.0, 0.0, 1.0, 0.0)
     params = {"falloff": b.falloff, "vector": vector, "cell": b.noise_cell, "seed": b.noise_seed}
     if b.kind == "TEST":

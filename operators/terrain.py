@@ -5,13 +5,13 @@ import time
 
 import bpy
 
-from ..addon import terrain_data
 from ..addon.cameras import camera_for, object_camera
 from ..addon.preferences import get_preferences
-from ..addon.terrain_settings import copy_terrain_settings, draw_terrain_settings, lod_settings, terrain_annotations
-from ..kernels.errors import BudgetError, InvalidInputError, TesseraError
-from ..kernels.terrain_lod import select
-from ..kernels.terrain_mesh import bake, triangle_count
+from ..addon.terrain import data as terrain_data
+from ..addon.terrain.settings import copy_terrain_settings, draw_terrain_settings, lod_settings, terrain_annotations
+from ..kernels.common.errors import BudgetError, InvalidInputError, TesseraError
+from ..kernels.terrain.lod import select
+from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
 
 #: Blender memory per output triangle (vertex share, 3 corners, edges, face, UVs), for the memory guard.

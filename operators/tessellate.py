@@ -7,7 +7,7 @@ from ..addon import bridge
 from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
 from ..addon.preferences import get_preferences
-from ..addon.settings import (
+from ..addon.tessellation.settings import (
     adaptive_settings,
     copy_settings,
     draw_settings,
@@ -15,9 +15,9 @@ from ..addon.settings import (
     setting_annotations,
     surface_options,
 )
-from ..kernels.adaptive import adaptive_levels
-from ..kernels.errors import GPUContextError, TesseraError
-from ..kernels.tessellate import check_budget, estimate, tessellate, uniform_levels
+from ..kernels.common.errors import GPUContextError, TesseraError
+from ..kernels.tessellation.adaptive import adaptive_levels
+from ..kernels.tessellation.tessellate import check_budget, estimate, tessellate, uniform_levels
 from .selection import select_only
 
 
@@ -128,7 +128,7 @@ class TESSERA_OT_tessellate(bpy.types.Operator):
         except GPUContextError as err:
             notes.append(f"No GPU for the compute path ({err}); evaluated on the CPU")
             return None
-        from ..gpu_shaders.patch_preview import evaluate_on_gpu
+        from ..gpu_shaders.tessellation.draw import evaluate_on_gpu
 
         method, alpha, quadratic = self.method, self.alpha, self.pn_normals == "QUADRATIC"
         return lambda ref, inputs: evaluate_on_gpu(ref, inputs, method, alpha, quadratic)

@@ -5,10 +5,10 @@ import bpy
 from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.preferences import get_preferences
-from ..addon.tube_settings import copy_tube_settings, draw_tube_settings, kernel_settings, tube_annotations
-from ..addon.tube_sources import SOURCE_TYPES, read_lines
-from ..kernels.errors import BudgetError, TesseraError
-from ..kernels.tubes import build_tubes
+from ..addon.tubes.settings import copy_tube_settings, draw_tube_settings, kernel_settings, tube_annotations
+from ..addon.tubes.sources import SOURCE_TYPES, read_lines
+from ..kernels.common.errors import BudgetError, TesseraError
+from ..kernels.tubes.builder import build_tubes
 from .selection import select_only
 
 # output bytes per vertex (position, normal) and per corner (vertex, edge, UV) plus per edge, for the memory guard

@@ -282,7 +282,7 @@ def build_terrain_scene(size=1025):
 def _synth():
     import importlib
 
-    return importlib.import_module("bl_ext.tessera_demo.tessera.kernels.terrain_synth")
+    return importlib.import_module("bl_ext.tessera_demo.tessera.kernels.terrain.synth")
 
 
 def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
@@ -292,8 +292,8 @@ def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
 
     package = "bl_ext.tessera_demo.tessera"
     mods = {n: __import__(f"{package}.{n}", fromlist=["x"]) for n in (
-        "addon.gpu_context", "addon.bridge", "kernels.adaptive", "kernels.camera", "kernels.tessellate",
-        "gpu_shaders.patch_preview", "gpu_shaders.offscreen")}
+        "addon.gpu_context", "addon.bridge", "kernels.tessellation.adaptive", "kernels.common.camera",
+        "kernels.tessellation.tessellate", "gpu_shaders.tessellation.draw", "gpu_shaders.offscreen")}
     mods["addon.gpu_context"].ensure_gpu_context()
     clear_scene()
     bpy.ops.mesh.primitive_monkey_add()
@@ -301,9 +301,10 @@ def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
     for poly in ob.data.polygons:
         poly.use_smooth = True
     arrays, _ = mods["addon.bridge"].read_mesh(ob.data)
-    tess, adaptive, preview = mods["kernels.tessellate"], mods["kernels.adaptive"], mods["gpu_shaders.patch_preview"]
-    cam = mods["kernels.camera"].Camera.looking_at((0.0, -6.4, 0.7), (0.0, 0.0, 0.0), fov_deg=40, width=size[0],
-                                                   height=size[1], far=100)
+    tess, adaptive = mods["kernels.tessellation.tessellate"], mods["kernels.tessellation.adaptive"]
+    preview = mods["gpu_shaders.tessellation.draw"]
+    cam = mods["kernels.common.camera"].Camera.looking_at((0.0, -6.4, 0.7), (0.0, 0.0, 0.0), fov_deg=40,
+                                                          width=size[0], height=size[1], far=100)
     settings = adaptive.AdaptiveSettings(metrics=("PROJECTED",), max_level=10, edge_pixels=16.0)
     v, u = np.mgrid[0:512, 0:512] / 512.0
     bumps = np.zeros((512, 512, 4), np.float32)

@@ -102,7 +102,7 @@ def clean_scene(bpy_module, addon):
 @pytest.fixture(scope="session")
 def gpu_renderer(addon_module):
     """Create a GPU context (background mode) and return the renderer string."""
-    errors = addon_module("kernels.errors")
+    errors = addon_module("kernels.common.errors")
     try:
         return addon_module("addon.gpu_context").ensure_gpu_context()
     except errors.GPUContextError as err:
@@ -112,8 +112,8 @@ def gpu_renderer(addon_module):
 @pytest.fixture(scope="session")
 def opencl():
     """The OpenCL runtime (PoCL in CI), required."""
-    from tessera.kernels import opencl_runtime
-    from tessera.kernels.errors import OpenCLUnavailableError
+    from tessera.kernels.common import opencl_runtime
+    from tessera.kernels.common.errors import OpenCLUnavailableError
 
     opencl_runtime.configure(mode="require")
     try:

@@ -1,0 +1,81 @@
+"""Live terrain preview in the 3D viewport: terrain objects with ``tessera.terrain.preview`` are drawn on the GPU.
+
+The height map is uploaded once per object (until its source settings change); levels are selected again
+only when the view changes (numpy, a few milliseconds for 65k tiles), and only the tile table of the new
+selection is uploaded. The preview is drawn even while the object itself is hidden, so the baked mesh can be
+hidden during a fly-through. Nothing is drawn or compiled in background mode.
+"""
+
+import bpy
+import numpy as np
+
+from ...kernels.common.camera import Camera
+from ...kernels.common.errors import TesseraError
+from ...kernels.terrain.lod import select
+from ..viewport import add_handlers, new_state, remove_handlers, tag_view3d_redraw
+from . import data as terrain_data
+from .settings import lod_settings, source_key
+
+_state = new_state()
+
+
+def settings_changed(ob):
+    """Forget ``ob``'s selection (and its upload when the source changed) and redraw (property update)."""
+    if isinstance(ob, bpy.types.Object):
+        entry = _state["cache"].get(ob.name)
+        if entry is not None and entry["source"] != source_key(ob.tessera.terrain):
+            _state["cache"].pop(ob.name, None)
+        elif entry is not None:
+            entry["view"] = None
+        _state["errors"].pop(ob.name, None)
+    tag_view3d_redraw()
+
+
+def entry_for(ob):
+    """Cached GPU data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
+    from ...gpu_shaders.terrain.draw import TerrainDrawData
+
+    cache = _state["cache"]
+    if ob.name not in cache and ob.name not in _state["errors"]:
+        try:
+            hm, table = terrain_data.analysis(ob)
+        except TesseraError as err:
+            _state["errors"][ob.name] = str(err)
+            return None
+        cache[ob.name] = {"source": source_key(ob.tessera.terrain), "view": None,
+                          "draw": TerrainDrawData(hm, table)}
+    return cache.get(ob.name)
+
+
+def update_view(ob, entry, view, projection, width, height):
+    """Re-select levels when the view (or a setting) changed; returns True when it did."""
+    model = np.array(ob.matrix_world)
+    key = (view @ model).tobytes() + np.asarray(projection).tobytes() + bytes((width % 256, height % 256))
+    if entry["view"] == key:
+        return False
+    draw = entry["draw"]
+    camera = Camera(view @ model, projection, width, height)
+    draw.set_selection(select(draw.hm, draw.table, camera, lod_settings(ob.tessera.terrain)))
+    entry["view"] = key
+    return True
+
+
+def _draw(context, region, view, proj):
+    for ob in context.view_layer.objects:
+        s = ob.tessera.terrain
+        if not (s.is_terrain and s.preview):
+            continue
+        entry = entry_for(ob)
+        if entry is None:
+            continue
+        update_view(ob, entry, view, proj, region.width, region.height)
+        entry["draw"].draw(proj @ view @ np.array(ob.matrix_world))
+
+
+def register():
+    add_handlers(_state, _draw)
+
+
+def unregister():
+    remove_handlers(_state)
+    terrain_data.forget()

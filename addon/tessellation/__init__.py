@@ -1,0 +1,2 @@
+"""Tessellation in Blender: `settings` (the options shared by the operator and ``Object.tessera.tessellate``),
+`preview` (the live GPU preview, seed 001 §5 done with instanced patterns) and `panel`."""

@@ -1,0 +1,212 @@
+"""Tessellation settings: one set of properties shared by the operator (redo panel) and the object.
+
+The same annotations define `TESSERA_PG_tessellate` (stored on every object as ``Object.tessera.tessellate``,
+so a batch script can re-run what the artist chose) and the properties of ``tessera.tessellate``.
+`copy_settings` moves values between the two; `surface_options` and `adaptive_settings` turn either
+into the kernels' dataclasses.
+"""
+
+import bpy
+
+from ...kernels.common.partition import MAX_LEVEL
+from ...kernels.tessellation.adaptive import AdaptiveSettings
+from ...kernels.tessellation.tessellate import SurfaceOptions
+from ..cameras import CAMERA_ITEMS
+from ..displacement.settings import TESSERA_PG_displacement
+from ..terrain.settings import TESSERA_PG_terrain
+from ..tubes.settings import TESSERA_PG_tubes
+
+METHOD_ITEMS = (
+    ("PN", "PN Triangles", "Cubic Bézier patches from positions and normals (smoothest; Vlachos et al.)"),
+    ("PHONG", "Phong", "Phong tessellation: quadratic, cheapest curved surface (Boubekeur and Alexa)"),
+    ("LINEAR", "Linear", "New vertices on the flat triangles: same shape, more vertices"),
+)
+LEVEL_MODE_ITEMS = (
+    ("UNIFORM", "Uniform", "The same level on every edge"),
+    ("ADAPTIVE", "Adaptive", "Per-edge levels from the chosen metrics (crack-free)"),
+)
+SPACING_ITEMS = (
+    ("EQUAL", "Equal", "Level rounded up to a whole number of equal segments"),
+    ("FRACTIONAL_EVEN", "Fractional Even", "Even segment counts; vertices slide continuously as the level changes"),
+)
+NORMAL_MODE_ITEMS = (
+    ("WATERTIGHT", "Watertight", "Sharp edges stay closed: geometry uses one averaged normal per vertex, "
+     "shading keeps the split normals"),
+    ("SPLIT", "Split", "Geometry follows the split normals: the surface opens along sharp edges"),
+)
+PN_NORMAL_ITEMS = (
+    ("QUADRATIC", "Quadratic", "Quadratic normal patch: shows inflections (folds)"),
+    ("LINEAR", "Linear", "Linearly interpolated normals"),
+)
+METRIC_ITEMS = (
+    ("PROJECTED", "Edge Length", "Split edges longer than a number of pixels on screen"),
+    ("DISTANCE", "Distance", "More levels near the camera"),
+    ("SILHOUETTE", "Silhouette", "Refine edges on the silhouette seen from the camera"),
+    ("CURVATURE", "Curvature", "Refine where the PN control net bends (no camera needed)"),
+)
+POWER_ITEMS = (
+    ("NONE", "None", "Keep levels as computed"),
+    ("CEIL", "Up", "Round up to a power of two (fewer T-junction patterns, more triangles)"),
+    ("FLOOR", "Down", "Round down to a power of two"),
+    ("NEAREST", "Nearest", "Round to the nearest power of two (in log scale)"),
+)
+DISTANCE_MAP_ITEMS = (
+    ("LINEAR", "Linear", "Level falls linearly from near to far"),
+    ("INVERSE", "Inverse", "Level falls like a z-buffer: most detail close to the camera"),
+)
+EVALUATE_ITEMS = (
+    ("CPU", "CPU", "Evaluate the surface with the numpy kernels"),
+    ("GPU", "GPU", "Evaluate the surface with a compute shader (same surface; falls back to the CPU without a GPU)"),
+)
+OUTPUT_ITEMS = (
+    ("NEW_OBJECT", "New Object", "Create a new object beside the source (from the evaluated mesh, with modifiers)"),
+    ("REPLACE", "Replace Mesh", "Replace the object's own mesh data (modifiers stay and apply on top)"),
+)
+
+
+def setting_annotations():
+    props = bpy.props
+    return {
+        "method": props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN"),
+        "level_mode": props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM"),
+        "level": props.FloatProperty(
+            name="Level", description="Segments per edge (and inner level) for every triangle",
+            default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2),
+        "spacing": props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL"),
+        "alpha": props.FloatProperty(
+            name="Shape Factor", description="Phong shape factor: 0 flat, 1 full projection (the seed), 0.75 default",
+            default=0.75, soft_min=0.0, soft_max=1.0, min=-1.0, max=2.0),
+        "alpha_attribute": props.StringProperty(
+            name="Shape Attribute", description="Float point attribute with a per-vertex shape factor (optional)"),
+        "normal_mode": props.EnumProperty(name="Sharp Edges", items=NORMAL_MODE_ITEMS, default="WATERTIGHT"),
+        "pn_normals": props.EnumProperty(name="PN Normals", items=PN_NORMAL_ITEMS, default="QUADRATIC"),
+        "metrics": props.EnumProperty(name="Metrics", items=METRIC_ITEMS, options={"ENUM_FLAG"},
+                                      default={"PROJECTED"}),
+        "max_level": props.FloatProperty(name="Max Level", description="Cap for adaptive levels",
+                                         default=16.0, min=1.0, max=float(MAX_LEVEL)),
+        "power_of_two": props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE"),
+        "edge_pixels": props.FloatProperty(name="Edge Pixels", description="Target edge length on screen",
+                                           default=10.0, min=0.5, soft_max=100.0, subtype="PIXEL"),
+        "distance_map": props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR"),
+        "near": props.FloatProperty(name="Near", description="Distance that gets the maximum level",
+                                    default=1.0, min=1e-4, subtype="DISTANCE", unit="LENGTH"),
+        "far": props.FloatProperty(name="Far", description="Distance beyond which the level is 1",
+                                   default=20.0, min=1e-3, subtype="DISTANCE", unit="LENGTH"),
+        "silhouette_beta": props.FloatProperty(
+            name="Silhouette Ramp", description="How far inside a silhouette triangle extra levels reach (beta)",
+            default=0.25, min=1e-4, max=1.0),
+        "curvature_gain": props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
+                                              default=10.0, min=0.0, soft_max=50.0),
+        "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE"),
+        "evaluate_on": props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU"),
+        "output": props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT"),
+    }
+
+
+SETTING_NAMES = tuple(setting_annotations())
+
+
+def _redraw(self, context):
+    from ..viewport import tag_view3d_redraw
+
+    tag_view3d_redraw()
+
+
+class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
+    __annotations__ = {
+        **setting_annotations(),
+        "stored": bpy.props.BoolProperty(name="Stored", description="These settings were saved by a tessellation run",
+                                         default=False),
+        "preview": bpy.props.BoolProperty(
+            name="Live Preview", default=False, update=_redraw,
+            description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
+                        "view); the object itself can be hidden meanwhile"),
+    }
+
+
+class TESSERA_PG_object(bpy.types.PropertyGroup):
+    tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
+    tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
+    displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
+    terrain: bpy.props.PointerProperty(type=TESSERA_PG_terrain)
+
+
+def copy_settings(source, target):
+    """Copy every tessellation setting from ``source`` to ``target`` (operator or property group)."""
+    for name in SETTING_NAMES:
+        setattr(target, name, getattr(source, name))
+
+
+def surface_options(settings):
+    return SurfaceOptions(alpha=settings.alpha, alpha_attribute=settings.alpha_attribute or None,
+                          normal_mode=settings.normal_mode, pn_normals=settings.pn_normals)
+
+
+def adaptive_settings(settings):
+    order = [m for m, _, _ in METRIC_ITEMS if m in settings.metrics]
+    return AdaptiveSettings(
+        metrics=tuple(order), max_level=settings.max_level, power_of_two=settings.power_of_two,
+        distance_map=settings.distance_map, near=settings.near, far=settings.far,
+        edge_pixels=settings.edge_pixels, silhouette_beta=settings.silhouette_beta,
+        curvature_gain=settings.curvature_gain,
+    )
+
+
+def needs_camera(settings):
+    return settings.level_mode == "ADAPTIVE" and bool(set(settings.metrics) - {"CURVATURE"})
+
+
+def draw_settings(layout, settings, show_output=True):
+    """The settings UI, shared by the sidebar panel and the redo panel."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    layout.prop(settings, "method")
+    if settings.method == "PHONG":
+        layout.prop(settings, "alpha")
+        ob = bpy.context.active_object
+        if ob is not None and ob.type == "MESH":
+            layout.prop_search(settings, "alpha_attribute", ob.data, "attributes", text="Shape Attribute")
+        else:
+            layout.prop(settings, "alpha_attribute")
+    if settings.method == "PN":
+        layout.prop(settings, "pn_normals")
+    if settings.method != "LINEAR":
+        layout.prop(settings, "normal_mode")
+        layout.prop(settings, "evaluate_on")
+    layout.prop(settings, "spacing")
+    layout.prop(settings, "level_mode")
+    if settings.level_mode == "UNIFORM":
+        layout.prop(settings, "level")
+    else:
+        col = layout.column(heading="Metrics")
+        col.prop(settings, "metrics")
+        layout.prop(settings, "max_level")
+        layout.prop(settings, "power_of_two")
+        if "PROJECTED" in settings.metrics:
+            layout.prop(settings, "edge_pixels")
+        if "DISTANCE" in settings.metrics:
+            layout.prop(settings, "distance_map")
+            layout.prop(settings, "near")
+            layout.prop(settings, "far")
+        if "SILHOUETTE" in settings.metrics:
+            layout.prop(settings, "silhouette_beta")
+        if "CURVATURE" in settings.metrics:
+            layout.prop(settings, "curvature_gain")
+        if needs_camera(settings):
+            layout.prop(settings, "camera_source")
+    if show_output:
+        layout.prop(settings, "output")
+
+
+classes = (TESSERA_PG_tessellate, TESSERA_PG_object)
+_register, _unregister = bpy.utils.register_classes_factory(classes)
+
+
+def register():
+    _register()
+    bpy.types.Object.tessera = bpy.props.PointerProperty(type=TESSERA_PG_object)
+
+
+def unregister():
+    del bpy.types.Object.tessera
+    _unregister()

@@ -1,0 +1,124 @@
+"""Tube settings: one set of properties shared by ``tessera.tubes`` (redo panel) and ``Object.tessera.tubes``
+(the viewport preview and batch re-runs). `kernel_settings` turns either into `kernels.tubes.builder.TubeSettings`."""
+
+import math
+
+import bpy
+
+from ...kernels.tubes.builder import TubeSettings
+from ..cameras import CAMERA_ITEMS
+
+RADIUS_ITEMS = (
+    ("POINT", "From Points", "Curves: point radius times Radius (like a bevel); hair: its 'radius' attribute "
+     "(Radius where it has none); mesh edges: Radius"),
+    ("CONSTANT", "Constant", "The same radius everywhere"),
+    ("ATTRIBUTE", "Attribute", "A float point attribute times Radius (hair curves and meshes)"),
+)
+SIDES_ITEMS = (
+    ("FIXED", "Fixed", "The same number of sides on every tube"),
+    ("CAMERA", "Camera", "Sides per tube from its projected size (level of detail)"),
+)
+CAP_ITEMS = (
+    ("NONE", "None", "Open ends"),
+    ("FLAT", "Flat", "One flat face per end (closed, manifold)"),
+    ("ROUND", "Round", "A hemisphere on each end (closed, manifold)"),
+)
+REFINE_ITEMS = (
+    ("CENTRIPETAL", "Centripetal", "Catmull-Rom with centripetal knots: no cusps or loops inside a segment"),
+    ("UNIFORM", "Uniform", "Catmull-Rom with uniform knots (the classic spline)"),
+)
+
+
+def tube_annotations(update=None):
+    """Property definitions; ``update`` (optional) is called when a value changes (the preview refreshes)."""
+    props = bpy.props
+    kw = {"update": update} if update else {}
+    return {
+        "radius_source": props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT", **kw),
+        "radius": props.FloatProperty(name="Radius", description="Radius, or the factor on curve point radii",
+                                      default=0.05, min=0.0, soft_max=10.0, subtype="DISTANCE", **kw),
+        "attribute": props.StringProperty(name="Attribute", description="Float point attribute with the radius",
+                                          default="radius", **kw),
+        "caps": props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT", **kw),
+        "sides_mode": props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED", **kw),
+        "sides": props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64, **kw),
+        "min_sides": props.IntProperty(name="Min Sides", default=3, min=3, max=1024, **kw),
+        "max_sides": props.IntProperty(name="Max Sides", default=32, min=3, max=1024, **kw),
+        "edge_pixels": props.FloatProperty(name="Side Length (px)", description="Target length of a side on screen",
+                                           default=8.0, min=0.5, soft_max=64.0, **kw),
+        "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE", **kw),
+        "aa_clamp": props.BoolProperty(name="Pixel Clamp", default=False, description="Keep every tube at least "
+                                       "one pixel in radius for the camera (thin tubes stay visible far away)", **kw),
+        "max_radius": props.FloatProperty(name="Max Clamp Radius", description="Cap of the clamp's inflation "
+                                          "(0: none)", default=0.0, min=0.0, subtype="DISTANCE", **kw),
+        "refine": props.IntProperty(name="Refine", description="Catmull-Rom segments per input segment (1: off)",
+                                    default=1, min=1, max=64, **kw),
+        "refine_kind": props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL", **kw),
+        "select_angle": props.FloatProperty(name="Angle Tolerance", subtype="ANGLE", default=0.0, min=0.0,
+                                            max=math.pi / 2, description="Keep a point only where the tangent has "
+                                            "turned this much (0: keep all points)", **kw),
+        "uvs": props.BoolProperty(name="UVs", default=True, description="UV map: U along the tube, V around it",
+                                  **kw),
+    }
+
+
+TUBE_SETTING_NAMES = tuple(tube_annotations())
+
+
+def _changed(self, context):
+    from . import preview as tube_preview
+
+    tube_preview.settings_changed(self.id_data)
+
+
+class TESSERA_PG_tubes(bpy.types.PropertyGroup):
+    __annotations__ = {
+        **tube_annotations(_changed),
+        "preview": bpy.props.BoolProperty(name="Preview Tubes", update=_changed, default=False,
+                                          description="Draw this object's tubes in the 3D viewport on the GPU "
+                                                      "(no mesh is made)"),
+    }
+
+
+def copy_tube_settings(source, target):
+    for name in TUBE_SETTING_NAMES:
+        setattr(target, name, getattr(source, name))
+
+
+def kernel_settings(s, aa_clamp=None):
+    return TubeSettings(
+        sides=s.sides, sides_mode=s.sides_mode, min_sides=s.min_sides, max_sides=max(s.min_sides, s.max_sides),
+        edge_pixels=s.edge_pixels, refine=s.refine, refine_kind=s.refine_kind, select_angle=s.select_angle,
+        aa_clamp=s.aa_clamp if aa_clamp is None else aa_clamp, max_radius=s.max_radius, caps=s.caps, uvs=s.uvs)
+
+
+def draw_tube_settings(layout, s):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(s, "radius_source")
+    col.prop(s, "radius")
+    if s.radius_source == "ATTRIBUTE":
+        col.prop(s, "attribute")
+    col.prop(s, "caps")
+    col.prop(s, "sides_mode")
+    if s.sides_mode == "FIXED":
+        col.prop(s, "sides")
+    else:
+        col.prop(s, "min_sides")
+        col.prop(s, "max_sides")
+        col.prop(s, "edge_pixels")
+    col.prop(s, "aa_clamp")
+    if s.aa_clamp:
+        col.prop(s, "max_radius")
+    if s.sides_mode == "CAMERA" or s.aa_clamp:
+        col.prop(s, "camera_source")
+    col.prop(s, "refine")
+    if s.refine > 1:
+        col.prop(s, "refine_kind")
+    col.prop(s, "select_angle")
+    col.prop(s, "uvs")
+
+
+classes = (TESSERA_PG_tubes,)
+register, unregister = bpy.utils.register_classes_factory(classes)

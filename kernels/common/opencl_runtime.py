@@ -1,0 +1,195 @@
+"""OpenCL device selection and program building, with a numpy fallback.
+
+``TESSERA_OPENCL`` selects the mode: ``0`` never uses OpenCL; ``1`` (default) uses it when pyopencl and
+a platform are present and otherwise warns once and falls back to numpy; ``require`` raises
+`OpenCLUnavailableError` instead of falling back. ``TESSERA_OPENCL_DEVICE`` (or the add-on preference)
+is a case-insensitive substring of the wanted device or platform name. Without one, a GPU is preferred.
+
+Programs are read from the ``.cl`` files beside the capability code (``kernels/<capability>/*.cl``, named
+``"<capability>/<file>"``) and built once per context (in-process cache); pyopencl's
+binary cache goes to ``TESSERA_CACHE_DIR`` or ``$XDG_CACHE_HOME/tessera``, never a fixed home path.
+"""
+
+import logging
+import os
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+
+log = logging.getLogger(__name__)
+
+MODES = ("0", "1", "require")
+KERNELS_DIR = Path(__file__).resolve().parents[1]
+
+
+@dataclass
+class _Settings:
+    mode: str | None = None  # None: read TESSERA_OPENCL
+    device: str | None = None  # None: read TESSERA_OPENCL_DEVICE
+    cache_dir: str | None = None  # None: TESSERA_CACHE_DIR or XDG_CACHE_HOME/tessera
+
+
+@dataclass
+class Runtime:
+    """A chosen OpenCL device with its context and queue; builds and caches programs."""
+
+    cl: object  # the pyopencl module
+    context: object
+    queue: object
+    device: object
+    cache_dir: str
+    _programs: dict = field(default_factory=dict)
+    _kernels: dict = field(default_factory=dict)
+
+    @property
+    def description(self):
+        return f"{self.device.platform.name.strip()} / {self.device.name.strip()}"
+
+    def program(self, name, options=()):
+        """Built program for ``kernels/<name>.cl`` (``name`` like ``"tubes/tube_body"``); raises `TesseraError`
+        with the compiler log."""
+        key = (name, tuple(options))
+        if key not in self._programs:
+            source = _read_source(name)
+            try:
+                prg = self.cl.Program(self.context, source).build(options=list(options), cache_dir=self.cache_dir)
+            except self.cl.RuntimeError as err:
+                raise TesseraError(f"OpenCL program {name}.cl failed to build on {self.description}:\n{err}") from err
+            self._programs[key] = prg
+        return self._programs[key]
+
+    def shared(self, host, read_only=False):
+        """A buffer on ``host`` memory (``USE_HOST_PTR``: no copy on a CPU device such as PoCL); ``host`` must
+        stay alive and contiguous until `sync_to_host` (or the queue finishes)."""
+        mf = self.cl.mem_flags
+        return self.cl.Buffer(self.context, (mf.READ_ONLY if read_only else mf.READ_WRITE) | mf.USE_HOST_PTR,
+                              hostbuf=host)
+
+    def sync_to_host(self, pairs):
+        """Wait for the device and make its writes to shared buffers visible: pairs of (buffer, host array)."""
+        for buf, host in pairs:
+            mapped, _ = self.cl.enqueue_map_buffer(self.queue, buf, self.cl.map_flags.READ, 0, host.shape, host.dtype)
+            mapped.base.release(self.queue)
+        self.queue.finish()
+
+    def kernel(self, program, name, options=()):
+        """A kernel object of a program, created once and reused (kernels are not free to retrieve)."""
+        key = (program, name, tuple(options))
+        if key not in self._kernels:
+            self._kernels[key] = self.cl.Kernel(self.program(program, options), name)
+        return self._kernels[key]
+
+
+_settings = _Settings()
+_state = {"resolved": False, "runtime": None, "warned": False}
+_sources = {}
+
+
+def _read_source(name):
+    if name not in _sources:
+        path = KERNELS_DIR / f"{name}.cl"
+        if not path.is_file():
+            raise TesseraError(f"OpenCL source {path.name} is missing from the installation")
+        _sources[name] = path.read_text(encoding="utf-8")
+    return _sources[name]
+
+
+def configure(mode=None, device=None, cache_dir=None):
+    """Set the mode, device preference and cache folder (None: from the environment); resets the choice."""
+    if mode is not None and mode not in MODES:
+        raise TesseraError(f"OpenCL mode must be one of {', '.join(MODES)}; got {mode!r}")
+    _settings.mode, _settings.device, _settings.cache_dir = mode, device, cache_dir
+    _state.update(resolved=False, runtime=None, warned=False)
+
+
+def current_mode():
+    mode = _settings.mode or os.environ.get("TESSERA_OPENCL", "1").strip().lower()
+    if mode not in MODES:
+        raise TesseraError(f"TESSERA_OPENCL must be one of {', '.join(MODES)}; got {mode!r}")
+    return mode
+
+
+def cache_dir():
+    """Folder for compiled-program caches: (str)."""
+    if _settings.cache_dir:
+        return _settings.cache_dir
+    if os.environ.get("TESSERA_CACHE_DIR"):
+        return os.environ["TESSERA_CACHE_DIR"]
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "tessera", "pyopencl")
+
+
+def _pick_device(cl, preference):
+    devices = [d for p in cl.get_platforms() for d in p.get_devices()]
+    if not devices:
+        raise OpenCLUnavailableError("No OpenCL device found (install an ICD, e.g. PoCL: apt install pocl-opencl-icd)")
+    if preference:
+        wanted = preference.lower()
+        for d in devices:
+            if wanted in d.name.lower() or wanted in d.platform.name.lower():
+                return d
+        names = ", ".join(d.name.strip() for d in devices)
+        raise OpenCLUnavailableError(f"No OpenCL device matches {preference!r}; available: {names}")
+    gpus = [d for d in devices if d.type & cl.device_type.GPU]
+    return (gpus or devices)[0]
+
+
+def _create():
+    try:
+        import pyopencl as cl
+    except ImportError as err:
+        raise OpenCLUnavailableError(f"pyopencl is not installed ({err})") from err
+    try:
+        device = _pick_device(cl, _settings.device or os.environ.get("TESSERA_OPENCL_DEVICE"))
+        context = cl.Context([device])
+        queue = cl.CommandQueue(context)
+    except cl.Error as err:
+        raise OpenCLUnavailableError(f"No usable OpenCL platform ({err})") from err
+    folder = cache_dir()
+    os.makedirs(folder, exist_ok=True)
+    return Runtime(cl=cl, context=context, queue=queue, device=device, cache_dir=folder)
+
+
+def get_runtime():
+    """The OpenCL runtime, or None when disabled or unavailable (then numpy is used).
+
+    Raises `OpenCLUnavailableError` only in ``require`` mode. The fallback warning is given once.
+    """
+    mode = current_mode()
+    if mode == "0":
+        return None
+    if not _state["resolved"]:
+        try:
+            _state["runtime"] = _create()
+            log.info("Tessera OpenCL device: %s", _state["runtime"].description)
+        except OpenCLUnavailableError as err:
+            if mode == "require":
+                raise
+            _state["runtime"] = None
+            if not _state["warned"]:
+                _state["warned"] = True
+                warnings.warn(f"Tessera: OpenCL unavailable, using numpy instead. {err}", RuntimeWarning, stacklevel=2)
+        _state["resolved"] = True
+    if _state["runtime"] is None and mode == "require":
+        raise OpenCLUnavailableError("OpenCL is required (TESSERA_OPENCL=require) but unavailable")
+    return _state["runtime"]
+
+
+BACKENDS = ("auto", "numpy", "opencl")
+
+
+def backend_runtime(backend, purpose="this kernel"):
+    """The runtime for a ``backend`` choice ("auto", "numpy", "opencl"): None means numpy.
+
+    "opencl" raises `OpenCLUnavailableError` when no device is available; "auto" falls back quietly.
+    """
+    if backend not in BACKENDS:
+        raise InvalidInputError(f"backend must be one of {BACKENDS}; got {backend!r}")
+    if backend == "numpy":
+        return None
+    runtime = get_runtime()
+    if runtime is None and backend == "opencl":
+        raise OpenCLUnavailableError(f"OpenCL was requested for {purpose} but no device is available")
+    return runtime

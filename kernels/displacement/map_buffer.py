@@ -1,0 +1,97 @@
+"""A displacement map kept on an OpenCL device between dabs (seed 004 §5.2, the interoperability layer).
+
+`MapBuffer(runtime, map)` uploads the (H, W, C) float32 host map once. Each dab then runs on the device copy and
+only its footprint rectangle comes back (`pull`), so a dab costs its footprint, not the map. The host array stays
+the truth after every call; host-side edits (undo, loading a file) go back with `push`. Transfers are
+rectangular copies (`clEnqueueReadBufferRect` and friends), correct on CPU and GPU devices alike.
+"""
+
+import numpy as np
+
+from ..common.errors import InvalidInputError
+from .map_dabs import MAP_PROGRAM
+
+
+class MapBuffer:
+    """Device copy of one host map; ``host`` is the (H, W, C) float32 array it mirrors."""
+
+    def __init__(self, runtime, dmap):
+        if not isinstance(dmap, np.ndarray) or dmap.dtype != np.float32 or dmap.ndim != 3 \
+                or not dmap.flags.c_contiguous:
+            raise InvalidInputError("A device map mirrors a contiguous (height, width, channels) float32 array")
+        self.runtime = runtime
+        self.host = dmap
+        cl = runtime.cl
+        self.buf = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=dmap)
+        self._scratch = None
+        self._scratch_bytes = 0
+        self._stamp = (None, None)  # (host array, device buffer) of the last stamp
+
+    @property
+    def row_bytes(self):
+        return self.host.shape[1] * self.host.shape[2] * 4
+
+    def _rect(self, region):
+        x0, y0, x1, y1 = region
+        texel = self.host.shape[2] * 4
+        return (x0 * texel, y0), ((x1 - x0) * texel, y1 - y0)
+
+    def pull(self, region):
+        """Copy the device rectangle ``(x0, y0, x1, y1)`` (end exclusive) into the host map."""
+        origin, size = self._rect(region)
+        self.runtime.cl.enqueue_copy(self.runtime.queue, self.host, self.buf, buffer_origin=origin,
+                                     host_origin=origin, region=size, buffer_pitches=(self.row_bytes,),
+                                     host_pitches=(self.row_bytes,))
+
+    def push(self, region=None):
+        """Copy the host rectangle (default: all of it) to the device after a host-side edit."""
+        h, w = self.host.shape[:2]
+        origin, size = self._rect(region or (0, 0, w, h))
+        self.runtime.cl.enqueue_copy(self.runtime.queue, self.buf, self.host, buffer_origin=origin,
+                                     host_origin=origin, region=size, buffer_pitches=(self.row_bytes,),
+                                     host_pitches=(self.row_bytes,))
+
+    def snapshot(self, region):
+        """A device buffer holding a tight copy of ``region`` (reused between calls): the halo of a smooth."""
+        cl = self.runtime.cl
+        origin, size = self._rect(region)
+        nbytes = size[0] * size[1]
+        if nbytes > self._scratch_bytes:
+            self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, nbytes)
+            self._scratch_bytes = nbytes
+        cl.enqueue_copy(self.runtime.queue, self._scratch, self.buf, src_origin=origin, dst_origin=(0, 0),
+                        region=size, src_pitches=(self.row_bytes,), dst_pitches=(size[0],))
+        return self._scratch
+
+    def smooth_all(self, strength, read_back=True):
+        """Whole-map smooth on the device into the spare buffer, which then becomes the map; pulls the result
+        (``read_back=False`` leaves the host stale: benchmarks of the device side only).
+
+        Returns False, with host and device unchanged, when the map holds NaN or infinite values.
+        """
+        cl = self.runtime.cl
+        h, w, c = self.host.shape
+        if self._scratch_bytes != self.host.nbytes:
+            self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, self.host.nbytes)
+            self._scratch_bytes = self.host.nbytes
+        bad = np.zeros(1, np.int32)
+        d_bad = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=bad)
+        n = w * c
+        kernel = self.runtime.kernel(MAP_PROGRAM, "smooth_all")
+        kernel(self.runtime.queue, ((n + 7) // 8, h), None, self.buf, self._scratch, d_bad, np.int32(n), np.int32(h),
+               np.int32(c), np.float32(strength))
+        cl.enqueue_copy(self.runtime.queue, bad, d_bad)
+        if bad[0]:
+            return False
+        self.buf, self._scratch = self._scratch, self.buf  # ping-pong: the result becomes the map
+        if read_back:
+            cl.enqueue_copy(self.runtime.queue, self.host, self.buf)
+        return True
+
+    def stamp_buffer(self, stamp):
+        """Device copy of a stamp map; the last one is kept while the same array is used."""
+        if self._stamp[0] is not stamp:
+            cl = self.runtime.cl
+            self._stamp = (stamp, cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR,
+                                            hostbuf=stamp))
+        return self._stamp[1]

@@ -1,0 +1,331 @@
+"""Applying dabs to a displacement map: validation, footprints, and the OpenCL or numpy kernel.
+
+`apply_dab(map, kind, backend=..., **params)` edits ``map`` (H, W, C) float32 in place, touching only the
+dab's footprint (a tile: the bounding box of the disc, clipped to the map), and returns that tile's
+``(x0, y0, x1, y1)``. Bad parameters (NaN, a force whose radius |f.xyz|·f.w is not positive, a stamp with the
+wrong channel count) and NaN inside the footprint raise `InvalidInputError` before anything is written, so
+the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the same result.
+
+`compile_custom` builds a user kernel body into the seed's custom template; compiler errors come back as
+`TesseraError` with the compiler log.
+"""
+
+import numpy as np
+
+from ..common.errors import InvalidInputError, TesseraError
+from ..common.opencl_runtime import backend_runtime
+from . import map_dabs as ref
+from .map_buffer import MapBuffer
+
+KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
+_FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
+
+
+def check_map(dmap):
+    """A displacement map must be a writable, C-contiguous (H, W, C) float32 array with C in 1, 3, 4."""
+    if not isinstance(dmap, np.ndarray) or dmap.dtype != np.float32 or dmap.ndim != 3 or dmap.shape[2] not in (1, 3, 4):
+        raise InvalidInputError("A displacement map is a float32 array of shape (height, width, 1, 3 or 4)")
+    if not dmap.flags.c_contiguous or not dmap.flags.writeable:
+        raise InvalidInputError("The displacement map must be a writable, contiguous array")
+    return dmap
+
+
+def _finite(name, value):
+    v = np.asarray(value, np.float64)
+    if not np.all(np.isfinite(v)):
+        raise InvalidInputError(f"Dab parameter {name!r} must be finite; got {value!r}")
+    return v
+
+
+def footprint(shape, pos, radius):
+    """Tile ``(x0, y0, x1, y1)`` (end exclusive) of the texels with distance < radius, clipped; None if empty."""
+    h, w = shape[:2]
+    x0 = max(0, int(np.floor(pos[0] - radius)))
+    y0 = max(0, int(np.floor(pos[1] - radius)))
+    x1 = min(w, int(np.ceil(pos[0] + radius)) + 1)
+    y1 = min(h, int(np.ceil(pos[1] + radius)) + 1)
+    if x1 <= x0 or y1 <= y0 or radius <= 0:
+        return None
+    return x0, y0, x1, y1
+
+
+def _plan(dmap, kind, p):
+    """Validated (region, numpy function, OpenCL kernel name, OpenCL scalar args) for one dab."""
+    channels = dmap.shape[2]
+    f32 = np.float32
+    if kind == "CONTACT":
+        pos, depth, radius = _finite("pos", p["pos"]), _finite("depth", p["depth"]), _finite("radius", p["radius"])
+        region = footprint(dmap.shape, pos, float(radius))
+        args = (_f2(pos), f32(depth), f32(radius))
+        return region, lambda t, x0, y0: ref.contact(t, x0, y0, pos, depth, radius), "contact", args
+    if kind == "FORCE":
+        pos, f = _finite("pos", p["pos"]), _finite("force", p["force"])
+        area = ref.force_area(f)
+        if not area > 0:
+            raise InvalidInputError(f"The force's radius |f.xyz| * f.w must be positive; got {float(area):g} "
+                                    f"(f = {tuple(float(x) for x in f)})")
+        region = footprint(dmap.shape, pos, float(area))
+        return region, lambda t, x0, y0: ref.force(t, x0, y0, pos, f), "force", (_f2(pos), _f4(f), f32(area))
+    if kind == "TEST":
+        args = [_finite(f"arg{i}", p.get(f"arg{i}", (0, 0, 0, 0))) for i in range(1, 5)]
+        region = footprint(dmap.shape, args[0][:2], float(args[2][0]))
+        return (region, lambda t, x0, y0: ref.test(t, x0, y0, *args), "test", tuple(_f4(a) for a in args))
+    if kind in ("DRAW", "FLATTEN", "SMOOTH", "NOISE"):
+        pos, radius = _finite("pos", p["pos"]), float(_finite("radius", p["radius"]))
+        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
+                                                                                       p.get("pressure", 1.0)))
+        kind_name = p.get("falloff", "SMOOTH")
+        if kind_name not in _FALLOFF_ID:
+            raise InvalidInputError(f"Falloff must be one of {ref.FALLOFFS}; got {kind_name!r}")
+        region = footprint(dmap.shape, pos, radius)
+        base = (_f2(pos), f32(radius), f32(strength), np.int32(_FALLOFF_ID[kind_name]))
+        if kind == "DRAW":
+            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
+            return (region, lambda t, x0, y0: ref.draw(t, x0, y0, pos, radius, strength, kind_name, vec), "draw",
+                    base + (_f4(vec),))
+        if kind == "NOISE":
+            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
+            cell = float(_finite("cell", p.get("cell", 8.0)))
+            seed = int(p.get("seed", 0)) & 0xFFFFFFFF
+            if not cell > 0:
+                raise InvalidInputError(f"The noise cell size must be positive; got {cell:g}")
+            return (region, lambda t, x0, y0: ref.noise(t, x0, y0, pos, radius, strength, kind_name, vec, cell, seed),
+                    "noise", base + (_f4(vec), f32(cell), np.uint32(seed)))
+        if kind == "FLATTEN":
+            target = p.get("target")
+            if target is None and region is not None:
+                x0, y0, x1, y1 = region
+                target = _flatten_target(dmap[y0:y1, x0:x1], x0, y0, pos, radius)
+            target = _finite("target", target if target is not None else (0, 0, 0, 0))
+            return (region, lambda t, x0, y0: ref.flatten(t, x0, y0, pos, radius, strength, kind_name, target),
+                    "flatten", base + (_f4(target),))
+        return (region, lambda t, x0, y0, src, sx0, sy0: ref.smooth(t, x0, y0, src, sx0, sy0, pos, radius, strength,
+                                                                     kind_name), "smooth", base)
+    if kind == "STAMP":
+        st = p["stamp"]
+        if not isinstance(st, np.ndarray) or st.ndim != 3 or st.shape[2] != channels or st.shape[0] < 1:
+            raise InvalidInputError(f"The stamp must be a (height, width, {channels}) array like the map")
+        st = np.ascontiguousarray(st, np.float32)
+        if not np.all(np.isfinite(st)):
+            raise InvalidInputError("The stamp contains NaN or infinite values")
+        pos, scale = _finite("pos", p["pos"]), float(_finite("scale", p.get("scale", 1.0)))
+        if scale <= 0:
+            raise InvalidInputError("The stamp scale must be positive")
+        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
+                                                                                       p.get("pressure", 1.0)))
+        rot = ref.stamp_rotation(float(_finite("angle", p.get("angle", 0.0))))
+        region = footprint(dmap.shape, pos, ref.stamp_extent(st.shape, scale) + 1.0)
+        return (region, lambda t, x0, y0: ref.stamp(t, x0, y0, st, pos, rot, scale, strength), "stamp",
+                (st, _f2(pos), rot, f32(scale), f32(strength)))
+    raise InvalidInputError(f"Unknown dab kind {kind!r}; expected one of {', '.join(KINDS)}")
+
+
+def _flatten_target(tile, x0, y0, pos, radius):
+    """The falloff-free mean of the texels inside the disc, as a float4 (xyz(w) or z for height maps)."""
+    h, w, c = tile.shape
+    inside = ref.texel_distance(x0, y0, w, h, pos) < np.float32(radius)
+    mean = tile[inside].astype(np.float64).mean(axis=0) if inside.any() else np.zeros(c)
+    out = np.zeros(4)
+    if c == 1:
+        out[2] = mean[0]
+    else:
+        out[:c] = mean
+    return out
+
+
+# OpenCL float2 / float4 kernel arguments passed by value
+_FLOAT2 = np.dtype([("x", np.float32), ("y", np.float32)])
+_FLOAT4 = np.dtype([("x", np.float32), ("y", np.float32), ("z", np.float32), ("w", np.float32)])
+
+
+def _f2(v):
+    return np.array(np.asarray(v, np.float64)[:2], np.float32).view(_FLOAT2)[0]
+
+
+def _f4(v):
+    return np.array(np.asarray(v, np.float64).reshape(4), np.float32).view(_FLOAT4)[0]
+
+
+def _runtime(backend):
+    return backend_runtime(backend, "the map edit")
+
+
+def _backend_runtime(backend, device):
+    """The OpenCL runtime to use, or None for numpy; a device-resident map always runs on its device."""
+    return _runtime("opencl") if device is not None else _runtime(backend)
+
+
+def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **params):
+    """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map.
+
+    ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
+    footprint moves; without it the footprint tile is uploaded and read back. ``before_write(region)`` is
+    called once every check has passed and before anything is written (undo records the region there).
+    """
+    check_map(dmap)
+    if device is not None and device.host is not dmap:
+        raise InvalidInputError("The device buffer mirrors a different map")
+    region, numpy_fn, cl_name, cl_args = _plan(dmap, kind, params)
+    if region is None:
+        return None
+    x0, y0, x1, y1 = region
+    halo = None
+    if kind == "SMOOTH":
+        halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
+    _check_finite(dmap, halo or region)
+    runtime = _backend_runtime(backend, device)
+    if before_write is not None:
+        before_write(region)
+    if runtime is None:
+        tile = dmap[y0:y1, x0:x1]  # a view: the reference edits the map in place
+        if kind == "SMOOTH":
+            hx0, hy0, hx1, hy1 = halo
+            numpy_fn(tile, x0, y0, dmap[hy0:hy1, hx0:hx1].copy(), hx0, hy0)
+        else:
+            numpy_fn(tile, x0, y0)
+    else:
+        _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
+    return region
+
+
+def smooth_map(dmap, strength=1.0, backend="auto", device=None):
+    """Smooth the whole map toward its 3x3 means (clamped borders) in place; returns the region (all of it).
+
+    With OpenCL the map goes through the device once (`MapBuffer.smooth_all`, ping-pong buffers); a temporary
+    device copy is made when no ``device`` is given.
+    """
+    check_map(dmap)
+    k = float(_finite("strength", strength))
+    h, w = dmap.shape[:2]
+    if device is not None and device.host is not dmap:
+        raise InvalidInputError("The device buffer mirrors a different map")
+    runtime = _backend_runtime(backend, device)
+    if runtime is None:
+        _check_finite(dmap, (0, 0, w, h))
+        dmap[...] = ref.smooth_full(dmap, k)
+    elif not (device or MapBuffer(runtime, dmap)).smooth_all(k):
+        raise InvalidInputError("The map has NaN or infinite values; nothing was changed")
+    return 0, 0, w, h
+
+
+def _check_finite(dmap, region):
+    x0, y0, x1, y1 = region
+    if not np.isfinite(dmap[y0:y1, x0:x1]).all():
+        raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
+
+
+def _run_opencl(runtime, dmap, region, name, args, halo, device):
+    """One kernel launch over the footprint, on the device-resident map or on an uploaded tile."""
+    cl = runtime.cl
+    mf = cl.mem_flags
+    ctx = runtime.context
+    x0, y0, x1, y1 = region
+    w, h, channels = x1 - x0, y1 - y0, dmap.shape[2]
+    if device is not None:
+        buf, base, mem_w = device.buf, (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
+    else:
+        tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+        buf, base, mem_w = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w
+    extra = []
+    if name == "smooth":
+        hx0, hy0, hx1, hy1 = halo
+        if device is not None:
+            src = device.snapshot(halo)
+        else:
+            src = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
+        extra = [src, np.int32(hx1 - hx0), np.int32(hy1 - hy0), np.int32(hx0), np.int32(hy0)]
+    if name == "stamp":
+        st = args[0]
+        st_buf = device.stamp_buffer(st) if device is not None else cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR,
+                                                                              hostbuf=st)
+        extra = [st_buf, np.int32(st.shape[1]), np.int32(st.shape[0])]
+        args = args[1:]
+    kernel = runtime.kernel(ref.MAP_PROGRAM, name)
+    kernel(runtime.queue, (w, h), None, buf, np.int64(base), np.int32(mem_w), np.int32(channels), np.int32(x0),
+           np.int32(y0), np.int32(w), np.int32(h), *extra, *args)
+    if device is not None:
+        device.pull(region)
+    else:
+        cl.enqueue_copy(runtime.queue, tile, buf)
+        dmap[y0:y1, x0:x1] = tile
+
+
+def morph(a, b, time, backend="auto"):
+    """Seed morphing: a new map a * (1 - t) + b * t; ``a`` and ``b`` are not modified."""
+    check_map(a)
+    check_map(b)
+    if a.shape != b.shape:
+        raise InvalidInputError(f"Morphing needs two maps of the same shape; got {a.shape} and {b.shape}")
+    t = float(_finite("time", time))
+    runtime = _runtime(backend)
+    if runtime is None:
+        return ref.morphing(a, b, t)
+    cl = runtime.cl
+    mf = cl.mem_flags
+    out = np.empty_like(a)
+    d_a = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
+    d_b = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=b)
+    d_out = cl.Buffer(runtime.context, mf.WRITE_ONLY, out.nbytes)
+    runtime.kernel(ref.MAP_PROGRAM, "morphing")(runtime.queue, (a.size,), None, d_a, d_b, d_out, np.int64(a.size),
+                                          np.float32(t))
+    cl.enqueue_copy(runtime.queue, out, d_out)
+    return out
+
+
+CUSTOM_TEMPLATE = """
+#pragma OPENCL FP_CONTRACT OFF
+__kernel void custom(__global float *map, const long base, const int mem_w, const int channels, const int x0,
+                     const int y0, const int w, const int h, const float4 arg1, const float4 arg2, const float4 arg3,
+                     const float4 arg4)
+{
+  const int gx = get_global_id(0), gy = get_global_id(1);
+  if (gx >= w || gy >= h) {
+    return;
+  }
+  const int x = x0 + gx, y = y0 + gy;
+  __global float *t = map + base + ((long)gy * mem_w + gx) * channels;
+  float4 image = (float4)(0.0f);
+  if (channels == 1) { image.z = t[0]; } else { for (int c = 0; c < channels; ++c) { ((float *)&image)[c] = t[c]; } }
+  (void)x; (void)y; (void)arg1; (void)arg2; (void)arg3; (void)arg4;
+#line 1 "custom body"
+%s
+  if (channels == 1) { t[0] = image.z; } else { for (int c = 0; c < channels; ++c) { t[c] = ((float *)&image)[c]; } }
+}
+"""
+
+
+def compile_custom(runtime, body):
+    """Build a custom kernel: ``body`` edits ``float4 image`` at texel (x, y) with arg1..arg4 (seed §5.7).
+
+    Raises `TesseraError` with the compiler log on a compile error. Returns the kernel.
+    """
+    cl = runtime.cl
+    try:
+        program = cl.Program(runtime.context, CUSTOM_TEMPLATE % body).build()
+    except cl.RuntimeError as err:
+        raise TesseraError(f"The custom kernel failed to compile:\n{err}") from err
+    return cl.Kernel(program, "custom")
+
+
+def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4, device=None):
+    """Run a compiled custom kernel over ``region`` (default: the whole map) in place; returns the region.
+
+    The kernel runs on a copy of the region, so output with NaN or infinities is refused with the map unchanged;
+    a `MapBuffer` given as ``device`` is updated afterwards.
+    """
+    check_map(dmap)
+    h, w = dmap.shape[:2]
+    x0, y0, x1, y1 = region or (0, 0, w, h)
+    vals = [_f4(_finite(f"arg{i + 1}", a)) for i, a in enumerate(args)]
+    tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+    cl = runtime.cl
+    d_tile = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
+    kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int64(0), np.int32(x1 - x0), np.int32(dmap.shape[2]),
+           np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *vals)
+    cl.enqueue_copy(runtime.queue, tile, d_tile)
+    if not np.all(np.isfinite(tile)):
+        raise TesseraError("The custom kernel produced NaN or infinite values; the map was left unchanged")
+    dmap[y0:y1, x0:x1] = tile
+    if device is not None:
+        device.push((x0, y0, x1, y1))
+    return x0, y0, x1, y1

@@ -1,0 +1,168 @@
+"""Height maps in: 8/16-bit PNG/TIFF, float EXR/TIFF (OpenImageIO), raw r16/r32 (memory-mapped), arrays.
+
+A `HeightMap` keeps the samples in the file's own type, so nothing is lost on the way in: 8-bit stays
+``uint8``, 16-bit stays ``uint16``, float stays ``float32``. A sample ``s`` means the world height
+
+    z = offset + scale * n(s),   n(s) = s / 255 (8-bit), s / 65535 (16-bit), s (float)
+
+Samples sit on the vertices of a regular grid, ``texel_size`` world units apart; row 0 is the bottom row
+(Blender's image order, v = 0). Image files store their top row first and are flipped (a view, no copy);
+raw files are taken as top row first too (the common r16/r32 layout) unless ``raw_bottom_up``.
+
+Raw files are memory-mapped, never read whole: a 65536² r16 file (8 GiB) costs no memory until its rows are
+touched, and `rows` converts only the band asked for.
+"""
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.errors import InvalidInputError, TesseraError
+from ..common.image_io import read_pixels
+
+IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
+RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
+_NORMALISE = {np.dtype(np.uint8): 1.0 / 255.0, np.dtype(np.uint16): 1.0 / 65535.0}
+#: Rows per band when a large map is scanned (NaN check, statistics): about 64 MiB of float32 at 16384 wide.
+SCAN_ROWS = 1024
+
+
+@dataclass(frozen=True)
+class HeightMap:
+    """Height samples and their world scale.
+
+    samples: (H, W) uint8, uint16 or float32 (may be a read-only memory map); row 0 at the bottom.
+    texel_size: world distance between neighbouring samples (> 0). scale, offset: see the module docstring.
+    """
+
+    samples: np.ndarray
+    texel_size: float = 1.0
+    scale: float = 1.0
+    offset: float = 0.0
+    source: str = ""
+
+    def __post_init__(self):
+        s = self.samples
+        if not isinstance(s, np.ndarray) or s.ndim != 2 or s.dtype not in (np.uint8, np.uint16, np.float32):
+            raise InvalidInputError("Height samples must be a 2-D uint8, uint16 or float32 array")
+        if min(s.shape) < 2:
+            raise InvalidInputError(f"A height map needs at least 2x2 samples; got {s.shape[1]}x{s.shape[0]}")
+        for name in ("texel_size", "scale", "offset"):
+            if not np.isfinite(getattr(self, name)):
+                raise InvalidInputError(f"The height map's {name} must be a finite number")
+        if not self.texel_size > 0:
+            raise InvalidInputError(f"The texel size must be positive; got {self.texel_size!r}")
+
+    @property
+    def width(self):
+        return self.samples.shape[1]
+
+    @property
+    def height(self):
+        return self.samples.shape[0]
+
+    @property
+    def unit(self):
+        """World height of one stored unit: (scale / 255, scale / 65535 or scale)."""
+        return self.scale * _NORMALISE.get(self.samples.dtype, 1.0)
+
+    def rows(self, y0, y1):
+        """World heights of rows ``[y0, y1)``: (y1 - y0, W) float32 (a copy; the samples are untouched)."""
+        band = np.asarray(self.samples[y0:y1], np.float32)
+        return (np.float32(self.offset) + np.float32(self.unit) * band).astype(np.float32)
+
+    def heights(self):
+        """All world heights: (H, W) float32. Use `rows` for maps too large to hold as float32."""
+        return self.rows(0, self.height)
+
+    def sample(self, x, y):
+        """Bilinear world height at texel coordinates (clamped to the map): x, y (...) float -> (...) float32.
+
+        Only the four neighbours of each point are read, so this works on memory-mapped maps.
+        """
+        x = np.clip(np.asarray(x, np.float64), 0.0, self.width - 1)
+        y = np.clip(np.asarray(y, np.float64), 0.0, self.height - 1)
+        x0 = np.minimum(np.floor(x).astype(np.int64), self.width - 2)
+        y0 = np.minimum(np.floor(y).astype(np.int64), self.height - 2)
+        fx, fy = x - x0, y - y0
+        s = self.samples
+        h00, h10 = s[y0, x0].astype(np.float64), s[y0, x0 + 1].astype(np.float64)
+        h01, h11 = s[y0 + 1, x0].astype(np.float64), s[y0 + 1, x0 + 1].astype(np.float64)
+        n = (h00 * (1 - fx) + h10 * fx) * (1 - fy) + (h01 * (1 - fx) + h11 * fx) * fy
+        return (self.offset + self.unit * n).astype(np.float32)
+
+
+def check_finite(samples, source=""):
+    """Raise `InvalidInputError` if float samples hold NaN or infinity (scanned in bands)."""
+    if samples.dtype.kind != "f":
+        return
+    for y0 in range(0, samples.shape[0], SCAN_ROWS):
+        band = samples[y0:y0 + SCAN_ROWS]
+        if not np.isfinite(band).all():
+            bad = np.argwhere(~np.isfinite(band))[0]
+            where = f" in {source}" if source else ""
+            raise InvalidInputError(f"The height map{where} has NaN or infinity at row {y0 + bad[0]}, column {bad[1]}")
+
+
+def from_array(samples, texel_size=1.0, scale=1.0, offset=0.0, source=""):
+    """A `HeightMap` from an (H, W) or (H, W, C) array (channel 0 is used), checked for NaN."""
+    a = np.asarray(samples)
+    if a.ndim == 3:
+        a = a[..., 0]
+    if a.dtype.kind == "f" and a.dtype != np.float32:
+        a = a.astype(np.float32)
+    check_finite(a, source)
+    return HeightMap(a, float(texel_size), float(scale), float(offset), source)
+
+
+def read_raw(path, width, height, dtype=None, texel_size=1.0, scale=1.0, offset=0.0, bottom_up=False):
+    """Memory-map a raw height file: little-endian uint16 (.r16/.raw) or float32 (.r32), top row first.
+
+    The file size must be exactly ``width * height * itemsize``. Float files are scanned for NaN in bands.
+    """
+    if not os.path.isfile(path):
+        raise TesseraError(f"No such height map file: {path}")
+    ext = os.path.splitext(path)[1].lower()
+    dt = np.dtype(dtype) if dtype is not None else RAW_TYPES.get(ext)
+    if dt is None or dt not in (np.dtype("<u2"), np.dtype("<f4"), np.dtype("u1")):
+        raise InvalidInputError(f"Raw height maps are .r16/.raw (uint16) or .r32 (float32); got {path!r}")
+    width, height = int(width), int(height)
+    if width < 2 or height < 2:
+        raise InvalidInputError(f"Give the raw map's size (at least 2x2); got {width}x{height}")
+    expected = width * height * dt.itemsize
+    actual = os.path.getsize(path)
+    if actual != expected:
+        side = int(round((actual / dt.itemsize) ** 0.5))
+        hint = f"; a square map of this file would be {side}x{side}" if side * side * dt.itemsize == actual else ""
+        name = os.path.basename(path)
+        raise InvalidInputError(f"{name} has {actual} bytes; {width}x{height} {dt.name} samples need {expected}{hint}")
+    mm = np.memmap(path, dtype=dt, mode="r", shape=(height, width))
+    samples = mm if bottom_up else mm[::-1]
+    check_finite(samples, path)
+    return HeightMap(samples, float(texel_size), float(scale), float(offset), path)
+
+
+def read_image(path, texel_size=1.0, scale=1.0, offset=0.0):
+    """Read a PNG/TIFF/EXR height map with OpenImageIO, keeping its precision (channel 0 is the height)."""
+    def pixel_type(fmt):
+        kind = {"uint8": "uint8", "uint16": "uint16", "float": "float", "half": "float", "double": "float"}.get(fmt)
+        if kind is None:
+            raise InvalidInputError(f"{path} stores {fmt} samples; use 8/16-bit integer or float height maps")
+        return kind
+
+    data, _ = read_pixels(path, "height map", pixel_type, n_channels=1)
+    return from_array(np.ascontiguousarray(data[..., 0]), texel_size, scale, offset, path)
+
+
+def read_heightmap(path, texel_size=1.0, scale=1.0, offset=0.0, raw_size=None, raw_dtype=None, raw_bottom_up=False):
+    """Read any supported height map file. ``raw_size=(width, height)`` is required for raw files."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext in RAW_TYPES or raw_dtype is not None:
+        if raw_size is None:
+            raise InvalidInputError(f"{os.path.basename(path)} is a raw height map: give its width and height")
+        return read_raw(path, raw_size[0], raw_size[1], raw_dtype, texel_size, scale, offset, raw_bottom_up)
+    if ext in IMAGE_EXTENSIONS:
+        return read_image(path, texel_size, scale, offset)
+    raise InvalidInputError(
+        f"Unsupported height map {os.path.basename(path)!r}; use {', '.join(IMAGE_EXTENSIONS + tuple(RAW_TYPES))}")

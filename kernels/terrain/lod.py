@@ -1,0 +1,336 @@
+"""View-dependent terrain levels (seed 000 §5.5, errata §8 items 12-13): per-tile edge and inner levels.
+
+Per tile, from the `terrain_analysis.TileTable`:
+
+- ``T_max = clamp(g(HAM_max), 1, L)``, ``g = k·sqrt(HAM)`` (SQRT) or ``1 + k·log2(1 + HAM)`` (LOG): a flat tile
+  (HAM_max = 0) gets 1 and is never subdivided.
+- ``T_min`` from the allowed screen-space error ε (pixels) and ĥ, the projected distance between the tile's
+  highest sample and the coarse tile below it: SEARCH (default) is the seed's process of Fig. 5.4, the
+  smallest power of two whose grid brings the peak within ε pixels; LOG2 is the corrected closed form
+  ``log2(ĥ/ε)``; PRINTED is (5-4) as printed, ``log2(ε/ĥ)``. Clamped to ``[1, T_max]``.
+- the distance law (5-5..5-7): ``T = T_max`` below ``d_max``, ``T_max·d_max²/d²`` up to
+  ``d_min = d_max·sqrt(T_max/T_min)``, ``T_min`` beyond; i.e. ``clamp(T_max·d_max²/d², T_min, T_max)``.
+
+Levels never exceed the tile size in texels (a quad always covers at least a texel, seed §5.4.2).
+Edge levels use the edge's midpoint (on the terrain surface) and ``max`` of the two tiles' T_max and T_min;
+every input is the same for both tiles, and only +, -, ×, / and sqrt touch it, so both tiles compute the
+same level bit for bit. The inner level uses the tile centre and the tile's own bounds. Tiles whose bounding
+box is outside the view frustum are culled (no triangles).
+
+Coordinates: sample (x, y) is at world ``((x - (W-1)/2)·texel, (y - (H-1)/2)·texel, height)``; the camera is
+given in that (terrain-local) space.
+"""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..common.errors import InvalidInputError
+from ..common.partition import MAX_LEVEL, segment_counts
+from .analysis import tile_bounds
+
+MODES = ("OURS", "DISTANCE", "UNIFORM")
+G_FUNCTIONS = ("SQRT", "LOG")
+T_MIN_RULES = ("SEARCH", "LOG2", "PRINTED")
+LEVELS = ("FRACTIONAL", "INTEGER", "POW2")
+SIDES = ("BOTTOM", "RIGHT", "TOP", "LEFT")
+
+
+@dataclass(frozen=True)
+class TerrainLod:
+    """Level-selection settings.
+
+    mode: OURS (T_max and T_min), DISTANCE (distance law without T_max: the seed's "straight view-dependent
+    LOD"), UNIFORM (max_level everywhere). epsilon: allowed error in pixels. d_max: near distance in world
+    units, 0 = automatic (a texel spans ``quad_pixels`` pixels there). levels: FRACTIONAL (continuous,
+    fractional-even spacing), INTEGER (ceil) or POW2 (ceil to a power of two: vertices land on texels).
+    """
+
+    mode: str = "OURS"
+    g: str = "SQRT"
+    ham_scale: float = 4.0
+    epsilon: float = 3.0
+    t_min_rule: str = "SEARCH"
+    d_max: float = 0.0
+    quad_pixels: float = 4.0
+    max_level: int = MAX_LEVEL
+    culling: bool = True
+    levels: str = "POW2"
+
+    def __post_init__(self):
+        for name, allowed in (("mode", MODES), ("g", G_FUNCTIONS), ("t_min_rule", T_MIN_RULES), ("levels", LEVELS)):
+            if getattr(self, name) not in allowed:
+                raise InvalidInputError(f"{name} must be one of {', '.join(allowed)}; got {getattr(self, name)!r}")
+        if not 1 <= self.max_level <= MAX_LEVEL:
+            raise InvalidInputError(f"max_level must be in [1, {MAX_LEVEL}]; got {self.max_level!r}")
+        for name in ("ham_scale", "epsilon", "quad_pixels"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+                raise InvalidInputError(f"{name} must be a positive number; got {getattr(self, name)!r}")
+        if not (np.isfinite(self.d_max) and self.d_max >= 0):
+            raise InvalidInputError(f"d_max must be >= 0 (0 = automatic); got {self.d_max!r}")
+
+    @property
+    def spacing(self):
+        return "FRACTIONAL_EVEN" if self.levels == "FRACTIONAL" else "EQUAL"
+
+
+@dataclass
+class Selection:
+    """Levels for one camera. Per tile (nty, ntx): t_max, t_min, inner (float64), culled (bool); ``edge``
+    (nty, ntx, 4) as each tile computed its own sides (BOTTOM, RIGHT, TOP, LEFT). Shared per edge:
+    h_edges (nty + 1, ntx) and v_edges (nty, ntx + 1) (rounded levels, what the mesh uses)."""
+
+    t_max: np.ndarray
+    t_min: np.ndarray
+    edge: np.ndarray
+    inner: np.ndarray
+    culled: np.ndarray
+    h_edges: np.ndarray
+    v_edges: np.ndarray
+    spacing: str
+
+    @property
+    def inner_counts(self):
+        return segment_counts(self.inner, self.spacing)
+
+
+def to_world(hm, x, y, z):
+    """Terrain-local world coordinates of sample coordinates: (..., 3) float64."""
+    return np.stack([(np.asarray(x, np.float64) - (hm.width - 1) * 0.5) * hm.texel_size,
+                     (np.asarray(y, np.float64) - (hm.height - 1) * 0.5) * hm.texel_size,
+                     np.asarray(z, np.float64)], axis=-1)
+
+
+def g_of_ham(ham_max, settings):
+    """T_max from the tile's HAM maximum: (...) -> (...) float64 in [1, max_level]."""
+    a = np.maximum(np.asarray(ham_max, np.float64), 0.0)
+    g = settings.ham_scale * (np.sqrt(a) if settings.g == "SQRT" else np.log2(1.0 + a))
+    if settings.g == "LOG":
+        g = 1.0 + g
+    return np.clip(g, 1.0, settings.max_level)
+
+
+def distance_level(d, t_max, t_min, d_max):
+    """Seed (5-5..5-7): T_max below d_max, T_max·d_max²/d² between, T_min beyond d_min. (...) float64."""
+    d = np.asarray(d, np.float64)
+    with np.errstate(divide="ignore"):
+        t = t_max * (d_max * d_max) / (d * d)
+    return np.where(d <= d_max, t_max, np.minimum(np.maximum(t, t_min), t_max))
+
+
+def auto_d_max(hm, camera, settings):
+    """Distance at which one texel spans ``quad_pixels`` pixels (vertically, through the image centre)."""
+    if settings.d_max > 0:
+        return float(settings.d_max)
+    focal = 0.5 * camera.height * float(np.asarray(camera.projection)[1, 1])
+    return hm.texel_size * focal / settings.quad_pixels
+
+
+def _clip_matrix(camera):
+    return np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
+
+
+def _project(camera, points):
+    """Pixel coordinates (..., 2) and clip w (...) of world points (..., 3)."""
+    cx, cy, w = _clip(_clip_matrix(camera), points)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        px = np.stack([(cx / w + 1) * 0.5 * camera.width, (cy / w + 1) * 0.5 * camera.height], -1)
+    return px, w
+
+
+def _clip(m, points):
+    """Clip x, y and w of world points (..., 3) under the 4x4 matrix ``m``: three (...) arrays."""
+    x, y, z = points[..., 0], points[..., 1], points[..., 2]
+    return [m[r, 0] * x + m[r, 1] * y + m[r, 2] * z + m[r, 3] for r in (0, 1, 3)]
+
+
+def _vertical_error_px(camera, m, top, dz):
+    """Pixels between clip points ``top`` (cx, cy, w, each (n,)) and the same world points moved by ``dz`` (n,)
+    along z; 0 where either point is behind the camera: (n,) float64."""
+    cx, cy, w = top
+    bx, by, bw = cx + m[0, 2] * dz, cy + m[1, 2] * dz, w + m[3, 2] * dz
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err = np.hypot((cx / w - bx / bw) * (0.5 * camera.width), (cy / w - by / bw) * (0.5 * camera.height))
+    return np.where((w > 0) & (bw > 0) & np.isfinite(err), err, 0.0)
+
+
+def _distance(eye, xyz):
+    """Distances from ``eye`` (3,) of points given as three planes ``xyz`` (3, ...): (...) float64."""
+    dx, dy, dz = xyz[0] - eye[0], xyz[1] - eye[1], xyz[2] - eye[2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+def _planes(points):
+    """(..., 3) points as contiguous (3, ...) coordinate planes (fast to stream through)."""
+    return np.ascontiguousarray(np.moveaxis(points, -1, 0))
+
+
+def _cached(table, key, make):
+    """A camera-independent array derived from the table, computed once (edits clear `TileTable.derived`)."""
+    if key not in table.derived:
+        table.derived[key] = make()
+    return table.derived[key]
+
+
+def _grid_height_at_peak(hm, table, xs, ys, level):
+    """Height at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64.
+
+    The grid cell around the peak is split along its (i, j)-(i+1, j+1) diagonal, as the mesh splits it.
+    """
+    (x0, x1), (y0, y1) = xs, ys
+    px, py = table.peak_x.astype(np.float64), table.peak_y.astype(np.float64)
+    sx, sy = (x1 - x0) / level, (y1 - y0) / level
+    fx, fy = (px - x0) / sx, (py - y0) / sy
+    i, j = np.minimum(np.floor(fx), level - 1), np.minimum(np.floor(fy), level - 1)
+    u, v = fx - i, fy - j
+    gx0, gy0 = x0 + i * sx, y0 + j * sy
+    gx1, gy1 = x0 + (i + 1) * sx, y0 + (j + 1) * sy
+    z00, z10 = hm.sample(gx0, gy0).astype(np.float64), hm.sample(gx1, gy0).astype(np.float64)
+    z01, z11 = hm.sample(gx0, gy1).astype(np.float64), hm.sample(gx1, gy1).astype(np.float64)
+    lower = u >= v
+    return np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00))
+
+
+def _peak_base(hm, table, xs, ys, level):
+    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height."""
+    def make():
+        return (_grid_height_at_peak(hm, table, xs, ys, level) - table.h_max).ravel()
+    return _cached(table, ("peak_dz", level), make)
+
+
+def _peak_clip(hm, table, m):
+    """Clip x, y, w of every tile's peak, flat (nty * ntx,) each."""
+    top = _cached(table, "peak", lambda: to_world(hm, table.peak_x, table.peak_y, table.h_max).reshape(-1, 3))
+    return _clip(m, top)
+
+
+def _peak_error_px(hm, table, camera, xs, ys, level):
+    """Projected vertical error at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64."""
+    m = _clip_matrix(camera)
+    err = _vertical_error_px(camera, m, _peak_clip(hm, table, m), _peak_base(hm, table, xs, ys, level))
+    return err.reshape(table.h_max.shape)
+
+
+def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
+    """T_min per tile, clamped to [1, T_max]: (nty, ntx) float64.
+
+    SEARCH tests each power of two only on the tiles no coarser level has brought within ε.
+    """
+    eps = settings.epsilon
+    if settings.t_min_rule == "SEARCH":
+        m = _clip_matrix(camera)
+        top = _peak_clip(hm, table, m)
+        t = np.full(t_max.size, float(settings.max_level))
+        todo = np.arange(t_max.size)
+        level = 1
+        while level <= settings.max_level and len(todo):
+            dz = _peak_base(hm, table, xs, ys, level)[todo]
+            ok = _vertical_error_px(camera, m, [c[todo] for c in top], dz) <= eps
+            t[todo[ok]] = level
+            todo = todo[~ok]
+            level *= 2
+        t = t.reshape(t_max.shape)
+    else:
+        h_hat = _peak_error_px(hm, table, camera, xs, ys, 1)
+        with np.errstate(divide="ignore"):
+            ratio = h_hat / eps if settings.t_min_rule == "LOG2" else eps / h_hat
+            t = np.log2(np.where(h_hat > 0, ratio, 1.0))
+    return np.clip(t, 1.0, t_max)
+
+
+def _culled(hm, table, camera, xs, ys):
+    """Tiles whose bounding box lies outside one frustum plane: (nty, ntx) bool.
+
+    Per plane ``p`` (clip ±x, ±y, ±z against w) a box is outside when its corner that maximises ``p`` is: the
+    maximum of a linear function over a box is the sum of its per-axis maxima (x per tile column, y per row).
+    """
+    m = _clip_matrix(camera)
+    (x0, x1), (y0, y1) = xs, ys
+    wx = [(x[0] - (hm.width - 1) * 0.5) * hm.texel_size for x in (x0, x1)]  # (ntx,) each, as in to_world
+    wy = [(y[:, 0] - (hm.height - 1) * 0.5) * hm.texel_size for y in (y0, y1)]  # (nty,) each
+    out = np.zeros(x0.shape, bool)
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            p = m[3] + sign * m[axis]
+            top_x = np.maximum(p[0] * wx[0], p[0] * wx[1])
+            top_y = np.maximum(p[1] * wy[0], p[1] * wy[1])
+            top_z = p[2] * (table.h_max if p[2] > 0 else table.h_min)
+            out |= (top_z + top_y[:, None]) + (top_x[None, :] + p[3]) < 0
+    return out
+
+
+def _round(levels, settings):
+    f = np.clip(levels, 1.0, settings.max_level)
+    if settings.levels == "INTEGER":
+        return np.ceil(f)
+    if settings.levels == "POW2":
+        m, e = np.frexp(f)  # f = m·2^e, m in [0.5, 1): the next power of two is 2^e, or f itself when m = 0.5
+        return np.minimum(np.ldexp(1.0, e - (m == 0.5)), settings.max_level)
+    return f
+
+
+def _neighbour(a, side, fill):
+    """The neighbouring tile's value across ``side`` (fill outside the map): (nty, ntx)."""
+    out = np.full_like(a, fill)
+    if side == 0:
+        out[1:] = a[:-1]
+    elif side == 2:
+        out[:-1] = a[1:]
+    elif side == 3:
+        out[:, 1:] = a[:, :-1]
+    else:
+        out[:, :-1] = a[:, 1:]
+    return out
+
+
+def select(hm, table, camera, settings=TerrainLod()):
+    """Edge and inner levels of every tile for ``camera`` (a `camera.Camera` in terrain-local space).
+
+    With ``camera=None`` the result is view-independent: every level is its T_max (the terrain as close up
+    as it ever needs to be), nothing is culled.
+    """
+    if table.shape != (hm.height, hm.width):
+        raise InvalidInputError("The tile table was made for a different height map; analyse the map again")
+    ntx, nty = table.counts
+    ts = table.tile_size
+    # "a quad always covers a texel" (seed §5.4.2): no level above the tile's size in texels
+    settings = replace(settings, max_level=min(settings.max_level, ts))
+    xb = tile_bounds(np.arange(ntx), ts, hm.width)
+    yb = tile_bounds(np.arange(nty), ts, hm.height)
+    xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
+    ys = tuple(np.broadcast_to(b[:, None].astype(np.float64), (nty, ntx)) for b in yb)
+    top = float(settings.max_level)
+    if settings.mode == "UNIFORM":
+        t_max = np.full((nty, ntx), top)
+        t_min = t_max.copy()
+    elif settings.mode == "DISTANCE":
+        t_max, t_min = np.full((nty, ntx), top), np.ones((nty, ntx))
+    elif camera is None:
+        t_max = g_of_ham(table.ham_max, settings)
+        t_min = t_max
+    else:
+        t_max = g_of_ham(table.ham_max, settings)
+        t_min = t_min_levels(hm, table, camera, settings, t_max, xs, ys)
+    if camera is None:  # the distance law at d = 0 everywhere: T_max
+        eye, d_max = np.zeros(3), np.inf
+    else:
+        eye, d_max = camera.eye, auto_d_max(hm, camera, settings)
+    (x0, x1), (y0, y1) = xs, ys
+    mx, my = (x0 + x1) * 0.5, (y0 + y1) * 0.5
+    points = ((mx, y0), (x1, my), (mx, y1), (x0, my))
+    edge = np.empty((nty, ntx, 4))
+    for side, (px, py) in enumerate(points):
+        p = _cached(table, ("edge", side), lambda px=px, py=py: _planes(to_world(hm, px, py, hm.sample(px, py))))
+        e_max = np.maximum(t_max, _neighbour(t_max, side, 0.0))
+        e_min = np.maximum(t_min, _neighbour(t_min, side, 0.0))
+        edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
+    centre = _cached(table, "centre", lambda: _planes(to_world(hm, mx, my, hm.sample(mx, my))))
+    inner = distance_level(_distance(eye, centre), t_max, t_min, d_max)
+    if settings.culling and camera is not None:
+        culled = _culled(hm, table, camera, xs, ys)
+    else:
+        culled = np.zeros((nty, ntx), bool)
+    rounded = _round(edge, settings)
+    h_edges = np.concatenate([rounded[:, :, 0], rounded[-1:, :, 2]], axis=0)
+    v_edges = np.concatenate([rounded[:, :, 3], rounded[:, -1:, 1]], axis=1)
+    return Selection(t_max, t_min, edge, _round(inner, settings), culled, h_edges, v_edges, settings.spacing)

@@ -1,0 +1,192 @@
+"""Crack-free terrain mesh from per-tile levels (a `terrain_lod.Selection`): welded, one pattern per class.
+
+Each tile is a quad domain with four edge segment counts and one inner count (from `partition`). Its pattern:
+an inner grid of ``n - 1`` × ``n - 1`` points, each cell split along its (i, j)-(i+1, j+1) diagonal, and
+four strips that zip the edge points to the grid's outer ring (a monotone merge of two parallel rows of
+points). A tile whose edges all have one segment and whose inner count is 1 is two triangles; otherwise the
+inner count is at least 2, so a ring exists.
+
+Vertices are welded by construction: a tile corner is one vertex for four tiles, an edge point one vertex
+for its two tiles (edges run +x or +y, so both tiles read the same points), inner points belong to their
+tile. A shared edge therefore cannot crack. Culled tiles emit no triangles; unused vertices are dropped.
+Triangles are counter-clockwise seen from +z.
+"""
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..common.partition import clamp_levels, point_params, segment_counts
+from .analysis import tile_bounds
+from .lod import to_world
+
+
+@dataclass
+class TerrainMesh:
+    """positions (n, 3) float32 (terrain-local world), uvs (n, 2) float32 (x / (W-1), y / (H-1)),
+    samples (n, 2) float64 (sample coordinates), triangles (m, 3) int32."""
+
+    positions: np.ndarray
+    uvs: np.ndarray
+    samples: np.ndarray
+    triangles: np.ndarray
+
+
+def _zip(outer, inner):
+    """Triangles of the strip between two parallel rows (both listed counter-clockwise around the tile)."""
+    p, q = len(outer) - 1, len(inner) - 1
+    tris, i, j = [], 0, 0
+    while i < p or j < q:
+        if j == q or (i < p and (2 * i + 1) * q <= (2 * j + 1) * p):
+            tris.append((outer[i], outer[i + 1], inner[j]))
+            i += 1
+        else:
+            tris.append((outer[i], inner[j + 1], inner[j]))
+            j += 1
+    return tris
+
+
+@lru_cache(maxsize=4096)
+def pattern(c0, c1, c2, c3, n):
+    """Triangles of one tile class in local vertex indices: (k, 3) int32.
+
+    Local vertices: 0..3 corners (0,0) (1,0) (1,1) (0,1); then the interior points of sides BOTTOM, RIGHT,
+    TOP, LEFT (``c - 1`` each, in +x or +y order); then the inner grid, row-major, ``(n - 1)²`` points.
+    """
+    counts = (c0, c1, c2, c3)
+    if n == 1 and max(counts) == 1:
+        return np.array([(0, 1, 2), (0, 2, 3)], np.int32)
+    starts = np.cumsum((4,) + tuple(c - 1 for c in counts))
+    side = [list(range(starts[s], starts[s] + counts[s] - 1)) for s in range(4)]
+    rows = [[0] + side[0] + [1], [1] + side[1] + [2], [2] + side[2][::-1] + [3], [3] + side[3][::-1] + [0]]
+    m = n - 1
+    grid = starts[4] + np.arange(m * m).reshape(m, m)  # grid[j - 1, i - 1]
+    ring = [list(grid[0, :]), list(grid[:, -1]), list(grid[-1, ::-1]), list(grid[::-1, 0])]
+    tris = [t for s in range(4) for t in _zip(rows[s], ring[s])]
+    if m > 1:
+        a, b = grid[:-1, :-1].ravel(), grid[:-1, 1:].ravel()
+        c, d = grid[1:, 1:].ravel(), grid[1:, :-1].ravel()
+        cells = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+        return np.concatenate([np.array(tris, np.int32).reshape(-1, 3), cells.astype(np.int32)])
+    return np.array(tris, np.int32)
+
+
+def _tile_counts(selection):
+    """Edge segment counts (nty, ntx, 4) and the inner counts the patterns use (nty, ntx)."""
+    sp = selection.spacing
+    hc, vc = segment_counts(selection.h_edges, sp), segment_counts(selection.v_edges, sp)
+    ec = np.stack([hc[:-1], vc[:, 1:], hc[1:], vc[:, :-1]], -1)  # per tile: BOTTOM, RIGHT, TOP, LEFT
+    n = selection.inner_counts.astype(np.int64)
+    return ec, np.where((n == 1) & (ec.max(-1) > 1), 2, n)
+
+
+def triangle_count(selection):
+    """Triangles `bake` will make, without making them (for memory guards and benchmarks): int."""
+    ec, n = _tile_counts(selection)
+    m = n - 1
+    per_tile = np.where(m == 0, 2, ec.sum(-1) + 4 * (m - 1) + 2 * (m - 1) ** 2)
+    return int(per_tile[~selection.culled].sum())
+
+
+def pattern_codes(c0, c1, c2, c3, n):
+    """What each local vertex of `pattern` is, for GPU patterns: (L, 3) float32 rows (kind, a, b).
+
+    kind 0: corner at (u, v) = (a, b); kinds 1-4: point ``a`` of side BOTTOM, RIGHT, TOP, LEFT; kind 5: inner
+    grid point (i, j) = (a, b). Positions follow from the tile's levels with `partition.point_params`.
+    """
+    rows = [(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)]
+    for s, c in enumerate((c0, c1, c2, c3)):
+        rows += [(s + 1, k, 0) for k in range(1, c)]
+    if not (n == 1 and max(c0, c1, c2, c3) == 1):
+        rows += [(5, i, j) for j in range(1, n) for i in range(1, n)]
+    return np.array(rows, np.float32)
+
+
+def pattern_classes(selection):
+    """Tiles grouped by pattern: dict (c0, c1, c2, c3, n) -> visible tile indices (row-major) int64."""
+    ec, n = _tile_counts(selection)
+    keys = np.concatenate([ec.reshape(-1, 4), n.reshape(-1, 1)], 1)
+    visible = np.nonzero(~selection.culled.ravel())[0]
+    classes, inverse = np.unique(keys[visible], axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    return {tuple(int(v) for v in key): visible[inverse == k] for k, key in enumerate(classes)}
+
+
+def _edge_points(levels, spacing, fixed, lo, hi, along_x):
+    """Interior points of a family of edges: counts (k,), first index (k,), sample coords (total, 2)."""
+    counts = segment_counts(levels, spacing).ravel()
+    f = clamp_levels(levels, spacing).ravel()
+    first = np.concatenate([[0], np.cumsum(counts - 1)])[:-1]
+    edge = np.repeat(np.arange(counts.size), counts - 1)
+    k = np.arange(edge.size) - first[edge] + 1
+    t = point_params(f[edge], counts[edge], k, spacing)
+    a, b, c = lo.ravel()[edge], hi.ravel()[edge], fixed.ravel()[edge]
+    pos = a + t * (b - a)
+    xy = np.stack([pos, c], 1) if along_x else np.stack([c, pos], 1)
+    return counts.reshape(levels.shape), first.reshape(levels.shape), xy
+
+
+def bake(hm, table, selection):
+    """The terrain mesh of a selection (`TerrainMesh`)."""
+    ntx, nty = table.counts
+    ts, spacing = table.tile_size, selection.spacing
+    xb = np.concatenate([tile_bounds(np.arange(ntx), ts, hm.width)[0], [hm.width - 1]]).astype(np.float64)
+    yb = np.concatenate([tile_bounds(np.arange(nty), ts, hm.height)[0], [hm.height - 1]]).astype(np.float64)
+    gy, gx = np.meshgrid(yb, xb, indexing="ij")
+    corners = np.stack([gx.ravel(), gy.ravel()], 1)  # (nty + 1) * (ntx + 1), row-major
+    hc, hf, hxy = _edge_points(selection.h_edges, spacing, gy[:, :-1], gx[:, :-1], gx[:, 1:], True)
+    vc, vf, vxy = _edge_points(selection.v_edges, spacing, gx[:-1, :], gy[:-1, :], gy[1:, :], False)
+    _, n = _tile_counts(selection)
+    f_in = clamp_levels(selection.inner, spacing)  # EQUAL spacing ignores it; a forced 2 stays exact
+    # inner grid points per tile, row-major, (n - 1)² each
+    m = (n - 1).ravel()
+    inner_first = np.concatenate([[0], np.cumsum(m * m)])[:-1]
+    tile = np.repeat(np.arange(m.size), m * m)
+    local = np.arange(tile.size) - inner_first[tile]
+    mm = np.maximum(m[tile], 1)
+    i, j = local % mm + 1, local // mm + 1
+    ff, nn = f_in.ravel()[tile], n.ravel()[tile]
+    ti, tj = point_params(ff, nn, i, spacing), point_params(ff, nn, j, spacing)
+    tx, ty = tile % ntx, tile // ntx
+    ixy = np.stack([xb[tx] + ti * (xb[tx + 1] - xb[tx]), yb[ty] + tj * (yb[ty + 1] - yb[ty])], 1)
+
+    n_c, n_h = corners.shape[0], hxy.shape[0]
+    base_in = n_c + n_h + vxy.shape[0]
+    samples = np.concatenate([corners, hxy, vxy, ixy])
+    tri_parts = []
+    for key, tiles in pattern_classes(selection).items():
+        c = key[:4]
+        tmpl = pattern(*key)
+        tyi, txi = tiles // ntx, tiles % ntx
+        cols = [tyi * (ntx + 1) + txi, tyi * (ntx + 1) + txi + 1, (tyi + 1) * (ntx + 1) + txi + 1,
+                (tyi + 1) * (ntx + 1) + txi]
+        starts = (n_c + hf[tyi, txi], n_c + n_h + vf[tyi, txi + 1], n_c + hf[tyi + 1, txi], n_c + n_h + vf[tyi, txi])
+        for s in range(4):
+            cols += [starts[s] + q for q in range(c[s] - 1)]
+        mloc = key[4] - 1
+        if not (mloc == 0 and max(c) == 1):
+            cols += [base_in + inner_first[tiles] + q for q in range(mloc * mloc)]
+        lmap = np.stack(cols, 1)
+        tri_parts.append(lmap[:, tmpl].reshape(-1, 3))
+    tris = np.concatenate(tri_parts) if tri_parts else np.zeros((0, 3), np.int64)
+    used = np.zeros(samples.shape[0], bool)
+    used[tris.ravel()] = True
+    remap = np.cumsum(used) - 1
+    samples = samples[used]
+    z = hm.sample(samples[:, 0], samples[:, 1])
+    positions = to_world(hm, samples[:, 0], samples[:, 1], z).astype(np.float32)
+    uvs = (samples / [hm.width - 1, hm.height - 1]).astype(np.float32)
+    return TerrainMesh(positions, uvs, samples, remap[tris].astype(np.int32))
+
+
+def full_grid(hm):
+    """The full-resolution grid (one quad per texel, the seed's "no LOD" reference): `TerrainMesh`."""
+    h, w = hm.height, hm.width
+    gy, gx = np.meshgrid(np.arange(h, dtype=np.float64), np.arange(w, dtype=np.float64), indexing="ij")
+    samples = np.stack([gx.ravel(), gy.ravel()], 1)
+    v = np.arange(h * w).reshape(h, w)
+    a, b, c, d = v[:-1, :-1].ravel(), v[:-1, 1:].ravel(), v[1:, 1:].ravel(), v[1:, :-1].ravel()
+    tris = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]).astype(np.int32)
+    positions = to_world(hm, gx.ravel(), gy.ravel(), hm.heights().ravel()).astype(np.float32)
+    return TerrainMesh(positions, (samples / [w - 1, h - 1]).astype(np.float32), samples, tris)

@@ -1,0 +1,194 @@
+"""Adaptive tessellation metrics as pure functions (digest 001 §4, with its corrections).
+
+Each metric maps per-edge data to a level, so the two triangles of a shared edge compute the same
+value bit for bit (the crack-free rule): every edge function is symmetric in its two endpoints
+(``a + b`` and ``(a - b)^2`` are exact under swapping) and uses nothing but that edge's data. Inner
+levels may use the whole triangle. Levels are float64; `clamp_and_round` applies the cap and the
+optional power-of-two rounding at the end.
+
+Functions take arrays with a leading "any" shape ``(...)`` so the same code serves per-edge ``(E,)``
+and per-face-side ``(T, 3)`` inputs (the latter is how a GPU patch sees them; tests compare the two).
+"""
+
+import numpy as np
+
+from ..common.errors import InvalidInputError
+from ..common.partition import MAX_LEVEL
+
+DISTANCE_MAPS = ("LINEAR", "INVERSE")
+POWER_OF_TWO = ("NONE", "CEIL", "FLOOR", "NEAREST")
+
+
+def _dot(a, b):
+    return np.einsum("...i,...i->...", a, b)
+
+
+def distance_level(d, d_min, d_max, t_max, mapping="LINEAR"):
+    """Camera-distance level (Eqs. 4.1-4.3), clamped to ``[1, t_max]``.
+
+    d: (...) distances. ``LINEAR``: ``t_max`` at ``d_min`` falling linearly to 1 at ``d_max``. ``INVERSE``:
+    the z-buffer-like ``A/d + B`` through the same two points (more levels near the camera).
+    """
+    if not d_max > d_min > 0 and mapping == "INVERSE":
+        raise InvalidInputError("The inverse distance map needs 0 < near distance < far distance")
+    if not d_max > d_min:
+        raise InvalidInputError("The far distance must be larger than the near distance")
+    d = np.asarray(d, dtype=np.float64)
+    if mapping == "LINEAR":
+        t = 1.0 + (t_max - 1.0) * (d_max - d) / (d_max - d_min)
+    elif mapping == "INVERSE":
+        a = (t_max - 1.0) * d_max * d_min / (d_max - d_min)
+        b = (d_max - t_max * d_min) / (d_max - d_min)
+        with np.errstate(divide="ignore"):
+            t = np.where(d > 0, a / np.maximum(d, np.finfo(np.float64).tiny) + b, t_max)
+    else:
+        raise InvalidInputError(f"Unknown distance map {mapping!r}; expected one of {', '.join(DISTANCE_MAPS)}")
+    return np.clip(t, 1.0, t_max)
+
+
+def edge_midpoints(a, b):
+    """(..., 3) x2 -> (..., 3) float64, symmetric in ``a`` and ``b``."""
+    return (np.asarray(a, np.float64) + np.asarray(b, np.float64)) * 0.5
+
+
+def distance_edge_levels(a, b, eye, d_min, d_max, t_max, mapping="LINEAR"):
+    """Distance metric per edge, from the distance of the edge midpoint to the eye: (..., 3) x2 -> (...)."""
+    m = edge_midpoints(a, b) - np.asarray(eye, np.float64)
+    return distance_level(np.sqrt(_dot(m, m)), d_min, d_max, t_max, mapping)
+
+
+def distance_inner_levels(corners, eye, d_min, d_max, t_max, mapping="LINEAR"):
+    """Distance metric inner level from the triangle centroid: (T, 3, 3) -> (T,)."""
+    c = np.asarray(corners, np.float64).mean(axis=1) - np.asarray(eye, np.float64)
+    return distance_level(np.sqrt(_dot(c, c)), d_min, d_max, t_max, mapping)
+
+
+def to_eye(points, view):
+    """World points (..., 3) -> eye space (..., 3) with a (4, 4) row-major view matrix."""
+    view = np.asarray(view, np.float64)
+    return np.asarray(points, np.float64) @ view[:3, :3].T + view[:3, 3]
+
+
+def projected_edge_levels(a, b, view, projection, height, e_max, t_max=MAX_LEVEL):
+    """Largest projected length of each edge in pixels over ``e_max`` (digest 001 §4.4, corrected).
+
+    The edge is treated as a sphere of diameter ``|b - a|`` at its midpoint: the midpoint ``m`` and
+    ``m + (0, |b - a|, 0)`` are taken in **eye space** and projected, so the result does not depend on
+    the edge's orientation. ``l_s = |y_ndc(m') - y_ndc(m)| * height / 2``, level ``l_s / e_max``.
+
+    a, b: (..., 3) world points; view, projection: (4, 4) row-major; height: viewport height in pixels.
+    An edge whose sphere reaches behind the eye plane gets ``t_max``; one entirely behind gets 1.
+    Returns (...) float64 in ``[1, t_max]``.
+    """
+    if e_max <= 0:
+        raise InvalidInputError("The target edge length in pixels must be positive")
+    pa, pb = to_eye(a, view), to_eye(b, view)
+    m = (pa + pb) * 0.5
+    diff = pa - pb
+    d = np.sqrt(_dot(diff, diff))
+    proj = np.asarray(projection, np.float64)
+
+    def ndc_y(x, y, z):
+        clip_y = proj[1, 0] * x + proj[1, 1] * y + proj[1, 2] * z + proj[1, 3]
+        clip_w = proj[3, 0] * x + proj[3, 1] * y + proj[3, 2] * z + proj[3, 3]
+        return clip_y, clip_w
+
+    y0, w0 = ndc_y(m[..., 0], m[..., 1], m[..., 2])
+    y1, w1 = ndc_y(m[..., 0], m[..., 1] + d, m[..., 2])
+    ahead = (w0 > 0) & (w1 > 0)
+    safe0, safe1 = np.where(ahead, w0, 1.0), np.where(ahead, w1, 1.0)
+    pixels = np.abs(y1 / safe1 - y0 / safe0) * (height * 0.5)
+    t = np.where(ahead, pixels / e_max, 1.0)
+    # Perspective: eye looks down -z. A sphere that crosses the eye plane is huge on screen.
+    crosses = m[..., 2] + 0.5 * d > 0
+    t = np.where(crosses & (m[..., 2] - 0.5 * d < 0), t_max, t)
+    return np.clip(t, 1.0, t_max)
+
+
+def face_normals(corners):
+    """Unnormalised face normals ``(p1 - p0) x (p2 - p0)``: (T, 3, 3) -> (T, 3) float64."""
+    p = np.asarray(corners, np.float64)
+    return np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+
+
+def silhouette_products(a, b, n_this, n_other, eye):
+    """Eq. 4.7 and 4.8 per edge: ``u = (v·n_this)(v·n_other)`` and its normalised form, ``v = eye - mid``.
+
+    a, b: (..., 3) edge endpoints; n_this, n_other: (..., 3) unit normals of the two faces. The product
+    is commutative, so either face computes the same value. Returns ``(u, u_hat)``, (...) float64 each.
+    """
+    v = np.asarray(eye, np.float64) - edge_midpoints(a, b)
+    x, y = _dot(v, np.asarray(n_this, np.float64)), _dot(v, np.asarray(n_other, np.float64))
+    vv = _dot(v, v)
+    u = x * y
+    u_hat = np.divide(u, vv, out=np.zeros_like(u), where=vv > 0)
+    return u, u_hat
+
+
+def silhouette_edge_levels(u, t_max):
+    """Eq. 4.9: ``t_max`` where the edge is a silhouette (``u < 0``), else 1. (...) -> (...)."""
+    return np.where(np.asarray(u) < 0, float(t_max), 1.0)
+
+
+def silhouette_inner_levels(u, u_hat, t_max, beta):
+    """Eq. 4.10 per face from its edges' ``u`` and ``u_hat`` (T, 3): the largest ramp over silhouette edges.
+
+    ``t = t_max - (t_max - 1) |u_hat| / beta`` where ``u <= 0`` and ``|u_hat| <= beta``, else 1.
+    """
+    if beta <= 0:
+        raise InvalidInputError("The silhouette ramp width beta must be positive")
+    u, u_hat = np.asarray(u, np.float64), np.abs(np.asarray(u_hat, np.float64))
+    ramp = t_max - (t_max - 1.0) * u_hat / beta
+    t = np.where((u <= 0) & (u_hat <= beta), ramp, 1.0)
+    return t.max(axis=-1)
+
+
+def curve_kappa(control):
+    """Eq. 4.4: the largest ``|p_i - (p_{i-1} + p_{i+1}) / 2| / |p_{i+1} - p_{i-1}|`` over interior points.
+
+    control: (..., n, d) control polygons, n >= 3. Degenerate chords (zero denominator) count as the
+    cap (``inf``) when the numerator is non-zero, 0 otherwise (digest 001 §10 item 5). Returns (...).
+    """
+    c = np.asarray(control, np.float64)
+    if c.shape[-2] < 3:
+        return np.zeros(c.shape[:-2])
+    num = c[..., 1:-1, :] - 0.5 * (c[..., :-2, :] + c[..., 2:, :])
+    den = c[..., 2:, :] - c[..., :-2, :]
+    num, den = np.sqrt(_dot(num, num)), np.sqrt(_dot(den, den))
+    kappa = np.divide(num, den, out=np.where(num > 0, np.inf, 0.0), where=den > 0)
+    return kappa.max(axis=-1)
+
+
+def curvature_level(kappa, n_control=4, gain=10.0, t_max=32.0, minimum=None):
+    """Eq. 4.5: ``max(minimum, min(t_max, gain * kappa))``; ``minimum`` defaults to ``2 (n - 1)``."""
+    low = 2.0 * (n_control - 1) if minimum is None else float(minimum)
+    return np.maximum(low, np.minimum(t_max, gain * np.asarray(kappa, np.float64)))
+
+
+def pn_inner_kappa(control):
+    """Curvature of the three interior isocurves of a cubic triangle net, through b111. (T, 10, 3) -> (T,).
+
+    Rows (in `kernels.tessellation.patches.cubic_basis` order): b120-b111-b102, b210-b111-b012, b201-b111-b021.
+    """
+    c = np.asarray(control, np.float64)
+    rows = np.stack([c[:, [4, 9, 7]], c[:, [3, 9, 6]], c[:, [8, 9, 5]]], axis=1)
+    return curve_kappa(rows).max(axis=1)
+
+
+def clamp_and_round(levels, t_max=MAX_LEVEL, power_of_two="NONE"):
+    """Clamp to ``[1, t_max]`` (``t_max <= 64``) and optionally round to a power of two.
+
+    ``CEIL`` is the digest's default (18 and 20 -> 32); ``FLOOR`` and ``NEAREST`` (nearest in log2) are
+    options. A rounded level never exceeds the largest power of two ``<= t_max``.
+    """
+    if not 1 <= t_max <= MAX_LEVEL:
+        raise InvalidInputError(f"The maximum level must lie in [1, {MAX_LEVEL}]; got {t_max}")
+    t = np.clip(np.asarray(levels, np.float64), 1.0, float(t_max))
+    if power_of_two == "NONE":
+        return t
+    if power_of_two not in POWER_OF_TWO:
+        raise InvalidInputError(f"Unknown power-of-two rounding {power_of_two!r}")
+    exponent = np.log2(t)
+    rounder = {"CEIL": np.ceil, "FLOOR": np.floor, "NEAREST": np.round}[power_of_two]
+    cap = np.floor(np.log2(float(t_max)))
+    return np.exp2(np.minimum(rounder(exponent), cap))

@@ -1,0 +1,121 @@
+"""Evaluate a patch surface (any polynomial basis) at every vertex of a `Refinement`.
+
+Output vertices come in three groups (see `kernels.tessellation.refine`): input corners (copied), edge points
+(evaluated once per mesh edge from that edge's own control, in the canonical direction, so shared
+edges are bit-identical from both sides) and interior points (evaluated from their face's control).
+
+Points of the same *class* (edges with the same segment count and level, faces with the same inner
+level) sit at the same parameters, so a class is evaluated as one matrix product
+``basis (P, K) @ control (K, owners * C)``. When there are too many classes for that to pay (random
+adaptive levels), points are evaluated one by one in chunks. Both give the same values up to the
+summation order of float64 products (checked in the tests).
+"""
+
+import numpy as np
+
+from ..common.topology import group_by_class, ragged
+from .interpolate import normalize_channels
+
+#: Use per-class matrix products when there are at most this many classes, or few per owner.
+MAX_CLASSES = 256
+#: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
+CHUNK = 1 << 16
+#: Points per chunk on the class path (keeps the float64 temporaries in cache before they are rounded).
+CHUNK_POINTS = 1 << 15
+
+
+def _class_path(n_classes, n_owners):
+    return n_classes <= MAX_CLASSES or n_classes * 16 <= n_owners
+
+
+def _evaluate_group(out, first, counts, keys, template_of, all_params, control, basis, unit=False):
+    """Evaluate points owned by rows of ``control``; writes ``out[first + ...]``.
+
+    counts: (K,) points per owner, stored contiguously in owner order from ``first``; keys: (K,) class
+    of each owner (same key -> same parameters); template_of: ``(owner, start) -> (P, ...)`` parameters
+    of one owner's points; all_params: ``() -> (N, ...)`` every point's parameters (the point path);
+    control: (K, k, C); basis: callable ``params (P, ...) -> (P, k)``; unit: normalise each value (in
+    float64, before rounding).
+    """
+    n = int(counts.sum())
+    if n == 0:
+        return
+    starts = np.cumsum(counts) - counts
+    if keys.min() == keys.max():
+        uniq, inverse = keys[:1], np.zeros(len(keys), np.int64)
+    else:
+        uniq, inverse = np.unique(keys, return_inverse=True)
+    channels = control.shape[2]
+    if _class_path(len(uniq), len(counts)):
+        planes = [np.ascontiguousarray(control[:, :, c]) for c in range(channels)]  # (K, k) per channel
+        for owners in group_by_class(inverse, len(uniq)):
+            p = int(counts[owners[0]])
+            if p == 0:
+                continue
+            basis_t = np.ascontiguousarray(basis(template_of(owners[0], int(starts[owners[0]]))).T)  # (k, p)
+            consecutive = owners[-1] - owners[0] + 1 == len(owners)
+            step = max(1, CHUNK_POINTS // p)
+            for lo in range(0, len(owners), step):
+                chunk = owners[lo : lo + step]
+                pick = slice(chunk[0], chunk[-1] + 1) if consecutive else chunk
+                vals = [plane[pick] @ basis_t for plane in planes]  # C x (n, p) float64
+                if unit:
+                    normalize_channels(vals)
+                if consecutive:
+                    at = first + int(starts[chunk[0]])
+                    block = out[at : at + len(chunk) * p].reshape(len(chunk), p, channels)
+                    for c in range(channels):
+                        block[:, :, c] = vals[c]
+                else:
+                    rows = (first + starts[chunk][:, None] + np.arange(p)).ravel()
+                    out[rows] = np.stack([v.ravel() for v in vals], axis=1)
+        return
+    owner, _, _ = ragged(counts)
+    params = all_params()
+    for lo in range(0, n, CHUNK):
+        hi = min(n, lo + CHUNK)
+        b = basis(params[lo:hi])
+        vals = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
+        if unit:
+            normalize_channels([vals[:, c] for c in range(channels)])
+        out[first + lo : first + hi] = vals
+
+
+def _edge_keys(ref):
+    return ref.edge_level if ref.spacing != "EQUAL" else ref.edge_segments.astype(np.float64)
+
+
+def _inner_keys(ref):
+    return ref.inner_level if ref.spacing != "EQUAL" else ref.inner_segments.astype(np.float64)
+
+
+def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control, face_basis, unit=False):
+    """Values of a patch surface at every output vertex.
+
+    corner_values: (V, C) values at the input vertices (the patches interpolate them);
+    edge_control: (E, ke, C) per mesh edge, for the direction ``edges[e, 0] -> edges[e, 1]``;
+    edge_basis: ``t (P,) -> (P, ke)``; face_control: (T, kf, C); face_basis: ``bary (P, 3) -> (P, kf)``.
+    unit: normalise every value (a normal field); the corner values must then be unit already.
+    Returns (n_vertices, C) float32 (evaluated in float64, rounded once).
+    """
+    channels = face_control.shape[2]
+    out = np.empty((ref.n_vertices, channels), dtype=np.float32)
+    out[: ref.n_corners] = corner_values
+    edge_counts = np.maximum(ref.edge_segments - 1, 0)
+    _evaluate_group(out, ref.n_corners, edge_counts, _edge_keys(ref),
+                    lambda e, start: ref.edge_point_t[start : start + int(edge_counts[e])],
+                    lambda: ref.edge_point_t, edge_control, edge_basis, unit)
+    _evaluate_group(out, ref.n_corners + len(ref.edge_point_edge), ref.interior_counts, _inner_keys(ref),
+                    ref.interior_template, lambda: ref.interior_bary, face_control, face_basis, unit)
+    return out
+
+
+def evaluate_corners(ref, triangles, face_control, face_basis):
+    """A face field at the corners of some output triangles: (m,) ids -> (m, 3, C) float64.
+
+    Uses ``ref.corner_bary``; for fields that differ between the faces of a shared vertex (split normals).
+    """
+    faces = ref.triangle_face[triangles]
+    bary = ref.corner_bary[triangles].reshape(-1, 3)
+    b = face_basis(bary).reshape(len(triangles), 3, -1)
+    return np.einsum("mck,mkd->mcd", b, face_control[faces])

@@ -1,0 +1,413 @@
+"""Tubes around polylines (seed 000 §4): rings on rotation-minimising frames, LOD, anti-aliasing clamp, caps.
+
+Ring ``k`` of a tube with ``n`` sides has vertices ``P_k + r_k (cos θ_j N_k + sin θ_j B_k)``, θ_j = 2πj/n,
+with radial unit normals (seed eq. 4-2, 4-8). Rings are welded around (no duplicate seam vertex; the UV seam
+is carried by corner UVs) and along the tube; closed curves join their last ring to the first. Faces are
+quads (outward, counter-clockwise), caps are n-gons (FLAT) or hemispheres (ROUND).
+
+The seed's anti-aliasing clamp keeps a tube at least one pixel in radius: r_eff = max(r, s_pix), where
+s_pix is the world size of one pixel at the point's depth, found by unprojecting NDC offsets (eq. 4-5).
+Here the clamp is applied to the polygon's inscribed radius (s_pix / cos(π/n)), so the tessellated tube,
+not only the ideal cylinder, covers two pixels; an optional maximum caps the inflation.
+"""
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..common.errors import InvalidInputError
+from .caps import cap_pieces, cap_sizes
+from .curve_refine import catmull_rom, select_points
+from .frames import rotation_minimizing_frames, rotation_minimizing_frames_opencl
+from .opencl_path import TubeDevice, runtime_for
+from .polylines import arc_lengths, chunks, drop_duplicates, take_curves
+
+CAPS = ("NONE", "FLAT", "ROUND")
+SIDES_MODES = ("FIXED", "CAMERA")
+
+
+@dataclass(frozen=True)
+class TubeSettings:
+    """Options of `build_tubes`.
+
+    sides: ring vertices for FIXED; min_sides / max_sides bound CAMERA, which picks per tube
+    ceil(π · projected diameter / edge_pixels); refine: Catmull-Rom subdivisions per segment (1 = off);
+    select_angle: tolerance in radians for point selection (0 = keep all); aa_clamp: keep one pixel of radius
+    for the camera; max_radius: cap of that inflation (0 = none); caps: NONE / FLAT / ROUND; uvs: corner UVs.
+    """
+
+    sides: int = 8
+    sides_mode: str = "FIXED"
+    min_sides: int = 3
+    max_sides: int = 32
+    edge_pixels: float = 8.0
+    refine: int = 1
+    refine_kind: str = "CENTRIPETAL"
+    select_angle: float = 0.0
+    aa_clamp: bool = False
+    max_radius: float = 0.0
+    caps: str = "NONE"
+    uvs: bool = True
+
+    def validate(self, camera):
+        if self.caps not in CAPS:
+            raise InvalidInputError(f"Caps must be one of {CAPS}; got {self.caps!r}")
+        if self.sides_mode not in SIDES_MODES:
+            raise InvalidInputError(f"Sides mode must be one of {SIDES_MODES}; got {self.sides_mode!r}")
+        if not 3 <= self.sides <= 1024 or not 3 <= self.min_sides <= self.max_sides <= 1024:
+            raise InvalidInputError("Tubes need 3 to 1024 sides, with min_sides <= max_sides")
+        if (self.sides_mode == "CAMERA" or self.aa_clamp) and camera is None:
+            raise InvalidInputError("Level of detail from the camera and the anti-aliasing clamp need a camera")
+        if self.edge_pixels <= 0:
+            raise InvalidInputError("Edge length in pixels must be positive")
+
+
+@dataclass
+class PolygonMesh:
+    """A polygon mesh as flat arrays.
+
+    positions: (V, 3) float32; face_sizes: (F,) int32; corner_verts: (L,) int32 (faces consecutive);
+    edges: (E, 2) int32 and corner_edges: (L,) int32 when known (the writer then skips edge computation);
+    point_normals: (V, 3) float32 or corner_normals: (L, 3) float32; corner_uvs: (L, 2) float32 or None;
+    face_material: (F,) int32.
+    """
+
+    positions: np.ndarray
+    face_sizes: np.ndarray
+    corner_verts: np.ndarray
+    edges: np.ndarray = None
+    corner_edges: np.ndarray = None
+    point_normals: np.ndarray = None
+    corner_normals: np.ndarray = None
+    corner_uvs: np.ndarray = None
+    face_material: np.ndarray = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def face_offsets(self):
+        """First corner of every face and the corner count: (F + 1,) int32 (corner ids fit, as corner_verts)."""
+        out = np.empty(len(self.face_sizes) + 1, np.int32)
+        out[0] = 0
+        np.cumsum(self.face_sizes, dtype=np.int32, out=out[1:])
+        return out
+
+
+def pixel_world_size(points, camera):
+    """World length of one pixel at each point's depth (seed eq. 4-3..4-5): (P,) float64; inf behind the eye.
+
+    Unprojects NDC (0, 0, z) and (2 / width, 0, z) at the point's NDC depth through ViewProjection⁻¹.
+    """
+    vp = np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
+    clip = points @ vp[:3, :3].T + vp[:3, 3]
+    w = points @ vp[3, :3] + vp[3, 3]
+    in_front = w > 1e-12
+    z = np.where(in_front, clip[:, 2] / np.where(in_front, w, 1.0), 0.0)
+    inv = np.linalg.inv(vp)
+
+    def unproject(x):
+        h = inv[:, 0] * x + inv[:, 2] * z[:, None] + inv[:, 3]  # (P, 4) for NDC (x, 0, z, 1)
+        return h[:, :3] / h[:, 3:4]
+
+    size = np.linalg.norm(unproject(np.zeros((len(z), 1))) - unproject(np.full((len(z), 1), 2.0 / camera.width)),
+                          axis=1)
+    return np.where(in_front, size, np.inf)
+
+
+def tube_sides(lines, settings, pixel_size):
+    """Sides per curve (C,) int: fixed, or from the largest projected diameter (pixels) along the tube."""
+    if settings.sides_mode == "FIXED":
+        return np.full(lines.n_curves, settings.sides, np.int64)
+    diameter_px = np.where(np.isfinite(pixel_size), 2.0 * lines.radius / pixel_size, 0.0)
+    biggest = np.zeros(lines.n_curves)
+    np.maximum.at(biggest, lines.curve_of_point(), diameter_px)
+    sides = np.ceil(np.pi * biggest / settings.edge_pixels)
+    return np.clip(sides, settings.min_sides, settings.max_sides).astype(np.int64)
+
+
+def effective_radius(radius, pixel_size, sides, max_radius=0.0):
+    """r_eff = max(r, min(s_pix / cos(π / n), max_radius)) per point: (P,) float64 (max_radius 0 = no cap)."""
+    inflate = pixel_size / np.cos(np.pi / sides)
+    if max_radius > 0:
+        inflate = np.minimum(inflate, max_radius)
+    return np.where(np.isfinite(inflate), np.maximum(radius, inflate), radius)
+
+
+def prepare_lines(lines, settings):
+    """Duplicates removed, refined and selected centre lines (the O(n) pre-process)."""
+    lines = drop_duplicates(lines)
+    if settings.refine > 1:
+        lines = drop_duplicates(catmull_rom(lines, settings.refine, settings.refine_kind))
+    if settings.select_angle > 0:
+        lines = select_points(lines, settings.select_angle)
+    return lines
+
+
+def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, backend="auto"):
+    """Tube mesh around every curve of ``lines`` (`polylines.Polylines`). Returns a `PolygonMesh`.
+
+    Layout: tubes sorted by side count (stable, so FIXED keeps the curve order), bodies first, then caps.
+    Output arrays are allocated once at their final size and written in chunks of curves, so memory stays
+    close to the output itself. ``backend``: "auto" (OpenCL when a device with doubles exists, else numpy),
+    "numpy" or "opencl" (the same numbering; values equal within float32 rounding).
+    """
+    settings.validate(camera)
+    runtime = runtime_for(backend)
+    lines = prepare_lines(lines, settings)
+    report = progress or (lambda f: None)
+    frames = _frames(lines, settings, camera, runtime)
+    report(0.3)
+    layout = _Layout(lines, frames["sides"], settings)
+    mesh = layout.allocate(settings)
+    mesh.notes = list(lines.notes)
+    caps = []
+    cursor = {"v": 0, "f": 0, "c": 0, "e": 0, "cap_v": layout.body_v, "cap_e": layout.body_e}
+    units = list(layout.units())
+    device = TubeDevice(runtime, mesh) if runtime is not None else None
+    for i, (n, curves) in enumerate(units):
+        _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device)
+        report(0.3 + 0.65 * (i + 1) / len(units))
+    if device is not None:
+        device.finish()
+    _write_caps(mesh, caps, layout, settings)
+    if settings.caps == "FLAT":
+        mesh.corner_normals[: layout.body_c] = mesh.point_normals[mesh.corner_verts[: layout.body_c]]
+        mesh.point_normals = None
+    report(1.0)
+    return mesh
+
+
+def tube_sections(lines, settings, camera=None):
+    """What a GPU draw of the tubes needs: the prepared `Polylines` and per point unit N, B (float32 (P, 3))
+    and the radius before the anti-aliasing clamp (which the shader applies per frame); sides per curve."""
+    lines = prepare_lines(lines, settings)
+    frames = _frames(lines, replace(settings, aa_clamp=False), camera, runtime_for("auto"))
+    return lines, frames
+
+
+def lod_sides(lines, settings, camera):
+    """Sides per curve (C,) for ``camera`` (prepared lines): what a preview recomputes when the view moves."""
+    pixel = pixel_world_size(lines.points, camera) if camera is not None else np.full(len(lines.points), np.inf)
+    return tube_sides(lines, settings, pixel)
+
+
+def _frames(lines, settings, camera, runtime=None):
+    """Per point: unit T, N, B (float32), effective radius, arc length; per curve: sides and length.
+
+    Chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
+    n_pts = len(lines.points)
+    out = {k: np.empty((n_pts, 3), np.float32) for k in ("t", "n", "b")}
+    out["radius"] = np.empty(n_pts, np.float32)
+    out["arc"], out["total"] = np.empty(n_pts), np.empty(lines.n_curves)
+    out["sides"] = np.empty(lines.n_curves, np.int64)
+    for c0, c1 in chunks(lines, 1 << 20):
+        sub = take_curves(lines, c0, c1)
+        p0, p1 = lines.offsets[c0], lines.offsets[c1]
+        pixel = pixel_world_size(sub.points, camera) if camera is not None else np.full(len(sub.points), np.inf)
+        sides = tube_sides(sub, settings, pixel)
+        out["sides"][c0:c1] = sides
+        radius = sub.radius
+        if settings.aa_clamp:
+            radius = effective_radius(radius, pixel, np.repeat(sides, sub.counts), settings.max_radius)
+        out["radius"][p0:p1] = radius
+        arc, total = arc_lengths(sub)
+        out["arc"][p0:p1], out["total"][c0:c1] = arc, total
+        if runtime is not None:
+            rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out[k][p0:p1] for k in ("t", "n", "b")])
+        else:
+            out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = rotation_minimizing_frames(sub)
+    return out
+
+
+class _Layout:
+    """Sizes of the output and the order in which tubes are written."""
+
+    def __init__(self, lines, sides, settings):
+        self.lines, self.sides = lines, sides
+        self.order = np.argsort(sides, kind="stable")
+        counts = lines.counts
+        segs = counts - 1 + lines.cyclic
+        self.body_v = int(np.sum(counts * sides))
+        self.body_f = int(np.sum(segs * sides))
+        self.body_c = 4 * self.body_f
+        self.body_e = self.body_v + self.body_f
+        open_ = ~lines.cyclic
+        cap_v = cap_e = cap_f = cap_c = 0
+        if settings.caps != "NONE":
+            for n in np.unique(sides[open_]):
+                ends = 2 * int(np.sum(open_ & (sides == n)))
+                dv, de, df, dc = cap_sizes(settings.caps, int(n))
+                cap_v, cap_e, cap_f, cap_c = cap_v + ends * dv, cap_e + ends * de, cap_f + ends * df, cap_c + ends * dc
+        self.totals = (self.body_v + cap_v, self.body_f + cap_f, self.body_c + cap_c, self.body_e + cap_e)
+
+    def allocate(self, settings):
+        v, f, c, e = self.totals
+        mesh = PolygonMesh(
+            positions=np.empty((v, 3), np.float32), face_sizes=np.empty(f, np.int32),
+            corner_verts=np.empty(c, np.int32), edges=np.empty((e, 2), np.int32), corner_edges=np.empty(c, np.int32),
+            point_normals=np.empty((v, 3), np.float32), face_material=np.empty(f, np.int32),
+        )
+        if settings.caps == "FLAT":
+            mesh.corner_normals = np.empty((c, 3), np.float32)
+        if settings.uvs:
+            mesh.corner_uvs = np.empty((c, 2), np.float32)
+        return mesh
+
+    def units(self, max_points=1 << 19):
+        """``(sides, curve ids)`` runs of equal side count with about ``max_points`` points each."""
+        sorted_sides = self.sides[self.order]
+        counts = self.lines.counts[self.order]
+        bounds = np.concatenate(([0], np.nonzero(np.diff(sorted_sides))[0] + 1, [len(self.order)]))
+        for g0, g1 in zip(bounds[:-1], bounds[1:], strict=True):
+            csum = np.cumsum(counts[g0:g1])
+            start = 0
+            while start < g1 - g0:
+                base = csum[start - 1] if start else 0
+                stop = int(np.searchsorted(csum, base + max_points, side="right"))
+                stop = min(max(stop, start + 1), g1 - g0)
+                yield int(sorted_sides[g0]), self.order[g0 + start:g0 + stop]
+                start = stop
+
+
+def _unit_points(lines, curves):
+    """Point ids of ``curves`` in order: a slice when they are consecutive, else an index array."""
+    counts = lines.counts[curves]
+    if len(curves) and np.all(np.diff(curves) == 1):
+        return slice(int(lines.offsets[curves[0]]), int(lines.offsets[curves[-1] + 1])), counts
+    starts = lines.offsets[curves]
+    local = np.concatenate(([0], np.cumsum(counts)))
+    idx = np.arange(local[-1]) - np.repeat(local[:-1] - starts, counts)
+    return idx, counts
+
+
+def _unit_topology(lines, curves):
+    """Points and segments of one run of curves: a dict of per-point arrays (local ids)."""
+    pick, counts = _unit_points(lines, curves)
+    cyclic = lines.cyclic[curves]
+    n_pts = int(counts.sum())
+    local = np.concatenate(([0], np.cumsum(counts)))
+    last = local[1:] - 1
+    # segments: every point but the last of an open curve; the last of a cyclic curve closes it
+    has_seg = np.ones(n_pts, bool)
+    has_seg[last[~cyclic]] = False
+    seg = np.nonzero(has_seg)[0]
+    nxt = seg + 1
+    closing = np.isin(seg, last[cyclic])
+    nxt[closing] = local[:-1][cyclic]
+    curve_of_point = np.repeat(np.arange(len(curves)), counts)
+    return {"pick": pick, "counts": counts, "cyclic": cyclic, "n_pts": n_pts, "local": local, "seg": seg,
+            "nxt": nxt, "closing": closing, "curve_of_point": curve_of_point}
+
+
+def _segment_u(frames, curves, unit):
+    """UV u at both ends of every segment: (S,) float32 each (a closing segment ends at u = 1)."""
+    arc = frames["arc"][unit["pick"]]
+    total = frames["total"][curves][unit["curve_of_point"]]
+    u = arc / np.maximum(total, 1e-300)
+    seg, nxt = unit["seg"], unit["nxt"]
+    return u[seg].astype(np.float32), np.where(unit["closing"], 1.0, u[nxt]).astype(np.float32)
+
+
+def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=None):
+    """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
+    unit = _unit_topology(lines, curves)
+    u_ends = _segment_u(frames, curves, unit) if settings.uvs else None
+    if device is not None:
+        device.write_body(lines, frames, n, curves, unit, cursor, u_ends, np.stack(_ring(n), axis=1))
+    else:
+        _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends)
+    if settings.caps != "NONE":
+        _collect_caps(lines, frames, n, curves, unit["pick"], unit["local"], unit["cyclic"], cursor["v"],
+                      cursor["e"], cursor, settings, caps)
+    n_pts, n_seg = unit["n_pts"], len(unit["seg"])
+    cursor["v"] += n_pts * n
+    cursor["f"] += n_seg * n
+    cursor["c"] += 4 * n_seg * n
+    cursor["e"] += (n_pts + n_seg) * n
+
+
+def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends):
+    pick, n_pts, seg, nxt = unit["pick"], unit["n_pts"], unit["seg"], unit["nxt"]
+    v0, f0, c0, e0 = cursor["v"], cursor["f"], cursor["c"], cursor["e"]
+
+    # vertices: radial directions (the normals), then centre + radius * radial
+    cos_t, sin_t = (x.astype(np.float32) for x in _ring(n))
+    nrm_out = mesh.point_normals[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
+    pos_out = mesh.positions[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
+    np.multiply(cos_t[None, :, None], frames["n"][pick][:, None, :], out=nrm_out)
+    np.multiply(sin_t[None, :, None], frames["b"][pick][:, None, :], out=pos_out)
+    nrm_out += pos_out
+    np.multiply(nrm_out, frames["radius"][pick][:, None, None], out=pos_out)
+    pos_out += lines.points[pick].astype(np.float32)[:, None, :]
+
+    n_seg = len(seg)
+    j = np.arange(n, dtype=np.int64)
+    j1 = (j + 1) % n
+    ring = (v0 + seg * n)[:, None]
+    ring_next = (v0 + nxt * n)[:, None]
+    cv = mesh.corner_verts[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4)
+    cv[..., 0], cv[..., 1], cv[..., 2], cv[..., 3] = ring + j, ring + j1, ring_next + j1, ring_next + j
+    # edges: ring edges of every point (p*n + j: side j to j+1), then the edges along every segment
+    ring_e = mesh.edges[e0:e0 + n_pts * n].reshape(n_pts, n, 2)
+    first = (v0 + np.arange(n_pts) * n)[:, None]
+    ring_e[..., 0], ring_e[..., 1] = first + j, first + j1
+    long_e = mesh.edges[e0 + n_pts * n:e0 + (n_pts + n_seg) * n].reshape(n_seg, n, 2)
+    long_e[..., 0], long_e[..., 1] = ring + j, ring_next + j
+    ce = mesh.corner_edges[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4)
+    along = (e0 + (n_pts + np.arange(n_seg)) * n)[:, None]
+    ce[..., 0], ce[..., 1] = (e0 + seg * n)[:, None] + j, along + j1
+    ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
+    mesh.face_sizes[f0:f0 + n_seg * n] = 4
+    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][unit["curve_of_point"][seg]], n)
+    if u_ends is not None:
+        u0, u1 = u_ends
+        v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
+        uv = mesh.corner_uvs[c0:c0 + 4 * n_seg * n].reshape(n_seg, n, 4, 2)
+        uv[:, :, 0, 0] = uv[:, :, 1, 0] = u0[:, None]
+        uv[:, :, 2, 0] = uv[:, :, 3, 0] = u1[:, None]
+        uv[:, :, 0, 1] = uv[:, :, 3, 1] = v_lo
+        uv[:, :, 1, 1] = uv[:, :, 2, 1] = v_hi
+
+
+def _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps):
+    open_ = ~cyclic
+    if not np.any(open_):
+        return
+    mat = lines.material_index[curves][open_]
+    for side, ends in ((-1.0, local[:-1][open_]), (1.0, local[1:][open_] - 1)):
+        p = pick.start + ends if isinstance(pick, slice) else pick[ends]
+        piece = cap_pieces(settings.caps, n, side, lines.points[p], frames["t"][p].astype(np.float64),
+                           frames["n"][p].astype(np.float64), frames["b"][p].astype(np.float64),
+                           frames["radius"][p].astype(np.float64), v0 + ends * n, e0 + ends * n, mat,
+                           cursor["cap_v"], cursor["cap_e"], settings.uvs)
+        cursor["cap_v"] += len(piece["positions"])
+        cursor["cap_e"] += len(piece["edges"])
+        caps.append(piece)
+
+
+def _write_caps(mesh, caps, layout, settings):
+    if not caps:
+        return
+    v, e = layout.body_v, layout.body_e
+    f, c = layout.body_f, layout.body_c
+    for piece in caps:
+        nv, ne = len(piece["positions"]), len(piece["edges"])
+        mesh.positions[v:v + nv] = piece["positions"]
+        mesh.point_normals[v:v + nv] = piece["normals"]
+        mesh.edges[e:e + ne] = piece["edges"]
+        v, e = v + nv, e + ne
+        for k, faces in enumerate(piece["faces"]):
+            nf, width = faces.shape
+            mesh.face_sizes[f:f + nf] = width
+            mesh.face_material[f:f + nf] = piece["materials"][k]
+            mesh.corner_verts[c:c + nf * width] = faces.ravel()
+            mesh.corner_edges[c:c + nf * width] = piece["corner_edges"][k].ravel()
+            if settings.uvs:
+                mesh.corner_uvs[c:c + nf * width] = piece["uvs"][k]
+            if settings.caps == "FLAT":
+                mesh.corner_normals[c:c + nf * width] = piece["corner_normals"][k]
+            f, c = f + nf, c + nf * width
+
+
+def _ring(n):
+    theta = 2.0 * np.pi * np.arange(n) / n
+    return np.cos(theta), np.sin(theta)

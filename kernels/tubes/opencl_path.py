@@ -1,0 +1,82 @@
+"""OpenCL paths of the tube kernel: frames (``tube_frames.cl``) and bodies (``tube_body.cl``).
+
+Same numbering and values as the numpy reference in `tubes` (tests compare them). The whole-mesh output
+arrays are shared with the device (``USE_HOST_PTR``: no copy on a CPU device such as PoCL) and mapped back
+once at the end.
+"""
+
+import numpy as np
+
+from ..common.errors import OpenCLUnavailableError
+from ..common.opencl_runtime import get_runtime
+from .frames import has_fp64
+
+BACKENDS = ("auto", "numpy", "opencl")
+
+
+def runtime_for(backend):
+    """The OpenCL runtime to use for ``backend``, or None for numpy."""
+    if backend == "numpy":
+        return None
+    runtime = get_runtime()
+    if runtime is not None and has_fp64(runtime):
+        return runtime
+    if backend == "opencl":
+        raise OpenCLUnavailableError("The tube kernels need an OpenCL device with double precision (cl_khr_fp64)")
+    return None
+
+
+class TubeDevice:
+    """Writes tube bodies into ``mesh`` (a preallocated `tubes.PolygonMesh`) with OpenCL."""
+
+    OUTPUTS = ("positions", "point_normals", "edges", "corner_verts", "corner_edges", "face_sizes", "face_material",
+               "corner_uvs")
+
+    def __init__(self, runtime, mesh):
+        self.runtime, self.mesh = runtime, mesh
+        self.buffers, self._inputs = {}, []
+        for name in self.OUTPUTS:
+            host = getattr(mesh, name)
+            if host is None or host.size == 0:
+                host = np.zeros(1, np.float32)  # a placeholder argument (e.g. no UVs)
+                setattr(self, f"_{name}_dummy", host)
+            self.buffers[name] = runtime.shared(host)
+
+    def _in(self, array, dtype):
+        """An input buffer sharing host memory; the array is kept alive until `finish`."""
+        a = np.ascontiguousarray(array, dtype=dtype)
+        if a.size == 0:
+            a = np.zeros(1, dtype)
+        self._inputs.append(a)
+        return self.runtime.shared(a, read_only=True)
+
+    def write_body(self, lines, frames, n, curves, unit, cursor, u_ends, ring):
+        """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None;
+        ring: (n, 2) float32 cos, sin of the side angles."""
+        pick, n_pts = unit["pick"], unit["n_pts"]
+        seg_of = np.full(n_pts, -1, np.int32)
+        seg_of[unit["seg"]] = np.arange(len(unit["seg"]), dtype=np.int32)
+        nxt = np.zeros(n_pts, np.int32)
+        nxt[unit["seg"]] = unit["nxt"]
+        u0 = np.zeros(n_pts, np.float32)
+        u1 = np.zeros(n_pts, np.float32)
+        if u_ends is not None:
+            u0[unit["seg"]], u1[unit["seg"]] = u_ends
+        material = lines.material_index[curves][unit["curve_of_point"]]
+        b = self.buffers
+        kernel = self.runtime.kernel("tubes/tube_body", "tube_body")
+        kernel(self.runtime.queue, (max(n_pts, 1),), None,
+               self._in(lines.points[pick], np.float32), self._in(frames["n"][pick], np.float32),
+               self._in(frames["b"][pick], np.float32), self._in(frames["radius"][pick], np.float32),
+               self._in(seg_of, np.int32), self._in(nxt, np.int32), self._in(u0, np.float32),
+               self._in(u1, np.float32), self._in(material, np.int32), self._in(ring, np.float32),
+               np.int32(n), np.int32(n_pts), np.int32(len(unit["seg"])), np.int64(cursor["v"]), np.int64(cursor["e"]),
+               np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(u_ends is not None),
+               b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
+               b["face_material"], b["corner_uvs"])
+
+    def finish(self):
+        """Wait for the device and make its writes visible in the host arrays."""
+        hosts = ((buf, getattr(self.mesh, name)) for name, buf in self.buffers.items())
+        self.runtime.sync_to_host([(buf, host) for buf, host in hosts if host is not None and host.size])
+        self._inputs.clear()
