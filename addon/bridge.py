@@ -255,36 +255,11 @@ def write_polygons(name, poly):
     return mesh
 
 
-def _split_wire(n_verts, edges):
-    """Point counts and cyclic flags of the consecutive-vertex runs of a curve's wire mesh (edges (E, 2))."""
-    a, b = edges[:, 0].astype(np.int64), edges[:, 1].astype(np.int64)
-    linked = np.zeros(n_verts, bool)  # linked[i]: an edge joins i and i + 1
-    step = np.abs(a - b) == 1
-    linked[np.minimum(a, b)[step]] = True
-    breaks = np.nonzero(~linked[:-1])[0] + 1
-    starts = np.concatenate(([0], breaks))
-    stops = np.concatenate((breaks, [n_verts]))
-    closing = {(int(min(x, y)), int(max(x, y))) for x, y in zip(a[~step], b[~step], strict=True)}
-    cyclic = np.array([(int(s), int(e - 1)) in closing for s, e in zip(starts, stops, strict=True)], bool)
-    return stops - starts, cyclic
-
-
 def _control_values(spline, name):
     points = spline.bezier_points if spline.type == "BEZIER" else spline.points
     values = np.empty(len(points), np.float32)
     points.foreach_get(name, values)
     return values.astype(np.float64)
-
-
-def _resample(values, count, cyclic):
-    """Control-point values spread linearly over ``count`` evaluated points (exact for poly and Bézier)."""
-    n = len(values)
-    if n == 1 or count == 1:
-        return np.full(count, values[0])
-    if cyclic:
-        u = np.arange(count) * n / count
-        return np.interp(u, np.arange(n + 1), np.append(values, values[0]))
-    return np.interp(np.arange(count) * (n - 1) / (count - 1), np.arange(n), values)
 
 
 def read_curve_object(ob, radius_scale=1.0):
@@ -294,6 +269,7 @@ def read_curve_object(ob, radius_scale=1.0):
     radius (x ``radius_scale``) and tilt are the control points' values spread over the evaluated points.
     Returns ``(lines, notes)``.
     """
+    from ..kernels.tubes.curve_sampling import spread_over_points, wire_runs
     from ..kernels.tubes.polylines import Polylines
 
     data = ob.data.copy()
@@ -307,7 +283,7 @@ def read_curve_object(ob, radius_scale=1.0):
             raise InvalidInputError(f"Curve {ob.name!r} has no points")
         positions = _get(wire.attributes["position"].data, "vector", n_v, np.float32, 3)
         edges = _get(wire.edges, "vertices", len(wire.edges), np.int32, 2)
-        counts, cyclic = _split_wire(n_v, edges)
+        counts, cyclic = wire_runs(n_v, edges)
         splines = [s for s in data.splines if len(s.bezier_points if s.type == "BEZIER" else s.points) > 0]
         radius = np.full(n_v, radius_scale)
         tilt = np.zeros(n_v)
@@ -315,8 +291,9 @@ def read_curve_object(ob, radius_scale=1.0):
         if len(splines) == len(counts):
             off = np.concatenate(([0], np.cumsum(counts)))
             for i, s in enumerate(splines):
-                radius[off[i]:off[i + 1]] = radius_scale * _resample(_control_values(s, "radius"), counts[i], cyclic[i])
-                tilt[off[i]:off[i + 1]] = _resample(_control_values(s, "tilt"), counts[i], cyclic[i])
+                span = slice(off[i], off[i + 1])
+                radius[span] = radius_scale * spread_over_points(_control_values(s, "radius"), counts[i], cyclic[i])
+                tilt[span] = spread_over_points(_control_values(s, "tilt"), counts[i], cyclic[i])
                 materials[i] = s.material_index
         else:
             notes.append(f"Curve {ob.name!r}: the evaluated splines do not match the control splines; "

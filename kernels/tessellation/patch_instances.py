@@ -28,7 +28,8 @@ import numpy as np
 
 from ..common.partition import clamp_levels
 from ..common.topology import ragged, triangle_edges
-from .refine import _face_levels, refine, single_triangle_levels
+from .refine import refine, single_triangle_levels
+from .refine_general import face_levels
 
 CONTROL_ROWS = 14
 KIND_CORNER, KIND_EDGE, KIND_INTERIOR = 0, 1, 2
@@ -87,7 +88,7 @@ def patch_classes(triangles, n_vertices, edge_levels, inner_levels=None, spacing
     """
     tris = np.asarray(triangles)
     edges, face_edges, _ = triangle_edges(tris)
-    edge_f, edge_n, inner_f, inner_n = _face_levels(face_edges, len(edges), edge_levels, inner_levels, spacing)
+    edge_f, edge_n, inner_f, inner_n = face_levels(face_edges, len(edges), edge_levels, inner_levels, spacing)
     counts = np.concatenate([edge_n[face_edges], inner_n[:, None]], axis=1).astype(np.int64)
     levels = np.concatenate([edge_f[face_edges], clamp_levels(inner_f, spacing)[:, None]], axis=1)
     key = ((counts[:, 0] * 65 + counts[:, 1]) * 65 + counts[:, 2]) * 65 + counts[:, 3]

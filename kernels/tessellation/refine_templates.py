@@ -15,7 +15,9 @@ import numpy as np
 
 from ..common.partition import point_params
 from ..common.topology import group_by_class, ragged
-from . import refine as core
+from .refine_general import interior_counts as count_interior
+from .refine_general import refine_general
+from .refinement import Lazy, LazyArrays, Refinement
 
 #: Use the class path when there are at most this many classes, or at least this many faces per class.
 MAX_CLASSES = 64
@@ -58,7 +60,7 @@ def _lone_pattern(outer_f, outer_n, inner_f, inner_n, spacing):
     order = [0, 2, 1]
     levels = (np.asarray(outer_f, np.float64)[order], np.asarray(outer_n, np.int64)[order],
               np.array([inner_f], np.float64), np.array([inner_n], np.int64))
-    ref = core._refine_general(tris, 3, edges, face_edges, flipped, levels, spacing)
+    ref = refine_general(tris, 3, edges, face_edges, flipped, levels, spacing)
     n0, n1, n2 = (int(x) for x in outer_n)
     k0, k2, k1 = np.arange(n0 - 1), np.arange(n2 - 1), np.arange(n1 - 1)
     slot_edge = np.concatenate([np.zeros(n0 - 1, np.int64), np.full(n2 - 1, 2), np.ones(n1 - 1, np.int64)])
@@ -213,7 +215,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     outer_f = edge_f[face_edges]
     point_edge, point_local, point_start = ragged(edge_n - 1)
     edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
-    interior_counts = core._interior_counts(inner_n)
+    interior_counts = count_interior(inner_n)
     interior_start = np.cumsum(interior_counts) - interior_counts
     interior_first = n_vertices + len(point_edge)
     tri_counts = outer_n.sum(axis=1) + 2 * interior_counts - 2
@@ -266,15 +268,16 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
                              ref.triangles, tri_start)
 
     n_faces = len(tris)
-    ref = core.Refinement(
+    ref = Refinement(
         n_corners=int(n_vertices), faces=tris, edges=edges,
         edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t, spacing=spacing,
         edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
         interior_counts=interior_counts, n_triangles=n_out, face_edges=face_edges, flipped=flipped,
-        lazy={"triangles": triangles,
-              "triangle_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts),
-              "interior_face": lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts),
-              "interior_bary": interior_bary, "corner_bary": corner_bary, "output_edges": output_edges},
+        arrays=LazyArrays(
+            triangles=Lazy(triangles),
+            triangle_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts)),
+            interior_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), interior_counts)),
+            interior_bary=Lazy(interior_bary), corner_bary=Lazy(corner_bary), output_edges=Lazy(output_edges)),
         face_class=inverse, classes=pattern_classes_,
     )
     return ref

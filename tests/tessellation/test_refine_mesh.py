@@ -172,4 +172,5 @@ def test_output_edges_from_the_patterns(spacing, levels, monkeypatch):
               "random": rng.uniform(1, 9, len(edges))}[levels]
         _check_output_edges(refine(f, len(v), lv, spacing=spacing))
     monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
-    assert refine(f, len(v), lv, spacing=spacing).output_edges() is None
+    general = refine(f, len(v), lv, spacing=spacing)
+    assert not general.has_output_edges and general.output_edges() is None
