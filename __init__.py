@@ -1,17 +1,16 @@
 """Tessera: generate geometry where artists need it (Blender extension entry point).
 
-Registration only: submodules are registered in the order below and unregistered in reverse.
+Registration only: submodules are registered in the order below and unregistered in reverse. `addon.properties`
+registers every capability's settings and the ``tessera`` pointers; panels register in the sidebar's order.
 Nothing is computed or compiled at import or register time.
 """
 
 import importlib
 
 _modules = (
+    "addon.viewport",
     "addon.preferences",
-    "addon.tubes.settings",
-    "addon.displacement.settings",
-    "addon.terrain.settings",
-    "addon.tessellation.settings",
+    "addon.properties",
     "addon.displacement.maps",
     "operators.tessellate",
     "operators.tubes",
@@ -19,7 +18,10 @@ _modules = (
     "operators.custom_kernel",
     "operators.terrain",
     "addon.menus",
-    "addon.panels",
+    "addon.tessellation.panel",
+    "addon.tubes.panel",
+    "addon.displacement.panel",
+    "addon.terrain.panel",
     "addon.tubes.preview",
     "addon.terrain.preview",
     "addon.tessellation.preview",

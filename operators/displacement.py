@@ -31,7 +31,7 @@ def _map_object(context):
 
 
 def kernel_brush(b, channels):
-    """`kernels.displacement.map_strokes.Brush` from ``Scene.tessera_brush``."""
+    """`kernels.displacement.map_strokes.Brush` from ``Scene.tessera.brush``."""
     vector = (*b.direction, 0.0) if channels > 1 else (0.0, 0.0, 1.0, 0.0)
     params = {"falloff": b.falloff, "vector": vector, "cell": b.noise_cell, "seed": b.noise_seed}
     if b.kind == "TEST":
@@ -141,7 +141,7 @@ class TESSERA_OT_displacement_export(bpy.types.Operator):
 def _new_session(context):
     """A stroke on the active object's map with the scene's brush."""
     settings = context.active_object.tessera.displacement
-    return StrokeSession(settings.image, settings, kernel_brush(context.scene.tessera_brush, channels_for(settings)))
+    return StrokeSession(settings.image, settings, kernel_brush(context.scene.tessera.brush, channels_for(settings)))
 
 
 class TESSERA_OT_displacement_stroke(bpy.types.Operator):

@@ -198,7 +198,7 @@ def build_tubes_scene():
 
 def stroke(points, **brush):
     """Replay one stroke in map texels ((x, y, pressure) rows) with the given brush settings."""
-    b = bpy.context.scene.tessera_brush
+    b = bpy.context.scene.tessera.brush
     for key, value in brush.items():
         setattr(b, key, value)
     elements = [{"name": "", "location": (x, y, 0.0), "mouse": (0, 0), "mouse_event": (0, 0), "pressure": p,

@@ -102,7 +102,7 @@ def brush_ring_at(context, mouse):
         return None
     settings = ob.tessera.displacement
     try:
-        return hit.ring(context.scene.tessera_brush.radius, tuple(settings.image.size), settings.uv_map)
+        return hit.ring(context.scene.tessera.brush.radius, tuple(settings.image.size), settings.uv_map)
     except (TesseraError, AttributeError):
         return None
 

@@ -35,13 +35,13 @@ class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
     bl_keymap = (
         ("tessera.displacement_stroke", {"type": "LEFTMOUSE", "value": "PRESS"}, None),
         ("wm.radial_control", {"type": "F", "value": "PRESS"},
-         {"properties": [("data_path_primary", "scene.tessera_brush.radius")]}),
+         {"properties": [("data_path_primary", "scene.tessera.brush.radius")]}),
         ("wm.radial_control", {"type": "F", "value": "PRESS", "shift": True},
-         {"properties": [("data_path_primary", "scene.tessera_brush.strength")]}),
+         {"properties": [("data_path_primary", "scene.tessera.brush.strength")]}),
     )
 
     def draw_settings(context, layout, tool):
-        draw_brush_settings(layout.column(), context.scene.tessera_brush)
+        draw_brush_settings(layout.column(), context.scene.tessera.brush)
 
 
 def register():

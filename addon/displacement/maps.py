@@ -5,7 +5,7 @@ The array is the truth while painting; the image is written after strokes (all R
 ``foreach_set``). Height maps store the height in R, G and B with alpha 1 (the Displace modifier reads the mean
 of RGB, divided by alpha). Maps are keyed by the image's ``session_uid``, which survives undo steps.
 
-Undo: each stroke increments ``Image.tessera_serial`` and keeps a `TileUndo` under that serial. After Blender
+Undo: each stroke increments ``Image.tessera.serial`` and keeps a `TileUndo` under that serial. After Blender
 undoes or redoes (global undo restores the serial), `_on_undo_redo` rolls the map back or forward tile by tile
 to the serial Blender now shows. Save: maps are written to their images and packed as float EXR (exact).
 Load: all map state is dropped; nothing is compiled or run.
@@ -38,7 +38,7 @@ class MapState:
             raise InvalidInputError(f"Image {image.name!r} has NaN or infinite pixels")
         self.host = np.ascontiguousarray(rgba[..., :1] if channels == 1 else rgba[..., :channels])
         self.rgba = rgba
-        self.serial = image.tessera_serial
+        self.serial = image.tessera.serial
         self.steps = {}  # serial -> TileUndo of the stroke that produced it
         runtime = get_runtime()
         self.device = MapBuffer(runtime, self.host) if runtime is not None else None
@@ -143,7 +143,7 @@ def commit(state, image, undo):
         del state.steps[serial]
     state.serial += 1
     state.steps[state.serial] = undo
-    image.tessera_serial = state.serial
+    image.tessera.serial = state.serial
     state.to_image(image)
 
 
@@ -205,7 +205,7 @@ def _maps_in_use():
 @bpy.app.handlers.persistent
 def _on_undo_redo(*_args):
     for image, state in _maps_in_use():
-        state.rewind(image, image.tessera_serial)
+        state.rewind(image, image.tessera.serial)
 
 
 @bpy.app.handlers.persistent

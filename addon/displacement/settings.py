@@ -1,5 +1,5 @@
 """Displacement-map settings: the map bound to an object (``Object.tessera.displacement``) and the brush
-(``Scene.tessera_brush``, shared by the brush tool and stroke replays). ``Image.tessera_serial`` counts the strokes
+(``Scene.tessera.brush``, shared by the brush tool and stroke replays). ``Image.tessera.serial`` counts the strokes
 applied to a map image; undo and redo restore the map to the serial that Blender's undo step holds."""
 
 import bpy
@@ -73,17 +73,11 @@ class TESSERA_PG_brush(bpy.types.PropertyGroup):
     noise_seed: bpy.props.IntProperty(name="Seed", default=0, min=0)
 
 
-classes = (TESSERA_PG_displacement, TESSERA_PG_brush)
-_register, _unregister = bpy.utils.register_classes_factory(classes)
+class TESSERA_PG_image(bpy.types.PropertyGroup):
+    """``Image.tessera``: the strokes applied to a map image (undo and redo restore the map to this serial)."""
+
+    serial: bpy.props.IntProperty(name="Stroke Serial", default=0, options={"HIDDEN"})
 
 
-def register():
-    _register()
-    bpy.types.Scene.tessera_brush = bpy.props.PointerProperty(type=TESSERA_PG_brush)
-    bpy.types.Image.tessera_serial = bpy.props.IntProperty(name="Stroke Serial", default=0, options={"HIDDEN"})
-
-
-def unregister():
-    del bpy.types.Image.tessera_serial
-    del bpy.types.Scene.tessera_brush
-    _unregister()
+classes = (TESSERA_PG_displacement, TESSERA_PG_brush, TESSERA_PG_image)
+register, unregister = bpy.utils.register_classes_factory(classes)

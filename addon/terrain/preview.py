@@ -10,53 +10,46 @@ import bpy
 import numpy as np
 
 from ...kernels.common.camera import Camera
-from ...kernels.common.errors import TesseraError
 from ...kernels.terrain.lod import select
-from ..viewport import add_handlers, new_state, remove_handlers, tag_view3d_redraw
+from ..viewport import Preview, PreviewEntry
 from . import data as terrain_data
-from .settings import lod_settings, source_key
-
-_state = new_state()
+from .settings import TOPIC, lod_settings, source_key
 
 
 def settings_changed(ob):
-    """Forget ``ob``'s selection (and its upload when the source changed) and redraw (property update)."""
-    if isinstance(ob, bpy.types.Object):
-        entry = _state["cache"].get(ob.name)
-        if entry is not None and entry["source"] != source_key(ob.tessera.terrain):
-            _state["cache"].pop(ob.name, None)
-        elif entry is not None:
-            entry["view"] = None
-        _state["errors"].pop(ob.name, None)
-    tag_view3d_redraw()
+    """Forget ``ob``'s selection (and its upload when the source changed); the "terrain" topic's subscriber."""
+    if not isinstance(ob, bpy.types.Object):
+        return
+    entry = PREVIEW.cache.get(ob)
+    if entry is not None and entry.source == source_key(ob.tessera.terrain):
+        entry.view = None
+        PREVIEW.cache.errors.pop(ob.session_uid, None)
+    else:
+        PREVIEW.cache.forget(ob)
 
 
 def entry_for(ob):
     """Cached GPU data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
-    from ...gpu_shaders.terrain.draw import TerrainDrawData
 
-    cache = _state["cache"]
-    if ob.name not in cache and ob.name not in _state["errors"]:
-        try:
-            hm, table = terrain_data.analysis(ob)
-        except TesseraError as err:
-            _state["errors"][ob.name] = str(err)
-            return None
-        cache[ob.name] = {"source": source_key(ob.tessera.terrain), "view": None,
-                          "draw": TerrainDrawData(hm, table)}
-    return cache.get(ob.name)
+    def build():
+        from ...gpu_shaders.terrain.draw import TerrainDrawData
+
+        hm, table = terrain_data.analysis(ob)
+        return PreviewEntry(TerrainDrawData(hm, table), source=source_key(ob.tessera.terrain))
+
+    return PREVIEW.entry(ob, build)
 
 
 def update_view(ob, entry, view, projection, width, height):
     """Re-select levels when the view (or a setting) changed; returns True when it did."""
     model = np.array(ob.matrix_world)
     key = (view @ model).tobytes() + np.asarray(projection).tobytes() + bytes((width % 256, height % 256))
-    if entry["view"] == key:
+    if entry.view == key:
         return False
-    draw = entry["draw"]
+    draw = entry.draw
     camera = Camera(view @ model, projection, width, height)
     draw.set_selection(select(draw.hm, draw.table, camera, lod_settings(ob.tessera.terrain)))
-    entry["view"] = key
+    entry.view = key
     return True
 
 
@@ -69,13 +62,16 @@ def _draw(context, region, view, proj):
         if entry is None:
             continue
         update_view(ob, entry, view, proj, region.width, region.height)
-        entry["draw"].draw(proj @ view @ np.array(ob.matrix_world))
+        entry.draw.draw(proj @ view @ np.array(ob.matrix_world))
+
+
+PREVIEW = Preview(_draw, topic=TOPIC, on_settings=settings_changed)
 
 
 def register():
-    add_handlers(_state, _draw)
+    PREVIEW.register()
 
 
 def unregister():
-    remove_handlers(_state)
+    PREVIEW.unregister()
     terrain_data.forget()

@@ -6,6 +6,7 @@ import bpy
 
 from ...kernels.terrain.lod import TerrainLod
 from ..cameras import CAMERA_ITEMS
+from ..viewport import invalidator
 
 SOURCE_ITEMS = (
     ("FILE", "File", "PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw r16/r32 read with OpenImageIO"),
@@ -69,15 +70,12 @@ def terrain_annotations(update=None):
     }
 
 
+#: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
+TOPIC = "terrain"
+_changed = invalidator(TOPIC)
 TERRAIN_SETTING_NAMES = tuple(terrain_annotations())
 SOURCE_NAMES = ("source", "filepath", "image_name", "raw_width", "raw_height", "texel_size", "height_scale",
                 "height_offset", "tile_size")
-
-
-def _changed(self, context):
-    from . import preview as terrain_preview
-
-    terrain_preview.settings_changed(self.id_data)
 
 
 class TESSERA_PG_terrain(bpy.types.PropertyGroup):

@@ -13,31 +13,18 @@ import bpy
 import numpy as np
 
 from ...kernels.common.camera import Camera
-from ...kernels.common.errors import TesseraError
 from ...kernels.tessellation.adaptive import adaptive_levels
 from ...kernels.tessellation.tessellate import surface_inputs, uniform_levels
 from .. import bridge
-from ..viewport import add_handlers, drop_stale, new_state, remove_handlers
-from .settings import SETTING_NAMES, adaptive_settings, surface_options
+from ..viewport import Preview, PreviewEntry
+from .settings import SETTING_NAMES, TOPIC, adaptive_settings, surface_options
 
-_state = new_state()
 #: Settings that change what is uploaded per mesh (the rest only change levels).
 SURFACE_NAMES = ("method", "alpha", "alpha_attribute", "normal_mode", "pn_normals")
 
 
 def _key(settings, names):
     return tuple(tuple(sorted(v)) if isinstance(v, set) else v for v in (getattr(settings, n) for n in names))
-
-
-@bpy.app.handlers.persistent  # survive file loads
-def _on_depsgraph(scene, depsgraph):
-    drop_stale(_state, depsgraph, bpy.types.Mesh)
-
-
-def forget(ob):
-    """Drop ``ob``'s uploaded data (it is rebuilt on the next draw)."""
-    _state["cache"].pop(ob.name, None)
-    _state["errors"].pop(ob.name, None)
 
 
 def _uv_name(ob):
@@ -57,28 +44,26 @@ def _surface_key(ob):
 
 def entry_for(ob):
     """Cached GPU data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
-    from ...gpu_shaders.tessellation.draw import PatchDrawData
+    surface = _surface_key(ob)
+    entry = PREVIEW.cache.get(ob)
+    if entry is not None and entry.source != surface:
+        PREVIEW.cache.forget(ob)
 
-    s = ob.tessera.tessellate
-    cache, surface = _state["cache"], _surface_key(ob)
-    entry = cache.get(ob.name)
-    if entry is not None and entry["surface"] != surface:
-        forget(ob)
-    if ob.name not in cache and ob.name not in _state["errors"]:
-        try:
-            arrays, _ = bridge.read_mesh(ob.data)
-            method = s.method
-            inputs = surface_inputs(arrays, uniform_levels(arrays, 1), method if method != "LINEAR" else "PN",
-                                    surface_options(s))
-            uv_name = _uv_name(ob)
-            uvs = arrays.corner_attributes.get(uv_name) if uv_name else None
-            tangents = bridge.corner_tangents(ob.data, uv_name) if uvs is not None and _tangent_space(ob) else None
-            draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=uvs, tangents=tangents)
-        except TesseraError as err:
-            _state["errors"][ob.name] = str(err)
-            return None
-        cache[ob.name] = {"data": ob.data.name, "surface": surface, "levels": None, "draw": draw}
-    return cache.get(ob.name)
+    def build():
+        from ...gpu_shaders.tessellation.draw import PatchDrawData
+
+        s = ob.tessera.tessellate
+        arrays, _ = bridge.read_mesh(ob.data)
+        method = s.method
+        inputs = surface_inputs(arrays, uniform_levels(arrays, 1), method if method != "LINEAR" else "PN",
+                                surface_options(s))
+        uv_name = _uv_name(ob)
+        uvs = arrays.corner_attributes.get(uv_name) if uv_name else None
+        tangents = bridge.corner_tangents(ob.data, uv_name) if uvs is not None and _tangent_space(ob) else None
+        draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=uvs, tangents=tangents)
+        return PreviewEntry(draw, data_uid=ob.data.session_uid, source=surface)
+
+    return PREVIEW.entry(ob, build)
 
 
 def update_levels(ob, entry, view, projection, width, height):
@@ -88,9 +73,9 @@ def update_levels(ob, entry, view, projection, width, height):
     key = _key(s, SETTING_NAMES)
     if s.level_mode == "ADAPTIVE":
         key += ((view @ model).tobytes(), np.asarray(projection).tobytes(), width, height)
-    if entry["levels"] == key:
+    if entry.view == key:
         return False
-    draw = entry["draw"]
+    draw = entry.draw
     mesh = draw.inputs.mesh
     if s.level_mode == "UNIFORM":
         edge, inner = uniform_levels(mesh, s.level), None
@@ -99,7 +84,7 @@ def update_levels(ob, entry, view, projection, width, height):
         camera = Camera(view, projection, width, height)
         edge, inner = adaptive_levels(world, mesh.triangles, adaptive_settings(s), camera, mesh.corner_normals)
     draw.set_levels(edge, inner, s.spacing)
-    entry["levels"] = key
+    entry.view = key
     return True
 
 
@@ -129,14 +114,16 @@ def _draw(context, region, view, proj):
         vp = proj @ view @ np.array(ob.matrix_world)
         disp = displacement_for(ob)
         if shading != "WIREFRAME":
-            entry["draw"].draw(vp, displacement=disp)
+            entry.draw.draw(vp, displacement=disp)
         if shading == "WIREFRAME" or context.space_data.overlay.show_wireframes:
-            entry["draw"].draw(vp, color=(0.05, 0.05, 0.05, 1.0), lit=False, displacement=disp, wireframe=True)
+            entry.draw.draw(vp, color=(0.05, 0.05, 0.05, 1.0), lit=False, displacement=disp, wireframe=True)
 
 
-def register():
-    add_handlers(_state, _draw, _on_depsgraph)
+def _settings_changed(ob):
+    """Uploads are keyed on the settings they depend on (`entry_for`); a change only lets a failed object retry."""
+    if isinstance(ob, bpy.types.Object):
+        PREVIEW.cache.errors.pop(ob.session_uid, None)
 
 
-def unregister():
-    remove_handlers(_state, _on_depsgraph)
+PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, on_settings=_settings_changed)
+register, unregister = PREVIEW.register, PREVIEW.unregister

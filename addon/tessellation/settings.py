@@ -12,9 +12,7 @@ from ...kernels.common.partition import MAX_LEVEL
 from ...kernels.tessellation.adaptive import AdaptiveSettings
 from ...kernels.tessellation.tessellate import SurfaceOptions
 from ..cameras import CAMERA_ITEMS
-from ..displacement.settings import TESSERA_PG_displacement
-from ..terrain.settings import TESSERA_PG_terrain
-from ..tubes.settings import TESSERA_PG_tubes
+from ..viewport import invalidator
 
 METHOD_ITEMS = (
     ("PN", "PN Triangles", "Cubic Bézier patches from positions and normals (smoothest; Vlachos et al.)"),
@@ -106,10 +104,9 @@ def setting_annotations():
 SETTING_NAMES = tuple(setting_annotations())
 
 
-def _redraw(self, context):
-    from ..viewport import tag_view3d_redraw
-
-    tag_view3d_redraw()
+#: The invalidation topic of these settings (`addon.viewport`).
+TOPIC = "tessellate"
+_redraw = invalidator(TOPIC)
 
 
 class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
@@ -122,13 +119,6 @@ class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
             description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
                         "view); the object itself can be hidden meanwhile"),
     }
-
-
-class TESSERA_PG_object(bpy.types.PropertyGroup):
-    tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
-    tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
-    displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
-    terrain: bpy.props.PointerProperty(type=TESSERA_PG_terrain)
 
 
 def copy_settings(source, target):
@@ -198,15 +188,5 @@ def draw_settings(layout, settings, show_output=True):
         layout.prop(settings, "output")
 
 
-classes = (TESSERA_PG_tessellate, TESSERA_PG_object)
-_register, _unregister = bpy.utils.register_classes_factory(classes)
-
-
-def register():
-    _register()
-    bpy.types.Object.tessera = bpy.props.PointerProperty(type=TESSERA_PG_object)
-
-
-def unregister():
-    del bpy.types.Object.tessera
-    _unregister()
+classes = (TESSERA_PG_tessellate,)
+register, unregister = bpy.utils.register_classes_factory(classes)

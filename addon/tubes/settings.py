@@ -7,6 +7,7 @@ import bpy
 
 from ...kernels.tubes.builder import TubeSettings
 from ..cameras import CAMERA_ITEMS
+from ..viewport import invalidator
 
 RADIUS_ITEMS = (
     ("POINT", "From Points", "Curves: point radius times Radius (like a bevel); hair: its 'radius' attribute "
@@ -62,13 +63,10 @@ def tube_annotations(update=None):
     }
 
 
+#: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
+TOPIC = "tubes"
+_changed = invalidator(TOPIC)
 TUBE_SETTING_NAMES = tuple(tube_annotations())
-
-
-def _changed(self, context):
-    from . import preview as tube_preview
-
-    tube_preview.settings_changed(self.id_data)
 
 
 class TESSERA_PG_tubes(bpy.types.PropertyGroup):

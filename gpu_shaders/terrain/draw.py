@@ -33,15 +33,12 @@ def _describe():
     return info
 
 
-_patterns = {}
-
-
 def _pattern_batch(shader, key):
+    """The tile pattern of class ``key`` (cached)."""
     from gpu_extras.batch import batch_for_shader
 
-    if key not in _patterns:
-        _patterns[key] = batch_for_shader(shader, "TRIS", {"code": pattern_codes(*key)}, indices=pattern(*key))
-    return _patterns[key]
+    return loader.batch(("terrain", key), lambda: batch_for_shader(shader, "TRIS", {"code": pattern_codes(*key)},
+                                                                   indices=pattern(*key)))
 
 
 class TerrainDrawData:

@@ -53,22 +53,18 @@ def _describe_compute():
     return info
 
 
-_patterns = {}
-
-
 def _pattern_batch(shader, key, wireframe=False):
-    """The pattern of class ``key`` as triangles, or as its unique edges for a wireframe."""
+    """The pattern of class ``key`` as triangles, or as its unique edges for a wireframe (cached)."""
     from gpu_extras.batch import batch_for_shader
 
-    if (key, wireframe) not in _patterns:
+    def build():
         codes, tris = pi.pattern(*key)
         if wireframe:
             edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
-            _patterns[key, wireframe] = batch_for_shader(shader, "LINES", {"code": codes},
-                                                         indices=np.unique(edges, axis=0).astype(np.int32))
-        else:
-            _patterns[key, wireframe] = batch_for_shader(shader, "TRIS", {"code": codes}, indices=tris)
-    return _patterns[key, wireframe]
+            return batch_for_shader(shader, "LINES", {"code": codes}, indices=np.unique(edges, axis=0).astype(np.int32))
+        return batch_for_shader(shader, "TRIS", {"code": codes}, indices=tris)
+
+    return loader.batch(("tessellation", key, wireframe), build)
 
 
 def _set_surface(shader, method, pn_quadratic, fractional, control):

@@ -66,21 +66,19 @@ def section_order(lines):
     return np.insert(idx, where, extra)
 
 
-_patterns = {}
-
-
 def pattern_batch(shader, n):
     """Instanced ring pattern with ``n`` sides: 64 x n vertices (ij), 63 x n quads as triangles (cached)."""
     from gpu_extras.batch import batch_for_shader
 
-    if n not in _patterns:
+    def build():
         k, j = np.meshgrid(np.arange(SECTIONS_PER_PATCH), np.arange(n), indexing="ij")
         ij = np.stack((k, j), axis=-1).reshape(-1, 2).astype(np.float32)
         a = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + np.arange(n)[None, :]).ravel()
         a1 = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + (np.arange(n)[None, :] + 1) % n).ravel()
         tris = np.concatenate((np.stack((a, a1, a1 + n), 1), np.stack((a, a1 + n, a + n), 1))).astype(np.int32)
-        _patterns[n] = batch_for_shader(shader, "TRIS", {"ij": ij}, indices=tris)
-    return _patterns[n]
+        return batch_for_shader(shader, "TRIS", {"ij": ij}, indices=tris)
+
+    return loader.batch(("tubes", n), build)
 
 
 class TubeDrawData:

@@ -10,6 +10,8 @@ the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the s
 `TesseraError` with the compiler log.
 """
 
+from dataclasses import dataclass, fields
+
 import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
@@ -49,75 +51,169 @@ def footprint(shape, pos, radius):
     return x0, y0, x1, y1
 
 
-def _plan(dmap, kind, p):
-    """Validated (region, numpy function, OpenCL kernel name, OpenCL scalar args) for one dab."""
+@dataclass(frozen=True)
+class DabParams:
+    """The parameters of one dab, as `apply_dab` takes them by keyword. None means "not given": the kind's
+    default applies (below), and a mirrored stroke leaves it alone.
+
+    pos: (x, y) texels (every kind but TEST); radius: texels (CONTACT and the brushes); strength (brushes and
+    STAMP, default 1) times pressure (default 1); falloff: a `map_dabs.FALLOFFS` name (brushes, default SMOOTH);
+    depth (CONTACT); force: float4, radius |f.xyz| * f.w (FORCE); vector: float4 offset direction (DRAW, NOISE,
+    default (0, 0, 1, 0)); cell, seed: noise lattice size (default 8) and seed (NOISE); target: float4 height or
+    vector to flatten toward (FLATTEN, default the mean under the brush); stamp: (h, w, C) array, scale (default
+    1) and angle (default 0) (STAMP); arg1..arg4: the seed's test kernel's four float4 (TEST, default 0).
+    """
+
+    pos: tuple | None = None
+    radius: float | None = None
+    strength: float | None = None
+    pressure: float | None = None
+    falloff: str | None = None
+    depth: float | None = None
+    force: tuple | None = None
+    vector: tuple | None = None
+    cell: float | None = None
+    seed: int | None = None
+    target: tuple | None = None
+    stamp: np.ndarray | None = None
+    scale: float | None = None
+    angle: float | None = None
+    arg1: tuple | None = None
+    arg2: tuple | None = None
+    arg3: tuple | None = None
+    arg4: tuple | None = None
+
+    @classmethod
+    def of(cls, params):
+        """From keyword arguments; an unknown name is refused with the list of known ones."""
+        unknown = sorted(set(params) - _PARAM_NAMES)
+        if unknown:
+            raise InvalidInputError(f"Unknown dab parameter(s) {', '.join(unknown)}; known: "
+                                    f"{', '.join(sorted(_PARAM_NAMES))}")
+        return cls(**params)
+
+    def given(self):
+        """The parameters that were given, as keywords."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+
+    def required(self, kind, name):
+        value = getattr(self, name)
+        if value is None:
+            raise InvalidInputError(f"A {kind} dab needs {name!r}")
+        return _finite(name, value)
+
+    def optional(self, name, default):
+        value = getattr(self, name)
+        return _finite(name, default if value is None else value)
+
+    def scaled_strength(self):
+        """strength x pressure (each 1 when not given)."""
+        return float(self.optional("strength", 1.0)) * float(self.optional("pressure", 1.0))
+
+
+_PARAM_NAMES = {f.name for f in fields(DabParams)}
+
+
+@dataclass(frozen=True)
+class DabPlan:
+    """A validated dab: its footprint ``region`` (x0, y0, x1, y1) or None; ``reference`` the numpy function
+    (``tile, x0, y0`` and, for SMOOTH, ``src, sx0, sy0``) that edits the tile in place; ``kernel`` the OpenCL kernel
+    name in ``map_dabs.cl`` and ``args`` its scalar arguments."""
+
+    region: tuple | None
+    reference: object
+    kernel: str
+    args: tuple
+
+
+def _plan_contact(dmap, d):
+    pos, depth, radius = d.required("CONTACT", "pos"), d.required("CONTACT", "depth"), d.required("CONTACT", "radius")
+    return DabPlan(footprint(dmap.shape, pos, float(radius)),
+                   lambda t, x0, y0: ref.contact(t, x0, y0, pos, depth, radius), "contact",
+                   (_f2(pos), np.float32(depth), np.float32(radius)))
+
+
+def _plan_force(dmap, d):
+    pos, f = d.required("FORCE", "pos"), d.required("FORCE", "force")
+    area = ref.force_area(f)
+    if not area > 0:
+        raise InvalidInputError(f"The force's radius |f.xyz| * f.w must be positive; got {float(area):g} "
+                                f"(f = {tuple(float(x) for x in f)})")
+    return DabPlan(footprint(dmap.shape, pos, float(area)), lambda t, x0, y0: ref.force(t, x0, y0, pos, f),
+                   "force", (_f2(pos), _f4(f), np.float32(area)))
+
+
+def _plan_test(dmap, d):
+    args = [d.optional(f"arg{i}", (0, 0, 0, 0)) for i in range(1, 5)]
+    return DabPlan(footprint(dmap.shape, args[0][:2], float(args[2][0])),
+                   lambda t, x0, y0: ref.test(t, x0, y0, *args), "test", tuple(_f4(a) for a in args))
+
+
+def _plan_brush(dmap, d, kind):
+    """DRAW, FLATTEN, SMOOTH and NOISE: a disc with a falloff."""
+    pos, radius = d.required(kind, "pos"), float(d.required(kind, "radius"))
+    strength = d.scaled_strength()
+    falloff = "SMOOTH" if d.falloff is None else d.falloff
+    if falloff not in _FALLOFF_ID:
+        raise InvalidInputError(f"Falloff must be one of {ref.FALLOFFS}; got {falloff!r}")
+    region = footprint(dmap.shape, pos, radius)
+    base = (_f2(pos), np.float32(radius), np.float32(strength), np.int32(_FALLOFF_ID[falloff]))
+    if kind == "DRAW":
+        vec = d.optional("vector", (0, 0, 1, 0))
+        return DabPlan(region, lambda t, x0, y0: ref.draw(t, x0, y0, pos, radius, strength, falloff, vec), "draw",
+                       base + (_f4(vec),))
+    if kind == "NOISE":
+        vec = d.optional("vector", (0, 0, 1, 0))
+        cell = float(d.optional("cell", 8.0))
+        seed = int(0 if d.seed is None else d.seed) & 0xFFFFFFFF
+        if not cell > 0:
+            raise InvalidInputError(f"The noise cell size must be positive; got {cell:g}")
+        return DabPlan(region, lambda t, x0, y0: ref.noise(t, x0, y0, pos, radius, strength, falloff, vec, cell,
+                                                           seed), "noise", base + (_f4(vec), np.float32(cell),
+                                                                                   np.uint32(seed)))
+    if kind == "FLATTEN":
+        target = d.target
+        if target is None and region is not None:
+            x0, y0, x1, y1 = region
+            target = _flatten_target(dmap[y0:y1, x0:x1], x0, y0, pos, radius)
+        target = _finite("target", target if target is not None else (0, 0, 0, 0))
+        return DabPlan(region, lambda t, x0, y0: ref.flatten(t, x0, y0, pos, radius, strength, falloff, target),
+                       "flatten", base + (_f4(target),))
+    return DabPlan(region, lambda t, x0, y0, src, sx0, sy0: ref.smooth(t, x0, y0, src, sx0, sy0, pos, radius,
+                                                                        strength, falloff), "smooth", base)
+
+
+def _plan_stamp(dmap, d):
     channels = dmap.shape[2]
-    f32 = np.float32
-    if kind == "CONTACT":
-        pos, depth, radius = _finite("pos", p["pos"]), _finite("depth", p["depth"]), _finite("radius", p["radius"])
-        region = footprint(dmap.shape, pos, float(radius))
-        args = (_f2(pos), f32(depth), f32(radius))
-        return region, lambda t, x0, y0: ref.contact(t, x0, y0, pos, depth, radius), "contact", args
-    if kind == "FORCE":
-        pos, f = _finite("pos", p["pos"]), _finite("force", p["force"])
-        area = ref.force_area(f)
-        if not area > 0:
-            raise InvalidInputError(f"The force's radius |f.xyz| * f.w must be positive; got {float(area):g} "
-                                    f"(f = {tuple(float(x) for x in f)})")
-        region = footprint(dmap.shape, pos, float(area))
-        return region, lambda t, x0, y0: ref.force(t, x0, y0, pos, f), "force", (_f2(pos), _f4(f), f32(area))
-    if kind == "TEST":
-        args = [_finite(f"arg{i}", p.get(f"arg{i}", (0, 0, 0, 0))) for i in range(1, 5)]
-        region = footprint(dmap.shape, args[0][:2], float(args[2][0]))
-        return (region, lambda t, x0, y0: ref.test(t, x0, y0, *args), "test", tuple(_f4(a) for a in args))
-    if kind in ("DRAW", "FLATTEN", "SMOOTH", "NOISE"):
-        pos, radius = _finite("pos", p["pos"]), float(_finite("radius", p["radius"]))
-        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
-                                                                                       p.get("pressure", 1.0)))
-        kind_name = p.get("falloff", "SMOOTH")
-        if kind_name not in _FALLOFF_ID:
-            raise InvalidInputError(f"Falloff must be one of {ref.FALLOFFS}; got {kind_name!r}")
-        region = footprint(dmap.shape, pos, radius)
-        base = (_f2(pos), f32(radius), f32(strength), np.int32(_FALLOFF_ID[kind_name]))
-        if kind == "DRAW":
-            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
-            return (region, lambda t, x0, y0: ref.draw(t, x0, y0, pos, radius, strength, kind_name, vec), "draw",
-                    base + (_f4(vec),))
-        if kind == "NOISE":
-            vec = _finite("vector", p.get("vector", (0, 0, 1, 0)))
-            cell = float(_finite("cell", p.get("cell", 8.0)))
-            seed = int(p.get("seed", 0)) & 0xFFFFFFFF
-            if not cell > 0:
-                raise InvalidInputError(f"The noise cell size must be positive; got {cell:g}")
-            return (region, lambda t, x0, y0: ref.noise(t, x0, y0, pos, radius, strength, kind_name, vec, cell, seed),
-                    "noise", base + (_f4(vec), f32(cell), np.uint32(seed)))
-        if kind == "FLATTEN":
-            target = p.get("target")
-            if target is None and region is not None:
-                x0, y0, x1, y1 = region
-                target = _flatten_target(dmap[y0:y1, x0:x1], x0, y0, pos, radius)
-            target = _finite("target", target if target is not None else (0, 0, 0, 0))
-            return (region, lambda t, x0, y0: ref.flatten(t, x0, y0, pos, radius, strength, kind_name, target),
-                    "flatten", base + (_f4(target),))
-        return (region, lambda t, x0, y0, src, sx0, sy0: ref.smooth(t, x0, y0, src, sx0, sy0, pos, radius, strength,
-                                                                     kind_name), "smooth", base)
-    if kind == "STAMP":
-        st = p["stamp"]
-        if not isinstance(st, np.ndarray) or st.ndim != 3 or st.shape[2] != channels or st.shape[0] < 1:
-            raise InvalidInputError(f"The stamp must be a (height, width, {channels}) array like the map")
-        st = np.ascontiguousarray(st, np.float32)
-        if not np.all(np.isfinite(st)):
-            raise InvalidInputError("The stamp contains NaN or infinite values")
-        pos, scale = _finite("pos", p["pos"]), float(_finite("scale", p.get("scale", 1.0)))
-        if scale <= 0:
-            raise InvalidInputError("The stamp scale must be positive")
-        strength = float(_finite("strength", p.get("strength", 1.0))) * float(_finite("pressure",
-                                                                                       p.get("pressure", 1.0)))
-        rot = ref.stamp_rotation(float(_finite("angle", p.get("angle", 0.0))))
-        region = footprint(dmap.shape, pos, ref.stamp_extent(st.shape, scale) + 1.0)
-        return (region, lambda t, x0, y0: ref.stamp(t, x0, y0, st, pos, rot, scale, strength), "stamp",
-                (st, _f2(pos), rot, f32(scale), f32(strength)))
-    raise InvalidInputError(f"Unknown dab kind {kind!r}; expected one of {', '.join(KINDS)}")
+    st = d.stamp
+    if not isinstance(st, np.ndarray) or st.ndim != 3 or st.shape[2] != channels or st.shape[0] < 1:
+        raise InvalidInputError(f"The stamp must be a (height, width, {channels}) array like the map")
+    st = np.ascontiguousarray(st, np.float32)
+    if not np.all(np.isfinite(st)):
+        raise InvalidInputError("The stamp contains NaN or infinite values")
+    pos, scale = d.required("STAMP", "pos"), float(d.optional("scale", 1.0))
+    if scale <= 0:
+        raise InvalidInputError("The stamp scale must be positive")
+    strength = d.scaled_strength()
+    rot = ref.stamp_rotation(float(d.optional("angle", 0.0)))
+    return DabPlan(footprint(dmap.shape, pos, ref.stamp_extent(st.shape, scale) + 1.0),
+                   lambda t, x0, y0: ref.stamp(t, x0, y0, st, pos, rot, scale, strength), "stamp",
+                   (st, _f2(pos), rot, np.float32(scale), np.float32(strength)))
+
+
+_PLANNERS = {
+    "CONTACT": _plan_contact, "FORCE": _plan_force, "TEST": _plan_test, "STAMP": _plan_stamp,
+    "DRAW": lambda m, d: _plan_brush(m, d, "DRAW"), "SMOOTH": lambda m, d: _plan_brush(m, d, "SMOOTH"),
+    "FLATTEN": lambda m, d: _plan_brush(m, d, "FLATTEN"), "NOISE": lambda m, d: _plan_brush(m, d, "NOISE"),
+}
+
+
+def plan_dab(dmap, kind, dab):
+    """Validate one dab (a `DabParams`) of ``kind`` on ``dmap``: a `DabPlan`, or `InvalidInputError`."""
+    planner = _PLANNERS.get(kind)
+    if planner is None:
+        raise InvalidInputError(f"Unknown dab kind {kind!r}; expected one of {', '.join(KINDS)}")
+    return planner(dmap, dab)
 
 
 def _flatten_target(tile, x0, y0, pos, radius):
@@ -155,8 +251,10 @@ def _backend_runtime(backend, device):
     return _runtime("opencl") if device is not None else _runtime(backend)
 
 
-def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **params):
+def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=None, **params):
     """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map.
+
+    The dab's parameters are a `DabParams` (``dab``) or its fields as keywords.
 
     ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
     footprint moves; without it the footprint tile is uploaded and read back. ``before_write(region)`` is
@@ -165,7 +263,10 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, **para
     check_map(dmap)
     if device is not None and device.host is not dmap:
         raise InvalidInputError("The device buffer mirrors a different map")
-    region, numpy_fn, cl_name, cl_args = _plan(dmap, kind, params)
+    if dab is not None and params:
+        raise InvalidInputError("Give the dab's parameters as a DabParams or as keywords, not both")
+    plan = plan_dab(dmap, kind, dab if dab is not None else DabParams.of(params))
+    region, numpy_fn, cl_name, cl_args = plan.region, plan.reference, plan.kernel, plan.args
     if region is None:
         return None
     x0, y0, x1, y1 = region

@@ -7,12 +7,12 @@ vertical centre line when asked, and records the tiles it touches in a `TileUndo
 step holds only those tiles (memory proportional to the stroke's area), and restores the exact bytes.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..common.errors import InvalidInputError
-from .map_edit import KINDS, apply_dab
+from .map_edit import KINDS, DabParams, apply_dab
 
 TILE = 64  # undo tile edge (texels)
 
@@ -20,7 +20,8 @@ TILE = 64  # undo tile edge (texels)
 @dataclass
 class Brush:
     """What one dab does: ``kind`` is a `map_edit.KINDS` name; radius in texels; extra kernel parameters in
-    ``params`` (falloff, vector, depth, force, cell, seed, stamp, angle, scale)."""
+    ``params``, by `map_edit.DabParams` field name (falloff, vector, depth, force, cell, seed, stamp, angle,
+    scale, ...)."""
 
     kind: str = "DRAW"
     radius: float = 16.0
@@ -38,6 +39,7 @@ class Brush:
             raise InvalidInputError(f"The brush radius must be positive; got {self.radius!r}")
         if not (np.isfinite(self.spacing) and self.spacing > 0):
             raise InvalidInputError(f"The dab spacing must be positive; got {self.spacing!r}")
+        DabParams.of(self.params)  # unknown parameter names are refused here, before any dab
         return self
 
 
@@ -109,27 +111,28 @@ class TileUndo:
                 min(int(ty.max() + 1) * TILE, self.shape[0]))
 
 
-def _mirrored(params, width):
-    """The dab's parameters mirrored across x = (width - 1) / 2: positions flip, vector x components negate."""
-    out = dict(params)
-    if "pos" in out:
-        out["pos"] = (width - 1 - params["pos"][0], params["pos"][1])
+def _mirrored(dab, width):
+    """The `DabParams` mirrored across x = (width - 1) / 2: positions flip, vector x components negate (only the
+    parameters that were given)."""
+    changes = {}
+    if dab.pos is not None:
+        changes["pos"] = (width - 1 - dab.pos[0], dab.pos[1])
     for key in ("vector", "force", "arg2"):
-        if key in out:
-            v = np.array(out[key], np.float64)
+        if getattr(dab, key) is not None:
+            v = np.array(getattr(dab, key), np.float64)
             v[0] = -v[0]
-            out[key] = v
-    if "arg1" in out:
-        a = np.array(out["arg1"], np.float64)
+            changes[key] = v
+    if dab.arg1 is not None:
+        a = np.array(dab.arg1, np.float64)
         a[0] = width - 1 - a[0]
-        out["arg1"] = a
-    if "angle" in out:
-        out["angle"] = np.pi - out["angle"]
-    return out
+        changes["arg1"] = a
+    if dab.angle is not None:
+        changes["angle"] = np.pi - dab.angle
+    return replace(dab, **changes)
 
 
 def dab_params(brush, x, y, pressure):
-    """Keyword arguments of `apply_dab` for one dab of ``brush`` at (x, y) with ``pressure``."""
+    """The `DabParams` of one dab of ``brush`` at (x, y) with ``pressure``."""
     radius = brush.radius * (pressure if brush.pressure_radius else 1.0)
     strength = brush.strength * (pressure if brush.pressure_strength else 1.0)
     p = dict(brush.params)
@@ -145,7 +148,7 @@ def dab_params(brush, x, y, pressure):
         p.update(pos=(x, y), strength=strength, scale=p.get("scale", 1.0) * (radius / brush.radius))
     else:
         p.update(pos=(x, y), radius=radius, strength=strength)
-    return p
+    return DabParams.of(p)
 
 
 def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, progress=None, spaced=True):
@@ -160,18 +163,18 @@ def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, pro
     width = dmap.shape[1]
     box = None
     for i, (x, y, pressure) in enumerate(dabs):
-        params = dab_params(brush, x, y, pressure)
-        todo = [params, _mirrored(params, width)] if brush.mirror_x else [params]
-        for p in todo:
-            box = union_region(box, _apply(dmap, brush.kind, p, backend, device, undo))
+        dab = dab_params(brush, x, y, pressure)
+        todo = [dab, _mirrored(dab, width)] if brush.mirror_x else [dab]
+        for d in todo:
+            box = union_region(box, _apply(dmap, brush.kind, d, backend, device, undo))
         if progress is not None and i % 64 == 0:
             progress((i + 1) / len(dabs))
     return box
 
 
-def _apply(dmap, kind, params, backend, device, undo):
+def _apply(dmap, kind, dab, backend, device, undo):
     before = None if undo is None else (lambda region: undo.record(dmap, region))
-    return apply_dab(dmap, kind, backend=backend, device=device, before_write=before, **params)
+    return apply_dab(dmap, kind, backend=backend, device=device, before_write=before, dab=dab)
 
 
 def union_region(a, b):

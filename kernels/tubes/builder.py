@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..common.errors import InvalidInputError
-from .caps import cap_pieces, cap_sizes
+from .caps import CapEnds, cap_pieces, cap_sizes
 from .curve_refine import catmull_rom, select_points
 from .frames import rotation_minimizing_frames, rotation_minimizing_frames_opencl
 from .opencl_path import TubeDevice, runtime_for
@@ -92,6 +92,70 @@ class PolygonMesh:
         return out
 
 
+@dataclass
+class TubeFrames:
+    """Frames and sizes of prepared centre lines (`_frames`).
+
+    Per point: t, n, b (P, 3) float32 unit tangent, normal and binormal (rotation-minimising); radius (P,) float32
+    (after the anti-aliasing clamp when it is on); arc (P,) float64 arc length from the curve's start. Per curve:
+    total (C,) float64 length (a closed curve's includes its closing segment); sides (C,) int64.
+    """
+
+    t: np.ndarray
+    n: np.ndarray
+    b: np.ndarray
+    radius: np.ndarray
+    arc: np.ndarray
+    total: np.ndarray
+    sides: np.ndarray
+
+    @classmethod
+    def empty(cls, n_points, n_curves):
+        vec = lambda: np.empty((n_points, 3), np.float32)  # noqa: E731
+        return cls(t=vec(), n=vec(), b=vec(), radius=np.empty(n_points, np.float32), arc=np.empty(n_points),
+                   total=np.empty(n_curves), sides=np.empty(n_curves, np.int64))
+
+
+@dataclass
+class Cursor:
+    """Where the next run of tubes is written: its first body vertex, face, corner and edge (``v``, ``f``, ``c``,
+    ``e``), and the next free cap vertex and edge (``cap_v``, ``cap_e``: caps are numbered after every body)."""
+
+    v: int = 0
+    f: int = 0
+    c: int = 0
+    e: int = 0
+    cap_v: int = 0
+    cap_e: int = 0
+
+    def advance(self, n_points, n_segments, sides):
+        """Move past a run of ``n_points`` rings and ``n_segments`` segments with ``sides`` sides."""
+        self.v += n_points * sides
+        self.f += n_segments * sides
+        self.c += 4 * n_segments * sides
+        self.e += (n_points + n_segments) * sides
+
+
+@dataclass(frozen=True)
+class CurveRun:
+    """The points and segments of one run of curves written together (`_run_topology`), in local point ids.
+
+    pick: slice or (P,) int64 of the run's points in the lines; counts, cyclic: (R,) per curve; n_pts: P;
+    local: (R + 1,) int64 first local point of each curve; seg: (S,) int64 first point of each segment; nxt: (S,)
+    its second point; closing: (S,) bool the segment closes a cyclic curve; curve_of_point: (P,) int64.
+    """
+
+    pick: object
+    counts: np.ndarray
+    cyclic: np.ndarray
+    n_pts: int
+    local: np.ndarray
+    seg: np.ndarray
+    nxt: np.ndarray
+    closing: np.ndarray
+    curve_of_point: np.ndarray
+
+
 def pixel_world_size(points, camera):
     """World length of one pixel at each point's depth (seed eq. 4-3..4-5): (P,) float64; inf behind the eye.
 
@@ -156,11 +220,11 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     report = progress or (lambda f: None)
     frames = _frames(lines, settings, camera, runtime)
     report(0.3)
-    layout = _Layout(lines, frames["sides"], settings)
+    layout = _Layout(lines, frames.sides, settings)
     mesh = layout.allocate(settings)
     mesh.notes = list(lines.notes)
     caps = []
-    cursor = {"v": 0, "f": 0, "c": 0, "e": 0, "cap_v": layout.body_v, "cap_e": layout.body_e}
+    cursor = Cursor(cap_v=layout.body_v, cap_e=layout.body_e)
     units = list(layout.units())
     device = TubeDevice(runtime, mesh) if runtime is not None else None
     for i, (n, curves) in enumerate(units):
@@ -177,8 +241,8 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
 
 
 def tube_sections(lines, settings, camera=None):
-    """What a GPU draw of the tubes needs: the prepared `Polylines` and per point unit N, B (float32 (P, 3))
-    and the radius before the anti-aliasing clamp (which the shader applies per frame); sides per curve."""
+    """What a GPU draw of the tubes needs: the prepared `Polylines` and their `TubeFrames` (unit N, B and the
+    radius before the anti-aliasing clamp, which the shader applies per frame; sides per curve)."""
     lines = prepare_lines(lines, settings)
     frames = _frames(lines, replace(settings, aa_clamp=False), camera, runtime_for("auto"))
     return lines, frames
@@ -191,30 +255,24 @@ def lod_sides(lines, settings, camera):
 
 
 def _frames(lines, settings, camera, runtime=None):
-    """Per point: unit T, N, B (float32), effective radius, arc length; per curve: sides and length.
-
-    Chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
-    n_pts = len(lines.points)
-    out = {k: np.empty((n_pts, 3), np.float32) for k in ("t", "n", "b")}
-    out["radius"] = np.empty(n_pts, np.float32)
-    out["arc"], out["total"] = np.empty(n_pts), np.empty(lines.n_curves)
-    out["sides"] = np.empty(lines.n_curves, np.int64)
+    """`TubeFrames` of prepared lines, chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
+    out = TubeFrames.empty(len(lines.points), lines.n_curves)
     for c0, c1 in chunks(lines, 1 << 20):
         sub = take_curves(lines, c0, c1)
         p0, p1 = lines.offsets[c0], lines.offsets[c1]
         pixel = pixel_world_size(sub.points, camera) if camera is not None else np.full(len(sub.points), np.inf)
         sides = tube_sides(sub, settings, pixel)
-        out["sides"][c0:c1] = sides
+        out.sides[c0:c1] = sides
         radius = sub.radius
         if settings.aa_clamp:
             radius = effective_radius(radius, pixel, np.repeat(sides, sub.counts), settings.max_radius)
-        out["radius"][p0:p1] = radius
+        out.radius[p0:p1] = radius
         arc, total = arc_lengths(sub)
-        out["arc"][p0:p1], out["total"][c0:c1] = arc, total
+        out.arc[p0:p1], out.total[c0:c1] = arc, total
         if runtime is not None:
-            rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out[k][p0:p1] for k in ("t", "n", "b")])
+            rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out.t[p0:p1], out.n[p0:p1], out.b[p0:p1]])
         else:
-            out["t"][p0:p1], out["n"][p0:p1], out["b"][p0:p1] = rotation_minimizing_frames(sub)
+            out.t[p0:p1], out.n[p0:p1], out.b[p0:p1] = rotation_minimizing_frames(sub)
     return out
 
 
@@ -279,8 +337,8 @@ def _unit_points(lines, curves):
     return idx, counts
 
 
-def _unit_topology(lines, curves):
-    """Points and segments of one run of curves: a dict of per-point arrays (local ids)."""
+def _run_topology(lines, curves):
+    """Points and segments of one run of curves: a `CurveRun`."""
     pick, counts = _unit_points(lines, curves)
     cyclic = lines.cyclic[curves]
     n_pts = int(counts.sum())
@@ -294,49 +352,43 @@ def _unit_topology(lines, curves):
     closing = np.isin(seg, last[cyclic])
     nxt[closing] = local[:-1][cyclic]
     curve_of_point = np.repeat(np.arange(len(curves)), counts)
-    return {"pick": pick, "counts": counts, "cyclic": cyclic, "n_pts": n_pts, "local": local, "seg": seg,
-            "nxt": nxt, "closing": closing, "curve_of_point": curve_of_point}
+    return CurveRun(pick=pick, counts=counts, cyclic=cyclic, n_pts=n_pts, local=local, seg=seg, nxt=nxt,
+                    closing=closing, curve_of_point=curve_of_point)
 
 
-def _segment_u(frames, curves, unit):
+def _segment_u(frames, curves, run):
     """UV u at both ends of every segment: (S,) float32 each (a closing segment ends at u = 1)."""
-    arc = frames["arc"][unit["pick"]]
-    total = frames["total"][curves][unit["curve_of_point"]]
+    arc = frames.arc[run.pick]
+    total = frames.total[curves][run.curve_of_point]
     u = arc / np.maximum(total, 1e-300)
-    seg, nxt = unit["seg"], unit["nxt"]
-    return u[seg].astype(np.float32), np.where(unit["closing"], 1.0, u[nxt]).astype(np.float32)
+    return u[run.seg].astype(np.float32), np.where(run.closing, 1.0, u[run.nxt]).astype(np.float32)
 
 
 def _write_body(mesh, lines, frames, n, curves, cursor, settings, caps, device=None):
     """Write the rings, quads and edges of ``curves`` (all with ``n`` sides) at the cursor; advance it."""
-    unit = _unit_topology(lines, curves)
-    u_ends = _segment_u(frames, curves, unit) if settings.uvs else None
+    run = _run_topology(lines, curves)
+    u_ends = _segment_u(frames, curves, run) if settings.uvs else None
     if device is not None:
-        device.write_body(lines, frames, n, curves, unit, cursor, u_ends, np.stack(_ring(n), axis=1))
+        device.write_body(lines, frames, n, curves, run, cursor, u_ends, np.stack(_ring(n), axis=1))
     else:
-        _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends)
+        _write_body_numpy(mesh, lines, frames, n, curves, run, cursor, u_ends)
     if settings.caps != "NONE":
-        _collect_caps(lines, frames, n, curves, unit["pick"], unit["local"], unit["cyclic"], cursor["v"],
-                      cursor["e"], cursor, settings, caps)
-    n_pts, n_seg = unit["n_pts"], len(unit["seg"])
-    cursor["v"] += n_pts * n
-    cursor["f"] += n_seg * n
-    cursor["c"] += 4 * n_seg * n
-    cursor["e"] += (n_pts + n_seg) * n
+        _collect_caps(lines, frames, n, curves, run, cursor, settings, caps)
+    cursor.advance(run.n_pts, len(run.seg), n)
 
 
-def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends):
-    pick, n_pts, seg, nxt = unit["pick"], unit["n_pts"], unit["seg"], unit["nxt"]
-    v0, f0, c0, e0 = cursor["v"], cursor["f"], cursor["c"], cursor["e"]
+def _write_body_numpy(mesh, lines, frames, n, curves, run, cursor, u_ends):
+    pick, n_pts, seg, nxt = run.pick, run.n_pts, run.seg, run.nxt
+    v0, f0, c0, e0 = cursor.v, cursor.f, cursor.c, cursor.e
 
     # vertices: radial directions (the normals), then centre + radius * radial
     cos_t, sin_t = (x.astype(np.float32) for x in _ring(n))
     nrm_out = mesh.point_normals[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
     pos_out = mesh.positions[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
-    np.multiply(cos_t[None, :, None], frames["n"][pick][:, None, :], out=nrm_out)
-    np.multiply(sin_t[None, :, None], frames["b"][pick][:, None, :], out=pos_out)
+    np.multiply(cos_t[None, :, None], frames.n[pick][:, None, :], out=nrm_out)
+    np.multiply(sin_t[None, :, None], frames.b[pick][:, None, :], out=pos_out)
     nrm_out += pos_out
-    np.multiply(nrm_out, frames["radius"][pick][:, None, None], out=pos_out)
+    np.multiply(nrm_out, frames.radius[pick][:, None, None], out=pos_out)
     pos_out += lines.points[pick].astype(np.float32)[:, None, :]
 
     n_seg = len(seg)
@@ -357,7 +409,7 @@ def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends):
     ce[..., 0], ce[..., 1] = (e0 + seg * n)[:, None] + j, along + j1
     ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
     mesh.face_sizes[f0:f0 + n_seg * n] = 4
-    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][unit["curve_of_point"][seg]], n)
+    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][run.curve_of_point[seg]], n)
     if u_ends is not None:
         u0, u1 = u_ends
         v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
@@ -368,19 +420,21 @@ def _write_body_numpy(mesh, lines, frames, n, curves, unit, cursor, u_ends):
         uv[:, :, 1, 1] = uv[:, :, 2, 1] = v_hi
 
 
-def _collect_caps(lines, frames, n, curves, pick, local, cyclic, v0, e0, cursor, settings, caps):
-    open_ = ~cyclic
+def _collect_caps(lines, frames, n, curves, run, cursor, settings, caps):
+    """Append the caps of the open curves of ``run`` (body rings numbered from ``cursor.v``, ``cursor.e``) to
+    ``caps``, numbering their new vertices and edges from ``cursor.cap_v``, ``cursor.cap_e``."""
+    open_ = ~run.cyclic
     if not np.any(open_):
         return
     mat = lines.material_index[curves][open_]
-    for side, ends in ((-1.0, local[:-1][open_]), (1.0, local[1:][open_] - 1)):
-        p = pick.start + ends if isinstance(pick, slice) else pick[ends]
-        piece = cap_pieces(settings.caps, n, side, lines.points[p], frames["t"][p].astype(np.float64),
-                           frames["n"][p].astype(np.float64), frames["b"][p].astype(np.float64),
-                           frames["radius"][p].astype(np.float64), v0 + ends * n, e0 + ends * n, mat,
-                           cursor["cap_v"], cursor["cap_e"], settings.uvs)
-        cursor["cap_v"] += len(piece["positions"])
-        cursor["cap_e"] += len(piece["edges"])
+    for side, ends in ((-1.0, run.local[:-1][open_]), (1.0, run.local[1:][open_] - 1)):
+        p = run.pick.start + ends if isinstance(run.pick, slice) else run.pick[ends]
+        ring = CapEnds(centre=lines.points[p], t=frames.t[p].astype(np.float64), n=frames.n[p].astype(np.float64),
+                       b=frames.b[p].astype(np.float64), radius=frames.radius[p].astype(np.float64),
+                       ring_v=cursor.v + ends * n, ring_e=cursor.e + ends * n, material=mat)
+        piece = cap_pieces(settings.caps, n, side, ring, cursor.cap_v, cursor.cap_e, settings.uvs)
+        cursor.cap_v += len(piece.positions)
+        cursor.cap_e += len(piece.edges)
         caps.append(piece)
 
 
@@ -390,21 +444,21 @@ def _write_caps(mesh, caps, layout, settings):
     v, e = layout.body_v, layout.body_e
     f, c = layout.body_f, layout.body_c
     for piece in caps:
-        nv, ne = len(piece["positions"]), len(piece["edges"])
-        mesh.positions[v:v + nv] = piece["positions"]
-        mesh.point_normals[v:v + nv] = piece["normals"]
-        mesh.edges[e:e + ne] = piece["edges"]
+        nv, ne = len(piece.positions), len(piece.edges)
+        mesh.positions[v:v + nv] = piece.positions
+        mesh.point_normals[v:v + nv] = piece.normals
+        mesh.edges[e:e + ne] = piece.edges
         v, e = v + nv, e + ne
-        for k, faces in enumerate(piece["faces"]):
+        for k, faces in enumerate(piece.faces):
             nf, width = faces.shape
             mesh.face_sizes[f:f + nf] = width
-            mesh.face_material[f:f + nf] = piece["materials"][k]
+            mesh.face_material[f:f + nf] = piece.materials[k]
             mesh.corner_verts[c:c + nf * width] = faces.ravel()
-            mesh.corner_edges[c:c + nf * width] = piece["corner_edges"][k].ravel()
+            mesh.corner_edges[c:c + nf * width] = piece.corner_edges[k].ravel()
             if settings.uvs:
-                mesh.corner_uvs[c:c + nf * width] = piece["uvs"][k]
+                mesh.corner_uvs[c:c + nf * width] = piece.uvs[k]
             if settings.caps == "FLAT":
-                mesh.corner_normals[c:c + nf * width] = piece["corner_normals"][k]
+                mesh.corner_normals[c:c + nf * width] = piece.corner_normals[k]
             f, c = f + nf, c + nf * width
 
 

@@ -5,7 +5,44 @@ body has vertices ``ring_v + j`` and ring edges ``ring_e + j`` (side j to j+1); 
 from each corner to the next. New vertices and edges are numbered from ``v_next`` and ``e_next``.
 """
 
+from dataclasses import dataclass, field
+
 import numpy as np
+
+
+@dataclass(frozen=True)
+class CapEnds:
+    """The tube ends that get a cap, ``E`` of them: centre, t, n, b (E, 3) float64 the end point and its frame
+    (unit tangent, normal, binormal); radius (E,) float64; ring_v, ring_e (E,) int64 the first vertex and first
+    ring edge of the end ring in the body; material (E,) int32."""
+
+    centre: np.ndarray
+    t: np.ndarray
+    n: np.ndarray
+    b: np.ndarray
+    radius: np.ndarray
+    ring_v: np.ndarray
+    ring_e: np.ndarray
+    material: np.ndarray
+
+
+@dataclass
+class CapPiece:
+    """Caps of one side of one run of tubes (`cap_pieces`).
+
+    positions, normals: (V, 3) float32 new vertices; edges: (K, 2) int64 new edges; per block of faces of one
+    width: faces and corner_edges (F, k) int64, materials (F,), uvs (F * k, 2) float32 when asked for, and
+    corner_normals (F * k, 3) float32 (FLAT only).
+    """
+
+    positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    faces: list = field(default_factory=list)
+    corner_edges: list = field(default_factory=list)
+    materials: list = field(default_factory=list)
+    uvs: list = field(default_factory=list)
+    corner_normals: list = field(default_factory=list)
 
 
 def cap_sizes(kind, n):
@@ -16,29 +53,25 @@ def cap_sizes(kind, n):
     return (m - 1) * n + 1, (2 * (m - 1) + 1) * n, m * n, (4 * (m - 1) + 3) * n
 
 
-def cap_pieces(kind, n, side, centre, t, nrm, bin_, radius, ring_v, ring_e, mat, v_next, e_next, uvs):
-    """Caps facing ``side`` * T (-1: curve starts, +1: curve ends) for ``E`` ends with ``n`` sides.
-
-    centre, t, nrm, bin_: (E, 3); radius, ring_v, ring_e, mat: (E,). Returns a dict of arrays: ``positions``,
-    ``normals`` (new vertices), ``edges`` (new edges), and lists ``faces`` / ``corner_edges`` ((F, k) each),
-    ``materials``, ``uvs``, ``corner_normals`` (FLAT only).
-    """
+def cap_pieces(kind, n, side, ends, v_next, e_next, uvs):
+    """Caps facing ``side`` * T (-1: curve starts, +1: curve ends) for the `CapEnds` ``ends`` with ``n`` sides;
+    new vertices and edges are numbered from ``v_next`` and ``e_next``. Returns a `CapPiece`."""
+    centre, t, nrm, bin_, radius = ends.centre, ends.t, ends.n, ends.b, ends.radius
+    ring_v, ring_e, mat = ends.ring_v, ends.ring_e, ends.material
     j = np.arange(n)
     theta = 2 * np.pi * j / n
-    out = {"positions": np.zeros((0, 3), np.float32), "normals": np.zeros((0, 3), np.float32),
-           "edges": np.zeros((0, 2), np.int64), "faces": [], "corner_edges": [], "materials": [], "uvs": [],
-           "corner_normals": []}
+    out = CapPiece()
     count = len(centre)
     if kind == "FLAT":
         order = (-j) % n if side < 0 else j  # a start cap faces -T: reversed ring order
-        out["faces"].append(ring_v[:, None] + order)
+        out.faces.append(ring_v[:, None] + order)
         edge_side = (order - 1) % n if side < 0 else j
-        out["corner_edges"].append(ring_e[:, None] + edge_side)
-        out["materials"].append(mat)
-        out["corner_normals"].append(np.repeat(side * t, n, axis=0).astype(np.float32))
+        out.corner_edges.append(ring_e[:, None] + edge_side)
+        out.materials.append(mat)
+        out.corner_normals.append(np.repeat(side * t, n, axis=0).astype(np.float32))
         if uvs:
             disk = _disk_uv(theta[order], 1.0)
-            out["uvs"].append(np.tile(disk, (count, 1)).astype(np.float32))
+            out.uvs.append(np.tile(disk, (count, 1)).astype(np.float32))
         return out
 
     m = max(1, n // 4)
@@ -52,8 +85,8 @@ def cap_pieces(kind, n, side, centre, t, nrm, bin_, radius, ring_v, ring_e, mat,
     along = side * t[:, None, None, :]
     dirs = np.cos(phi)[None, :, None, None] * radial + np.sin(phi)[None, :, None, None] * along
     dirs = np.concatenate((dirs.reshape(count, -1, 3), along[:, 0]), axis=1)  # rings 1..m-1, then the pole
-    out["positions"] = (centre[:, None, :] + radius[:, None, None] * dirs).reshape(-1, 3).astype(np.float32)
-    out["normals"] = dirs.reshape(-1, 3).astype(np.float32)
+    out.positions = (centre[:, None, :] + radius[:, None, None] * dirs).reshape(-1, 3).astype(np.float32)
+    out.normals = dirs.reshape(-1, 3).astype(np.float32)
 
     def vert(i, jj):
         return ring_v[:, None] + jj if i == 0 else vb + (i - 1) * n + jj
@@ -68,26 +101,26 @@ def cap_pieces(kind, n, side, centre, t, nrm, bin_, radius, ring_v, ring_e, mat,
     blocks = [np.stack((vert(i, j), vert(i, j1)), axis=-1) for i in range(1, m)]
     blocks += [np.stack((vert(i - 1, j), vert(i, j)), axis=-1) for i in range(1, m)]
     blocks.append(np.stack((vert(m - 1, j), pole), axis=-1))
-    out["edges"] = np.concatenate(blocks, axis=1).reshape(-1, 2)
+    out.edges = np.concatenate(blocks, axis=1).reshape(-1, 2)
     for i in range(1, m):
         a, a1, b, b1 = vert(i - 1, j), vert(i - 1, j1), vert(i, j), vert(i, j1)
         ra, rb, lj, lj1 = ring_edge(i - 1, j), ring_edge(i, j), long_edge(i, j), long_edge(i, j1)
         f, ce = ((a, a1, b1, b), (ra, lj1, rb, lj)) if side > 0 else ((b, b1, a1, a), (rb, lj1, ra, lj))
-        out["faces"].append(np.stack(f, axis=-1).reshape(-1, 4))
-        out["corner_edges"].append(np.stack(ce, axis=-1).reshape(-1, 4))
-        out["materials"].append(np.repeat(mat, n))
+        out.faces.append(np.stack(f, axis=-1).reshape(-1, 4))
+        out.corner_edges.append(np.stack(ce, axis=-1).reshape(-1, 4))
+        out.materials.append(np.repeat(mat, n))
         if uvs:
             sa, sb = np.cos((np.pi / 2) * (i - 1) / m), np.cos((np.pi / 2) * i / m)
-            out["uvs"].append(_corner_uvs(theta, (sa, sa, sb, sb) if side > 0 else (sb, sb, sa, sa), count))
+            out.uvs.append(_corner_uvs(theta, (sa, sa, sb, sb) if side > 0 else (sb, sb, sa, sa), count))
     a, a1, ra = vert(m - 1, j), vert(m - 1, j1), ring_edge(m - 1, j)
     pe, pe1 = eb + 2 * (m - 1) * n + j, eb + 2 * (m - 1) * n + j1
     f, ce = ((a, a1, pole), (ra, pe1, pe)) if side > 0 else ((pole, a1, a), (pe1, ra, pe))
-    out["faces"].append(np.stack(f, axis=-1).reshape(-1, 3))
-    out["corner_edges"].append(np.stack(ce, axis=-1).reshape(-1, 3))
-    out["materials"].append(np.repeat(mat, n))
+    out.faces.append(np.stack(f, axis=-1).reshape(-1, 3))
+    out.corner_edges.append(np.stack(ce, axis=-1).reshape(-1, 3))
+    out.materials.append(np.repeat(mat, n))
     if uvs:
         s = np.cos((np.pi / 2) * (m - 1) / m)
-        out["uvs"].append(_corner_uvs(theta, (s, s, 0.0) if side > 0 else (0.0, s, s), count))
+        out.uvs.append(_corner_uvs(theta, (s, s, 0.0) if side > 0 else (0.0, s, s), count))
     return out
 
 

@@ -1,6 +1,6 @@
 """OpenCL paths of the tube kernel: frames (``tube_frames.cl``) and bodies (``tube_body.cl``).
 
-Same numbering and values as the numpy reference in `tubes` (tests compare them). The whole-mesh output
+Same numbering and values as the numpy reference in `builder` (tests compare them). The whole-mesh output
 arrays are shared with the device (``USE_HOST_PTR``: no copy on a CPU device such as PoCL) and mapped back
 once at the end.
 """
@@ -27,7 +27,7 @@ def runtime_for(backend):
 
 
 class TubeDevice:
-    """Writes tube bodies into ``mesh`` (a preallocated `tubes.PolygonMesh`) with OpenCL."""
+    """Writes tube bodies into ``mesh`` (a preallocated `builder.PolygonMesh`) with OpenCL."""
 
     OUTPUTS = ("positions", "point_normals", "edges", "corner_verts", "corner_edges", "face_sizes", "face_material",
                "corner_uvs")
@@ -50,28 +50,29 @@ class TubeDevice:
         self._inputs.append(a)
         return self.runtime.shared(a, read_only=True)
 
-    def write_body(self, lines, frames, n, curves, unit, cursor, u_ends, ring):
-        """One run of tubes with ``n`` sides (see `tubes._write_body`); u_ends: UV u at segment ends or None;
-        ring: (n, 2) float32 cos, sin of the side angles."""
-        pick, n_pts = unit["pick"], unit["n_pts"]
+    def write_body(self, lines, frames, n, curves, run, cursor, u_ends, ring):
+        """One `builder.CurveRun` of tubes with ``n`` sides at the `builder.Cursor` (see `builder._write_body`);
+        frames: `builder.TubeFrames`; u_ends: UV u at segment ends or None; ring: (n, 2) float32 cos, sin of the
+        side angles."""
+        pick, n_pts = run.pick, run.n_pts
         seg_of = np.full(n_pts, -1, np.int32)
-        seg_of[unit["seg"]] = np.arange(len(unit["seg"]), dtype=np.int32)
+        seg_of[run.seg] = np.arange(len(run.seg), dtype=np.int32)
         nxt = np.zeros(n_pts, np.int32)
-        nxt[unit["seg"]] = unit["nxt"]
+        nxt[run.seg] = run.nxt
         u0 = np.zeros(n_pts, np.float32)
         u1 = np.zeros(n_pts, np.float32)
         if u_ends is not None:
-            u0[unit["seg"]], u1[unit["seg"]] = u_ends
-        material = lines.material_index[curves][unit["curve_of_point"]]
+            u0[run.seg], u1[run.seg] = u_ends
+        material = lines.material_index[curves][run.curve_of_point]
         b = self.buffers
         kernel = self.runtime.kernel("tubes/tube_body", "tube_body")
         kernel(self.runtime.queue, (max(n_pts, 1),), None,
-               self._in(lines.points[pick], np.float32), self._in(frames["n"][pick], np.float32),
-               self._in(frames["b"][pick], np.float32), self._in(frames["radius"][pick], np.float32),
+               self._in(lines.points[pick], np.float32), self._in(frames.n[pick], np.float32),
+               self._in(frames.b[pick], np.float32), self._in(frames.radius[pick], np.float32),
                self._in(seg_of, np.int32), self._in(nxt, np.int32), self._in(u0, np.float32),
                self._in(u1, np.float32), self._in(material, np.int32), self._in(ring, np.float32),
-               np.int32(n), np.int32(n_pts), np.int32(len(unit["seg"])), np.int64(cursor["v"]), np.int64(cursor["e"]),
-               np.int64(cursor["f"]), np.int64(cursor["c"]), np.int32(u_ends is not None),
+               np.int32(n), np.int32(n_pts), np.int32(len(run.seg)), np.int64(cursor.v), np.int64(cursor.e),
+               np.int64(cursor.f), np.int64(cursor.c), np.int32(u_ends is not None),
                b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
                b["face_material"], b["corner_uvs"])
 

@@ -16,7 +16,7 @@ def make_plane(bpy, mode="HEIGHT"):
 
 
 def brush(bpy, **kw):
-    b = bpy.context.scene.tessera_brush
+    b = bpy.context.scene.tessera.brush
     defaults = dict(kind="DRAW", radius=6.0, strength=0.25, falloff="SMOOTH", spacing=0.25, mirror_x=False,
                     use_pressure_strength=True, use_pressure_radius=False)
     for key, value in {**defaults, **kw}.items():
@@ -86,16 +86,16 @@ def test_replay_is_deterministic_and_undo_serial_restores_exact_bytes(clean_scen
     brush(bpy, kind="SMOOTH", radius=9.0, strength=1.0)
     assert replay(bpy, [(10, 10, 1.0), (20, 12, 1.0)]) == {"FINISHED"}
     second = state.host.copy()
-    assert image.tessera_serial == 2 and not np.array_equal(first, second)
+    assert image.tessera.serial == 2 and not np.array_equal(first, second)
     maps = addon_module("addon.displacement.maps")
-    image.tessera_serial = 1  # what Blender's undo step holds after Ctrl+Z
+    image.tessera.serial = 1  # what Blender's undo step holds after Ctrl+Z
     maps._on_undo_redo()
     assert state.host.tobytes() == first.tobytes()
     assert np.array_equal(image_rgba(image)[..., 0], first[..., 0])
-    image.tessera_serial = 2  # redo
+    image.tessera.serial = 2  # redo
     maps._on_undo_redo()
     assert state.host.tobytes() == second.tobytes()
-    image.tessera_serial = 0
+    image.tessera.serial = 0
     maps._on_undo_redo()
     assert not state.host.any()
     step = state.steps[2]
@@ -131,7 +131,7 @@ def test_bad_strokes_change_nothing(clean_scene, bpy_module, addon_module):
     brush(bpy, kind="FORCE", strength=0.0)  # a force of zero radius is refused
     with pytest.raises(RuntimeError, match="radius"):
         replay(bpy, [(3, 3, 1.0)])
-    assert not state_of(addon_module, ob).host.any() and ob.tessera.displacement.image.tessera_serial == 0
+    assert not state_of(addon_module, ob).host.any() and ob.tessera.displacement.image.tessera.serial == 0
 
 
 def test_export_and_import_round_trip(clean_scene, bpy_module, addon_module, tmp_path):

@@ -134,3 +134,22 @@ def test_noise_is_bounded_map_anchored_and_seeded():
     c = zero_map(1, 64)
     apply_dab(c, "NOISE", backend="numpy", pos=(30, 30), radius=12, strength=0.5, falloff="CONSTANT", cell=4, seed=8)
     assert not np.array_equal(a, c)
+
+
+def test_dab_parameters_are_a_record_and_bad_names_are_refused():
+    """Keywords and a `DabParams` give the same dab; an unknown or missing parameter is an `InvalidInputError`
+    naming it, with the map unchanged."""
+    from tessera.kernels.displacement.map_edit import DabParams
+
+    a, b = zero_map(), zero_map()
+    apply_dab(a, "DRAW", backend="numpy", pos=(20, 30), radius=6, strength=0.5, falloff="LINEAR")
+    apply_dab(b, "DRAW", backend="numpy", dab=DabParams(pos=(20, 30), radius=6, strength=0.5, falloff="LINEAR"))
+    assert a.any() and np.array_equal(a, b)
+    m = zero_map()
+    with pytest.raises(InvalidInputError, match="radiuss"):
+        apply_dab(m, "DRAW", backend="numpy", pos=(20, 30), radiuss=6)
+    with pytest.raises(InvalidInputError, match="'depth'"):
+        apply_dab(m, "CONTACT", backend="numpy", pos=(20, 30), radius=6)
+    with pytest.raises(InvalidInputError, match="not both"):
+        apply_dab(m, "DRAW", backend="numpy", dab=DabParams(pos=(1, 1), radius=2), strength=1.0)
+    assert not m.any()

@@ -72,3 +72,11 @@ def test_a_failing_dab_changes_nothing_of_its_own():
     with pytest.raises(InvalidInputError):
         run_stroke(m, Brush(kind="DRAW", radius=4), [(16, 16, 1)], backend="numpy", undo=TileUndo(m))
     assert np.array_equal(m, before, equal_nan=True)
+
+
+def test_a_brush_with_an_unknown_parameter_is_refused_before_any_dab():
+    m = np.zeros((32, 32, 1), np.float32)
+    with pytest.raises(InvalidInputError, match="celll"):
+        run_stroke(m, Brush(kind="NOISE", radius=4, params={"celll": 5.0}), [(5, 5, 1.0), (20, 20, 1.0)],
+                   backend="numpy")
+    assert not m.any()

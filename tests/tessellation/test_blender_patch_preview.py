@@ -36,7 +36,7 @@ def test_preview_follows_settings_view_and_edits(gpu_renderer, addon_module, cle
     assert not preview.update_levels(ob, entry, cam.view, cam.projection, 200, 200)  # nothing changed: no work
     model = np.array(ob.matrix_world)
     vp = cam.projection @ cam.view @ model
-    gpu_img = offscreen.render(lambda: entry["draw"].draw(vp), size=(200, 200))
+    gpu_img = offscreen.render(lambda: entry.draw.draw(vp), size=(200, 200))
     # the operator with the same settings, for the scene camera at the same place
     cam_data = bpy.data.cameras.new("cam")
     cam_ob = bpy.data.objects.new("cam", cam_data)
@@ -58,16 +58,16 @@ def test_preview_follows_settings_view_and_edits(gpu_renderer, addon_module, cle
     assert (cpu[..., 0] > 0).sum() > 3000
     close = np.all(np.abs(cpu.astype(int) - gpu_img.astype(int)) <= 2, axis=-1)
     assert close.mean() >= 0.995, close.mean()
-    assert entry["draw"].triangle_count == len(arrays.triangles)
+    assert entry.draw.triangle_count == len(arrays.triangles)
     # a new view re-selects; an edit of the mesh drops the upload
     far = _view(Camera, (12.0, -9.0, 6.0))
-    before = entry["draw"].triangle_count
+    before = entry.draw.triangle_count
     assert preview.update_levels(ob, entry, far.view, far.projection, 200, 200)
-    assert entry["draw"].triangle_count < before
+    assert entry.draw.triangle_count < before
     ob.data.vertices[0].co.x += 0.1
     ob.data.update()
     bpy.context.view_layer.update()
-    assert ob.name not in preview._state["cache"]
+    assert ob not in preview.PREVIEW.cache
     assert preview.entry_for(ob) is not None
 
 
@@ -123,8 +123,8 @@ def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, a
     vp = cam.projection @ cam.view @ np.array(ob.matrix_world)
     disp = preview.displacement_for(ob)
     assert disp.mode == "TANGENT"
-    gpu_img = offscreen.render(lambda: entry["draw"].draw(vp, displacement=disp), size=(200, 200))
-    plain = offscreen.render(lambda: entry["draw"].draw(vp), size=(200, 200))
+    gpu_img = offscreen.render(lambda: entry.draw.draw(vp, displacement=disp), size=(200, 200))
+    plain = offscreen.render(lambda: entry.draw.draw(vp), size=(200, 200))
     rest, _ = bridge.read_mesh(ob.data)
     dg = bpy.context.evaluated_depsgraph_get()
     moved, _ = bridge.read_mesh(ob.evaluated_get(dg).to_mesh())

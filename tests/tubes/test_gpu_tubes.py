@@ -45,7 +45,7 @@ def test_preview_draws_the_same_tubes_as_the_mesh(gpu_renderer, addon_module, si
         cpu = offscreen.render_triangles(mesh.positions, quads_to_tris(mesh), vp, size=(200, 200),
                                          color=(1, 1, 1, 1), lit=False)
         prepared, frames = tubes.tube_sections(lines, settings, cam)
-        data = preview.TubeDrawData(prepared, frames["n"], frames["b"], frames["radius"])
+        data = preview.TubeDrawData(prepared, frames.n, frames.b, frames.radius)
         data.set_sides(tubes.lod_sides(prepared, settings, cam))
         gpu = offscreen.render(lambda data=data, vp=vp: data.draw(vp, 200, color=(1, 1, 1, 1), lit=False),
                                size=(200, 200))
@@ -70,7 +70,7 @@ def test_preview_clamp_keeps_far_tubes_visible_like_the_mesh(gpu_renderer, addon
     cpu = offscreen.render_triangles(mesh.positions, quads_to_tris(mesh), vp, size=(160, 160), color=(1, 1, 1, 1),
                                      lit=False)
     prepared, frames = tubes.tube_sections(lines, settings, cam)
-    data = preview.TubeDrawData(prepared, frames["n"], frames["b"], frames["radius"])
+    data = preview.TubeDrawData(prepared, frames.n, frames.b, frames.radius)
     data.set_sides(tubes.lod_sides(prepared, settings, cam))
     gpu = offscreen.render(lambda: data.draw(vp, 160, color=(1, 1, 1, 1), lit=False, clamp=True), size=(160, 160))
     a, b = cpu[..., 0] > 127, gpu[..., 0] > 127
@@ -87,17 +87,17 @@ def test_preview_cache_refreshes_only_on_change(gpu_renderer, addon_module, clea
     ob = bpy.context.active_object
     ob.tessera.tubes.preview = True
     bpy.context.view_layer.update()  # settle the updates of adding the curve
-    entry = preview._entry(ob)
-    assert entry is not None and preview._entry(ob) is entry  # built once, reused
-    assert entry["draw"].section_bytes == 48 * (ob.data.resolution_u + 1)
+    entry = preview.entry_for(ob)
+    assert entry is not None and preview.entry_for(ob) is entry  # built once, reused
+    assert entry.draw.section_bytes == 48 * (ob.data.resolution_u + 1)
     bpy.context.view_layer.update()
-    assert preview._entry(ob) is entry  # nothing changed: nothing rebuilt
+    assert preview.entry_for(ob) is entry  # nothing changed: nothing rebuilt
     ob.data.splines[0].bezier_points[0].co.x += 1.0
     bpy.context.view_layer.update()
-    assert ob.name not in preview._state["cache"]  # an edit drops the uploaded sections
-    entry = preview._entry(ob)
+    assert ob not in preview.PREVIEW.cache  # an edit drops the uploaded sections
+    entry = preview.entry_for(ob)
     ob.tessera.tubes.sides = 5
-    assert ob.name not in preview._state["cache"]  # so does a settings change
+    assert ob not in preview.PREVIEW.cache  # so does a settings change
     ob.tessera.tubes.preview = False
     bpy.data.curves.remove(ob.data)
-    preview._state["cache"].clear()
+    preview.PREVIEW.cache.clear()

@@ -1,0 +1,56 @@
+"""The one ``tessera`` pointer on each ID type that Tessera stores settings on.
+
+- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain`` (each capability's settings);
+- ``Scene.tessera``: ``brush`` (the displacement brush shared by the tool and stroke replays);
+- ``Image.tessera``: ``serial`` (strokes applied to a map image, for undo).
+
+`register` registers the capabilities' property groups first (a pointer needs its type registered), then the
+roots, then the pointers, so the order is written here and nowhere else.
+"""
+
+import bpy
+
+from .displacement import settings as displacement_settings
+from .displacement.settings import TESSERA_PG_brush, TESSERA_PG_displacement, TESSERA_PG_image
+from .terrain import settings as terrain_settings
+from .terrain.settings import TESSERA_PG_terrain
+from .tessellation import settings as tessellation_settings
+from .tessellation.settings import TESSERA_PG_tessellate
+from .tubes import settings as tube_settings
+from .tubes.settings import TESSERA_PG_tubes
+
+_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings)
+
+
+class TESSERA_PG_object(bpy.types.PropertyGroup):
+    tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
+    tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
+    displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
+    terrain: bpy.props.PointerProperty(type=TESSERA_PG_terrain)
+
+
+class TESSERA_PG_scene(bpy.types.PropertyGroup):
+    brush: bpy.props.PointerProperty(type=TESSERA_PG_brush)
+
+
+classes = (TESSERA_PG_object, TESSERA_PG_scene)
+_ROOTS = ((bpy.types.Object, TESSERA_PG_object), (bpy.types.Scene, TESSERA_PG_scene),
+          (bpy.types.Image, TESSERA_PG_image))
+
+
+def register():
+    for module in _SETTINGS:
+        module.register()
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    for id_type, group in _ROOTS:
+        id_type.tessera = bpy.props.PointerProperty(type=group)
+
+
+def unregister():
+    for id_type, _ in reversed(_ROOTS):
+        del id_type.tessera
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
+    for module in reversed(_SETTINGS):
+        module.unregister()

@@ -1,0 +1,29 @@
+"""Sidebar panel Tessera > Terrain: a terrain object's settings, the preview toggle, and the bake."""
+
+import bpy
+
+from ..sidebar import Sidebar
+from .settings import draw_terrain_settings
+
+
+class TESSERA_PT_terrain(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_terrain"
+    bl_label = "Terrain"
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.tessera.terrain.is_terrain
+
+    def draw_header(self, context):
+        self.layout.prop(context.active_object.tessera.terrain, "preview", text="")
+
+    def draw(self, context):
+        draw_terrain_settings(self.layout, context.active_object.tessera.terrain)
+        row = self.layout.row()
+        row.scale_y = 1.4
+        row.operator("tessera.terrain_bake", icon="VIEW_CAMERA")
+
+
+classes = (TESSERA_PT_terrain,)
+register, unregister = bpy.utils.register_classes_factory(classes)

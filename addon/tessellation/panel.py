@@ -1,0 +1,24 @@
+"""Sidebar panel Tessera > Tessellate: edits the object's tessellation settings and runs them."""
+
+import bpy
+
+from ..sidebar import Sidebar
+from .settings import draw_settings
+
+
+class TESSERA_PT_tessellate(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_tessellate"
+    bl_label = "Tessellate"
+
+    def draw(self, context):
+        settings = context.active_object.tessera.tessellate
+        self.layout.prop(settings, "preview", icon="HIDE_OFF")
+        draw_settings(self.layout, settings)
+        row = self.layout.row()
+        row.scale_y = 1.4
+        op = row.operator("tessera.tessellate", icon="MOD_SUBSURF")
+        op.use_object_settings = True
+
+
+classes = (TESSERA_PT_tessellate,)
+register, unregister = bpy.utils.register_classes_factory(classes)
