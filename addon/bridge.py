@@ -343,3 +343,20 @@ def read_wire_mesh(mesh):
     positions = _get(mesh.attributes["position"].data, "vector", n_v, np.float32, 3)
     edges = _get(mesh.edges, "vertices", len(mesh.edges), np.int32, 2)
     return positions, edges
+
+
+def read_image_pixels(image, channels=None):
+    """An image's pixels as (H, W, C) float32, row 0 at the bottom (Blender's order); C = ``channels`` or the
+    image's own channel count. One ``foreach_get``."""
+    w, h = image.size
+    c = channels or image.channels
+    pixels = np.empty(w * h * c, np.float32)
+    image.pixels.foreach_get(pixels)
+    return pixels.reshape(h, w, c)
+
+
+def write_image_pixels(image, pixels):
+    """Replace every pixel of ``image`` with ``pixels`` ((H, W, C) float32 as `read_image_pixels` gives) and
+    tell Blender the image changed. One ``foreach_set``."""
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
+    image.update()

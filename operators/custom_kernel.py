@@ -19,7 +19,6 @@ from ..kernels.displacement.map_edit import apply_custom, compile_custom
 from ..kernels.displacement.map_strokes import TileUndo
 
 _trusted_sources = set()  # sha256 of sources the user confirmed in this session
-stats = {"compiled": 0}  # how many custom kernels were compiled in this session (tests check load runs none)
 
 
 def _digest(source):
@@ -88,7 +87,6 @@ class TESSERA_OT_displacement_custom(bpy.types.Operator):
             self.report({"ERROR"}, "Custom kernels need OpenCL, and no OpenCL device is available")
             return {"CANCELLED"}
         try:
-            stats["compiled"] += 1
             kernel = compile_custom(runtime, source)
             state = map_state(settings.image, channels_for(settings))
             args = [tuple(settings.kernel_args[4 * i:4 * i + 4]) for i in range(4)]

@@ -12,6 +12,7 @@ import bpy
 import mathutils
 import numpy as np
 
+from ..addon import bridge
 from ..addon.displacement import nodes as displace_nodes
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
@@ -49,7 +50,7 @@ def new_map_image(name, width, height, data=None):
     rgba[..., 3] = 1.0
     if data is not None:
         rgba[..., :3] = data if data.shape[2] != 1 else np.repeat(data, 3, axis=2)
-    image.pixels.foreach_set(rgba.ravel())
+    bridge.write_image_pixels(image, rgba)
     return image
 
 

@@ -8,7 +8,7 @@ import bpy
 from ..addon.cameras import camera_for, object_camera
 from ..addon.preferences import get_preferences
 from ..addon.terrain import data as terrain_data
-from ..addon.terrain.settings import copy_terrain_settings, draw_terrain_settings, lod_settings, terrain_annotations
+from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
 from ..kernels.common.errors import BudgetError, InvalidInputError, TesseraError
 from ..kernels.terrain.lod import select
 from ..kernels.terrain.mesh import bake, triangle_count
@@ -52,18 +52,15 @@ def _bake_into(context, ob, camera, report):
     return sel
 
 
-class TESSERA_OT_terrain_add(bpy.types.Operator):
+class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     """Add a terrain object from a height map, meshed adaptively for the scene camera"""
 
     bl_idname = "tessera.terrain_add"
     bl_label = "Terrain from Height Map"
     bl_options = {"REGISTER", "UNDO"}
 
-    __annotations__ = {
-        **terrain_annotations(),
-        "filter_glob": bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw",
-                                                options={"HIDDEN"}),
-    }
+    # the options: TerrainOptions (addon/terrain/settings.py), shared with Object.tessera.terrain
+    filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw", options={"HIDDEN"})
 
     @classmethod
     def poll(cls, context):

@@ -8,11 +8,11 @@ from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
 from ..addon.preferences import get_preferences
 from ..addon.tessellation.settings import (
+    TessellateOptions,
     adaptive_settings,
     copy_settings,
     draw_settings,
     needs_camera,
-    setting_annotations,
     surface_options,
 )
 from ..kernels.common.errors import GPUContextError, TesseraError
@@ -26,19 +26,17 @@ def _world_positions(positions, matrix):
     return positions @ m[:3, :3].T + m[:3, 3]
 
 
-class TESSERA_OT_tessellate(bpy.types.Operator):
+class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
     """Tessellate the active mesh: PN triangles, Phong or linear, with uniform or adaptive crack-free levels"""
 
     bl_idname = "tessera.tessellate"
     bl_label = "Tessellate"
     bl_options = {"REGISTER", "UNDO"}
 
-    __annotations__ = {
-        **setting_annotations(),
-        "use_object_settings": bpy.props.BoolProperty(
-            name="Use Object Settings", description="Take every setting from the object (Object > Tessera panel)",
-            default=False, options={"SKIP_SAVE"}),
-    }
+    # the options: TessellateOptions (addon/tessellation/settings.py), shared with Object.tessera.tessellate
+    use_object_settings: bpy.props.BoolProperty(
+        name="Use Object Settings", description="Take every setting from the object (Object > Tessera panel)",
+        default=False, options={"SKIP_SAVE"})
 
     @classmethod
     def poll(cls, context):

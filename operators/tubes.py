@@ -5,7 +5,7 @@ import bpy
 from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.preferences import get_preferences
-from ..addon.tubes.settings import copy_tube_settings, draw_tube_settings, kernel_settings, tube_annotations
+from ..addon.tubes.settings import TubeOptions, copy_tube_settings, draw_tube_settings, kernel_settings
 from ..addon.tubes.sources import SOURCE_TYPES, read_lines
 from ..kernels.common.errors import BudgetError, TesseraError
 from ..kernels.tubes.builder import build_tubes
@@ -15,14 +15,14 @@ from .selection import select_only
 _BYTES_PER_VERTEX, _BYTES_PER_CORNER, _BYTES_PER_EDGE = 24, 16, 8
 
 
-class TESSERA_OT_tubes(bpy.types.Operator):
+class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
     """Build tube meshes around the selected curves, hair curves or mesh edges"""
 
     bl_idname = "tessera.tubes"
     bl_label = "Tubes"
     bl_options = {"REGISTER", "UNDO"}
 
-    __annotations__ = tube_annotations()
+    # the options: TubeOptions (addon/tubes/settings.py), shared with Object.tessera.tubes
 
     @classmethod
     def poll(cls, context):

@@ -18,6 +18,7 @@ from ...kernels.common.errors import InvalidInputError, TesseraError
 from ...kernels.common.opencl_runtime import get_runtime
 from ...kernels.displacement.map_buffer import MapBuffer
 from ...kernels.displacement.map_strokes import TileUndo, run_stroke, stroke_dabs, union_region
+from .. import bridge
 from . import nodes as displace_nodes
 
 MODIFIER_NAME = "Tessera Displacement"
@@ -31,9 +32,7 @@ class MapState:
         w, h = image.size
         if w == 0 or h == 0:
             raise TesseraError(f"Image {image.name!r} has no pixels (is its file missing?)")
-        rgba = np.empty(w * h * 4, np.float32)
-        image.pixels.foreach_get(rgba)
-        rgba = rgba.reshape(h, w, 4)
+        rgba = bridge.read_image_pixels(image, 4)
         if not np.isfinite(rgba).all():
             raise InvalidInputError(f"Image {image.name!r} has NaN or infinite pixels")
         self.host = np.ascontiguousarray(rgba[..., :1] if channels == 1 else rgba[..., :channels])
@@ -55,8 +54,7 @@ class MapState:
             self.rgba[y0:y1, x0:x1, :tile.shape[2]] = tile
             if tile.shape[2] == 3:
                 self.rgba[y0:y1, x0:x1, 3] = 1.0
-        image.pixels.foreach_set(self.rgba.ravel())
-        image.update()
+        bridge.write_image_pixels(image, self.rgba)
         for ob in bpy.data.objects:
             if ob.type == "MESH" and ob.tessera.displacement.image == image:
                 ob.update_tag()

@@ -8,7 +8,6 @@ is written through the bridge and replaces the object's mesh data.
 import os
 
 import bpy
-import numpy as np
 
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.mesh_arrays import MeshArrays
@@ -30,9 +29,7 @@ def read_source(s):
         w, h = image.size
         if w < 2 or h < 2:
             raise InvalidInputError(f"The image {image.name!r} has no pixels (is its file missing?)")
-        pixels = np.empty(w * h * image.channels, np.float32)
-        image.pixels.foreach_get(pixels)
-        return heightmap_io.from_array(pixels.reshape(h, w, image.channels), source=image.name, **scale)
+        return heightmap_io.from_array(bridge.read_image_pixels(image), source=image.name, **scale)
     path = bpy.path.abspath(s.filepath)
     if not s.filepath:
         raise InvalidInputError("Choose a height-map file")

@@ -6,7 +6,7 @@ import bpy
 
 from ...kernels.terrain.lod import TerrainLod
 from ..cameras import CAMERA_ITEMS
-from ..viewport import invalidator
+from ..viewport import invalidator, with_update
 
 SOURCE_ITEMS = (
     ("FILE", "File", "PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw r16/r32 read with OpenImageIO"),
@@ -33,54 +33,51 @@ LEVEL_ITEMS = (
 )
 
 
-def terrain_annotations(update=None):
-    """Property definitions; ``update`` (optional) runs when a value changes."""
-    props = bpy.props
-    kw = {"update": update} if update else {}
-    return {
-        "source": props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE", **kw),
-        "filepath": props.StringProperty(name="Height Map", subtype="FILE_PATH", **kw),
-        "image_name": props.StringProperty(name="Image", description="Blender image with the heights", **kw),
-        "raw_width": props.IntProperty(name="Raw Width", default=0, min=0, description="Samples per row (raw files)",
-                                       **kw),
-        "raw_height": props.IntProperty(name="Raw Height", default=0, min=0, description="Rows (raw files)", **kw),
-        "texel_size": props.FloatProperty(name="Texel Size", default=1.0, min=1e-6, subtype="DISTANCE",
-                                          description="Distance between neighbouring samples", **kw),
-        "height_scale": props.FloatProperty(name="Height Scale", default=100.0, subtype="DISTANCE",
-                                            description="Height of a full-scale integer sample (255 or 65535); "
-                                                        "the factor on float samples", **kw),
-        "height_offset": props.FloatProperty(name="Height Offset", default=0.0, subtype="DISTANCE", **kw),
-        "tile_size": props.IntProperty(name="Tile Size", default=64, min=2, max=1024,
-                                       description="Texels per tile side (64: one quad per texel at level 64)",
-                                       **kw),
-        "mode": props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS", **kw),
-        "g": props.EnumProperty(name="T_max From HAM", items=G_ITEMS, default="SQRT", **kw),
-        "ham_scale": props.FloatProperty(name="HAM Scale", default=4.0, min=1e-3, soft_max=64.0,
-                                         description="k in the T_max function", **kw),
-        "epsilon": props.FloatProperty(name="Error (px)", default=3.0, min=0.05, soft_max=32.0,
-                                       description="Allowed screen-space error of a tile's peak", **kw),
-        "t_min_rule": props.EnumProperty(name="T_min Rule", items=T_MIN_ITEMS, default="SEARCH", **kw),
-        "d_max": props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, subtype="DISTANCE",
-                                     description="Below this distance tiles get T_max (0: where a texel spans "
-                                                 "4 pixels)", **kw),
-        "levels": props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2", **kw),
-        "culling": props.BoolProperty(name="Frustum Culling", default=True,
-                                      description="Drop tiles outside the camera's view", **kw),
-        "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE", **kw),
-    }
+class TerrainOptions:
+    """The terrain options, declared once: ``tessera.terrain_add`` inherits them as they are, and
+    `TESSERA_PG_terrain` (``Object.tessera.terrain``) takes them with the preview's invalidation added
+    (`with_update`)."""
+
+    source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE")
+    filepath: bpy.props.StringProperty(name="Height Map", subtype="FILE_PATH")
+    image_name: bpy.props.StringProperty(name="Image", description="Blender image with the heights")
+    raw_width: bpy.props.IntProperty(name="Raw Width", default=0, min=0, description="Samples per row (raw files)")
+    raw_height: bpy.props.IntProperty(name="Raw Height", default=0, min=0, description="Rows (raw files)")
+    texel_size: bpy.props.FloatProperty(name="Texel Size", default=1.0, min=1e-6, subtype="DISTANCE",
+                                        description="Distance between neighbouring samples")
+    height_scale: bpy.props.FloatProperty(name="Height Scale", default=100.0, subtype="DISTANCE",
+                                          description="Height of a full-scale integer sample (255 or 65535); "
+                                          "the factor on float samples")
+    height_offset: bpy.props.FloatProperty(name="Height Offset", default=0.0, subtype="DISTANCE")
+    tile_size: bpy.props.IntProperty(name="Tile Size", default=64, min=2, max=1024,
+                                     description="Texels per tile side (64: one quad per texel at level 64)")
+    mode: bpy.props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS")
+    g: bpy.props.EnumProperty(name="T_max From HAM", items=G_ITEMS, default="SQRT")
+    ham_scale: bpy.props.FloatProperty(name="HAM Scale", default=4.0, min=1e-3, soft_max=64.0,
+                                       description="k in the T_max function")
+    epsilon: bpy.props.FloatProperty(name="Error (px)", default=3.0, min=0.05, soft_max=32.0,
+                                     description="Allowed screen-space error of a tile's peak")
+    t_min_rule: bpy.props.EnumProperty(name="T_min Rule", items=T_MIN_ITEMS, default="SEARCH")
+    d_max: bpy.props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, subtype="DISTANCE",
+                                   description="Below this distance tiles get T_max (0: where a texel spans "
+                                   "4 pixels)")
+    levels: bpy.props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2")
+    culling: bpy.props.BoolProperty(name="Frustum Culling", default=True,
+                                    description="Drop tiles outside the camera's view")
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
 
 
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
 TOPIC = "terrain"
 _changed = invalidator(TOPIC)
-TERRAIN_SETTING_NAMES = tuple(terrain_annotations())
+TERRAIN_SETTING_NAMES = tuple(TerrainOptions.__annotations__)
 SOURCE_NAMES = ("source", "filepath", "image_name", "raw_width", "raw_height", "texel_size", "height_scale",
                 "height_offset", "tile_size")
 
 
 class TESSERA_PG_terrain(bpy.types.PropertyGroup):
     __annotations__ = {
-        **terrain_annotations(_changed),
+        **with_update(TerrainOptions, _changed),
         "preview": bpy.props.BoolProperty(name="Preview Terrain", update=_changed, default=False,
                                           description="Draw this terrain in the 3D viewport on the GPU, "
                                                       "re-selecting levels as the view moves"),

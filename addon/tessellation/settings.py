@@ -62,46 +62,46 @@ OUTPUT_ITEMS = (
 )
 
 
-def setting_annotations():
-    props = bpy.props
-    return {
-        "method": props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN"),
-        "level_mode": props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM"),
-        "level": props.FloatProperty(
-            name="Level", description="Segments per edge (and inner level) for every triangle",
-            default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2),
-        "spacing": props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL"),
-        "alpha": props.FloatProperty(
-            name="Shape Factor", description="Phong shape factor: 0 flat, 1 full projection (the seed), 0.75 default",
-            default=0.75, soft_min=0.0, soft_max=1.0, min=-1.0, max=2.0),
-        "alpha_attribute": props.StringProperty(
-            name="Shape Attribute", description="Float point attribute with a per-vertex shape factor (optional)"),
-        "normal_mode": props.EnumProperty(name="Sharp Edges", items=NORMAL_MODE_ITEMS, default="WATERTIGHT"),
-        "pn_normals": props.EnumProperty(name="PN Normals", items=PN_NORMAL_ITEMS, default="QUADRATIC"),
-        "metrics": props.EnumProperty(name="Metrics", items=METRIC_ITEMS, options={"ENUM_FLAG"},
-                                      default={"PROJECTED"}),
-        "max_level": props.FloatProperty(name="Max Level", description="Cap for adaptive levels",
-                                         default=16.0, min=1.0, max=float(MAX_LEVEL)),
-        "power_of_two": props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE"),
-        "edge_pixels": props.FloatProperty(name="Edge Pixels", description="Target edge length on screen",
-                                           default=10.0, min=0.5, soft_max=100.0, subtype="PIXEL"),
-        "distance_map": props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR"),
-        "near": props.FloatProperty(name="Near", description="Distance that gets the maximum level",
-                                    default=1.0, min=1e-4, subtype="DISTANCE", unit="LENGTH"),
-        "far": props.FloatProperty(name="Far", description="Distance beyond which the level is 1",
-                                   default=20.0, min=1e-3, subtype="DISTANCE", unit="LENGTH"),
-        "silhouette_beta": props.FloatProperty(
-            name="Silhouette Ramp", description="How far inside a silhouette triangle extra levels reach (beta)",
-            default=0.25, min=1e-4, max=1.0),
-        "curvature_gain": props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
-                                              default=10.0, min=0.0, soft_max=50.0),
-        "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE"),
-        "evaluate_on": props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU"),
-        "output": props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT"),
-    }
+class TessellateOptions:
+    """The tessellation options, declared once: the operator ``tessera.tessellate`` and `TESSERA_PG_tessellate`
+    (``Object.tessera.tessellate``) both inherit them."""
+
+    method: bpy.props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN")
+    level_mode: bpy.props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM")
+    level: bpy.props.FloatProperty(
+        name="Level", description="Segments per edge (and inner level) for every triangle",
+        default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2)
+    spacing: bpy.props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL")
+    alpha: bpy.props.FloatProperty(
+        name="Shape Factor", description="Phong shape factor: 0 flat, 1 full projection (the seed), 0.75 default",
+        default=0.75, soft_min=0.0, soft_max=1.0, min=-1.0, max=2.0)
+    alpha_attribute: bpy.props.StringProperty(
+        name="Shape Attribute", description="Float point attribute with a per-vertex shape factor (optional)")
+    normal_mode: bpy.props.EnumProperty(name="Sharp Edges", items=NORMAL_MODE_ITEMS, default="WATERTIGHT")
+    pn_normals: bpy.props.EnumProperty(name="PN Normals", items=PN_NORMAL_ITEMS, default="QUADRATIC")
+    metrics: bpy.props.EnumProperty(name="Metrics", items=METRIC_ITEMS, options={"ENUM_FLAG"},
+                                    default={"PROJECTED"})
+    max_level: bpy.props.FloatProperty(name="Max Level", description="Cap for adaptive levels",
+                                       default=16.0, min=1.0, max=float(MAX_LEVEL))
+    power_of_two: bpy.props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE")
+    edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", description="Target edge length on screen",
+                                         default=10.0, min=0.5, soft_max=100.0, subtype="PIXEL")
+    distance_map: bpy.props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR")
+    near: bpy.props.FloatProperty(name="Near", description="Distance that gets the maximum level",
+                                  default=1.0, min=1e-4, subtype="DISTANCE", unit="LENGTH")
+    far: bpy.props.FloatProperty(name="Far", description="Distance beyond which the level is 1",
+                                 default=20.0, min=1e-3, subtype="DISTANCE", unit="LENGTH")
+    silhouette_beta: bpy.props.FloatProperty(
+        name="Silhouette Ramp", description="How far inside a silhouette triangle extra levels reach (beta)",
+        default=0.25, min=1e-4, max=1.0)
+    curvature_gain: bpy.props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
+                                            default=10.0, min=0.0, soft_max=50.0)
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+    evaluate_on: bpy.props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU")
+    output: bpy.props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT")
 
 
-SETTING_NAMES = tuple(setting_annotations())
+SETTING_NAMES = tuple(TessellateOptions.__annotations__)
 
 
 #: The invalidation topic of these settings (`addon.viewport`).
@@ -109,16 +109,13 @@ TOPIC = "tessellate"
 _redraw = invalidator(TOPIC)
 
 
-class TESSERA_PG_tessellate(bpy.types.PropertyGroup):
-    __annotations__ = {
-        **setting_annotations(),
-        "stored": bpy.props.BoolProperty(name="Stored", description="These settings were saved by a tessellation run",
-                                         default=False),
-        "preview": bpy.props.BoolProperty(
-            name="Live Preview", default=False, update=_redraw,
-            description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
-                        "view); the object itself can be hidden meanwhile"),
-    }
+class TESSERA_PG_tessellate(TessellateOptions, bpy.types.PropertyGroup):
+    stored: bpy.props.BoolProperty(name="Stored", description="These settings were saved by a tessellation run",
+                                   default=False)
+    preview: bpy.props.BoolProperty(
+        name="Live Preview", default=False, update=_redraw,
+        description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
+                    "view); the object itself can be hidden meanwhile")
 
 
 def copy_settings(source, target):

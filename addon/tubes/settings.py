@@ -7,7 +7,7 @@ import bpy
 
 from ...kernels.tubes.builder import TubeSettings
 from ..cameras import CAMERA_ITEMS
-from ..viewport import invalidator
+from ..viewport import invalidator, with_update
 
 RADIUS_ITEMS = (
     ("POINT", "From Points", "Curves: point radius times Radius (like a bevel); hair: its 'radius' attribute "
@@ -30,48 +30,45 @@ REFINE_ITEMS = (
 )
 
 
-def tube_annotations(update=None):
-    """Property definitions; ``update`` (optional) is called when a value changes (the preview refreshes)."""
-    props = bpy.props
-    kw = {"update": update} if update else {}
-    return {
-        "radius_source": props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT", **kw),
-        "radius": props.FloatProperty(name="Radius", description="Radius, or the factor on curve point radii",
-                                      default=0.05, min=0.0, soft_max=10.0, subtype="DISTANCE", **kw),
-        "attribute": props.StringProperty(name="Attribute", description="Float point attribute with the radius",
-                                          default="radius", **kw),
-        "caps": props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT", **kw),
-        "sides_mode": props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED", **kw),
-        "sides": props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64, **kw),
-        "min_sides": props.IntProperty(name="Min Sides", default=3, min=3, max=1024, **kw),
-        "max_sides": props.IntProperty(name="Max Sides", default=32, min=3, max=1024, **kw),
-        "edge_pixels": props.FloatProperty(name="Side Length (px)", description="Target length of a side on screen",
-                                           default=8.0, min=0.5, soft_max=64.0, **kw),
-        "camera_source": props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE", **kw),
-        "aa_clamp": props.BoolProperty(name="Pixel Clamp", default=False, description="Keep every tube at least "
-                                       "one pixel in radius for the camera (thin tubes stay visible far away)", **kw),
-        "max_radius": props.FloatProperty(name="Max Clamp Radius", description="Cap of the clamp's inflation "
-                                          "(0: none)", default=0.0, min=0.0, subtype="DISTANCE", **kw),
-        "refine": props.IntProperty(name="Refine", description="Catmull-Rom segments per input segment (1: off)",
-                                    default=1, min=1, max=64, **kw),
-        "refine_kind": props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL", **kw),
-        "select_angle": props.FloatProperty(name="Angle Tolerance", subtype="ANGLE", default=0.0, min=0.0,
-                                            max=math.pi / 2, description="Keep a point only where the tangent has "
-                                            "turned this much (0: keep all points)", **kw),
-        "uvs": props.BoolProperty(name="UVs", default=True, description="UV map: U along the tube, V around it",
-                                  **kw),
-    }
+class TubeOptions:
+    """The tube options, declared once: the operator ``tessera.tubes`` inherits them as they are, and
+    `TESSERA_PG_tubes` (``Object.tessera.tubes``) takes them with the preview's invalidation added (`with_update`)."""
+
+    radius_source: bpy.props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT")
+    radius: bpy.props.FloatProperty(name="Radius", description="Radius, or the factor on curve point radii",
+                                    default=0.05, min=0.0, soft_max=10.0, subtype="DISTANCE")
+    attribute: bpy.props.StringProperty(name="Attribute", description="Float point attribute with the radius",
+                                        default="radius")
+    caps: bpy.props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT")
+    sides_mode: bpy.props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED")
+    sides: bpy.props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64)
+    min_sides: bpy.props.IntProperty(name="Min Sides", default=3, min=3, max=1024)
+    max_sides: bpy.props.IntProperty(name="Max Sides", default=32, min=3, max=1024)
+    edge_pixels: bpy.props.FloatProperty(name="Side Length (px)", description="Target length of a side on screen",
+                                         default=8.0, min=0.5, soft_max=64.0)
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+    aa_clamp: bpy.props.BoolProperty(name="Pixel Clamp", default=False, description="Keep every tube at least "
+                                     "one pixel in radius for the camera (thin tubes stay visible far away)")
+    max_radius: bpy.props.FloatProperty(name="Max Clamp Radius", description="Cap of the clamp's inflation "
+                                        "(0: none)", default=0.0, min=0.0, subtype="DISTANCE")
+    refine: bpy.props.IntProperty(name="Refine", description="Catmull-Rom segments per input segment (1: off)",
+                                  default=1, min=1, max=64)
+    refine_kind: bpy.props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL")
+    select_angle: bpy.props.FloatProperty(name="Angle Tolerance", subtype="ANGLE", default=0.0, min=0.0,
+                                          max=math.pi / 2, description="Keep a point only where the tangent has "
+                                          "turned this much (0: keep all points)")
+    uvs: bpy.props.BoolProperty(name="UVs", default=True, description="UV map: U along the tube, V around it")
 
 
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
 TOPIC = "tubes"
 _changed = invalidator(TOPIC)
-TUBE_SETTING_NAMES = tuple(tube_annotations())
+TUBE_SETTING_NAMES = tuple(TubeOptions.__annotations__)
 
 
 class TESSERA_PG_tubes(bpy.types.PropertyGroup):
     __annotations__ = {
-        **tube_annotations(_changed),
+        **with_update(TubeOptions, _changed),
         "preview": bpy.props.BoolProperty(name="Preview Tubes", update=_changed, default=False,
                                           description="Draw this object's tubes in the 3D viewport on the GPU "
                                                       "(no mesh is made)"),
