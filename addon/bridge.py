@@ -13,6 +13,7 @@ import numpy as np
 
 from ..kernels.common.errors import InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.common.tolerances import FLAT_FACE_NORMAL_ATOL
 from ..kernels.displacement.tangent_space import triangle_tangents
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
@@ -242,7 +243,7 @@ def write_polygons(name, poly):
         if poly.corner_normals is not None:
             corner_face = np.repeat(np.arange(n_f), poly.face_sizes)
             first = poly.corner_normals[starts]
-            flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < 1e-6, axis=1)
+            flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < FLAT_FACE_NORMAL_ATOL, axis=1)
             sharp = np.logical_and.reduceat(flat, starts)
             _new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", sharp)
         if poly.corner_uvs is not None:

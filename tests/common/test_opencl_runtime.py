@@ -1,4 +1,4 @@
-"""Runtime selection logic (no OpenCL platform needed: the platform is simulated absent)."""
+"""Runtime selection logic (the platform simulated absent) and, in the opencl tier, program build errors."""
 
 import warnings
 
@@ -68,3 +68,11 @@ def test_cache_dir_is_not_in_home(monkeypatch, tmp_path):
     opencl_runtime.configure(cache_dir=str(tmp_path / "prefs"))
     assert opencl_runtime.cache_dir() == str(tmp_path / "prefs")
     opencl_runtime.configure()
+
+
+@pytest.mark.opencl
+def test_build_error_reports_the_compiler_log(opencl, monkeypatch):
+    monkeypatch.setitem(opencl_runtime._sources, "broken", "__kernel void k(__global float *x) { x[0] = y; }")
+    with pytest.raises(TesseraError, match="failed to build") as err:
+        opencl.program("broken")
+    assert "y" in str(err.value)

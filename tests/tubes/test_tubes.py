@@ -13,7 +13,7 @@ from tessera.kernels.tubes.polylines import Polylines, drop_duplicates
 
 @pytest.fixture(autouse=True)
 def numpy_reference():
-    """These tests check the numpy reference; tests/tessellation/test_opencl.py compares the OpenCL path with it."""
+    """These tests check the numpy reference; tests/tubes/test_opencl_tubes.py compares the OpenCL path with it."""
     opencl_runtime.configure(mode="0")
     yield
     opencl_runtime.configure()
