@@ -43,6 +43,20 @@ class MapBuffer:
                                      host_origin=origin, region=size, buffer_pitches=(self.row_bytes,),
                                      host_pitches=(self.row_bytes,))
 
+    def pull_finite(self, region):
+        """`pull` ``region`` only if every value there is finite; otherwise copy the host rectangle back to the
+        device (undoing the device-side edit) and return False. Host and device agree either way."""
+        origin, size = self._rect(region)
+        x0, y0, x1, y1 = region
+        tile = np.empty((y1 - y0, x1 - x0, self.host.shape[2]), np.float32)
+        self.runtime.cl.enqueue_copy(self.runtime.queue, tile, self.buf, buffer_origin=origin, host_origin=(0, 0),
+                                     region=size, buffer_pitches=(self.row_bytes,), host_pitches=(size[0],))
+        if not np.isfinite(tile).all():
+            self.push(region)
+            return False
+        self.host[y0:y1, x0:x1] = tile
+        return True
+
     def push(self, region=None):
         """Copy the host rectangle (default: all of it) to the device after a host-side edit."""
         h, w = self.host.shape[:2]

@@ -278,12 +278,14 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     if before_write is not None:
         before_write(region)
     if runtime is None:
-        tile = dmap[y0:y1, x0:x1]  # a view: the reference edits the map in place
-        if kind == "SMOOTH":
-            hx0, hy0, hx1, hy1 = halo
-            numpy_fn(tile, x0, y0, dmap[hy0:hy1, hx0:hx1].copy(), hx0, hy0)
-        else:
-            numpy_fn(tile, x0, y0)
+        tile = dmap[y0:y1, x0:x1].copy()  # scratch: committed only when every value is finite
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused by _commit, not warned about
+            if kind == "SMOOTH":
+                hx0, hy0, hx1, hy1 = halo
+                numpy_fn(tile, x0, y0, dmap[hy0:hy1, hx0:hx1].copy(), hx0, hy0)
+            else:
+                numpy_fn(tile, x0, y0)
+        _commit(dmap, region, tile)
     else:
         _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
     return region
@@ -303,10 +305,21 @@ def smooth_map(dmap, strength=1.0, backend="auto", device=None):
     runtime = _backend_runtime(backend, device)
     if runtime is None:
         _check_finite(dmap, (0, 0, w, h))
-        dmap[...] = ref.smooth_full(dmap, k)
+        _commit(dmap, (0, 0, w, h), ref.smooth_full(dmap, k))
     elif not (device or MapBuffer(runtime, dmap)).smooth_all(k):
         raise InvalidInputError("The map has NaN or infinite values; nothing was changed")
     return 0, 0, w, h
+
+
+_NOT_FINITE = "The edit would write NaN or infinite values (are its strength or parameters huge?); nothing was changed"
+
+
+def _commit(dmap, region, tile):
+    """Write the scratch ``tile`` into ``region`` of the map, or refuse (map unchanged) if it is not all finite."""
+    if not np.isfinite(tile).all():
+        raise InvalidInputError(_NOT_FINITE)
+    x0, y0, x1, y1 = region
+    dmap[y0:y1, x0:x1] = tile
 
 
 def _check_finite(dmap, region):
@@ -325,7 +338,7 @@ def _run_opencl(runtime, dmap, region, name, args, halo, device):
     if device is not None:
         buf, base, mem_w = device.buf, (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
     else:
-        tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+        tile = dmap[y0:y1, x0:x1].copy()  # scratch (a copy even when the region is the whole map)
         buf, base, mem_w = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w
     extra = []
     if name == "smooth":
@@ -345,10 +358,11 @@ def _run_opencl(runtime, dmap, region, name, args, halo, device):
     kernel(runtime.queue, (w, h), None, buf, np.int64(base), np.int32(mem_w), np.int32(channels), np.int32(x0),
            np.int32(y0), np.int32(w), np.int32(h), *extra, *args)
     if device is not None:
-        device.pull(region)
+        if not device.pull_finite(region):
+            raise InvalidInputError(_NOT_FINITE)
     else:
         cl.enqueue_copy(runtime.queue, tile, buf)
-        dmap[y0:y1, x0:x1] = tile
+        _commit(dmap, region, tile)
 
 
 def morph(a, b, time, backend="auto"):
@@ -418,7 +432,7 @@ def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4, d
     h, w = dmap.shape[:2]
     x0, y0, x1, y1 = region or (0, 0, w, h)
     vals = [_f4(_finite(f"arg{i + 1}", a)) for i, a in enumerate(args)]
-    tile = np.ascontiguousarray(dmap[y0:y1, x0:x1])
+    tile = dmap[y0:y1, x0:x1].copy()  # scratch: never a view of the map, even when the region is all of it
     cl = runtime.cl
     d_tile = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
     kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int64(0), np.int32(x1 - x0), np.int32(dmap.shape[2]),

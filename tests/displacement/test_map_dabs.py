@@ -153,3 +153,17 @@ def test_dab_parameters_are_a_record_and_bad_names_are_refused():
     with pytest.raises(InvalidInputError, match="not both"):
         apply_dab(m, "DRAW", backend="numpy", dab=DabParams(pos=(1, 1), radius=2), strength=1.0)
     assert not m.any()
+
+
+@pytest.mark.parametrize("kind, params", [
+    ("DRAW", {"pos": (20, 20), "radius": 8, "strength": 3e38, "vector": (0, 0, 3e38, 0), "falloff": "CONSTANT"}),
+    ("NOISE", {"pos": (20, 20), "radius": 8, "strength": 3e38, "vector": (3e38, 3e38, 3e38, 0), "cell": 2.0}),
+    ("CONTACT", {"pos": (20, 20), "radius": 8, "depth": -3e38}),
+])
+def test_a_dab_that_would_overflow_is_refused_with_the_map_unchanged(kind, params):
+    """Finite parameters can still overflow float32: the result is computed aside and refused, not committed."""
+    m = np.full((40, 40, 4), 3e38, np.float32)
+    before = m.copy()
+    with pytest.raises(InvalidInputError, match="NaN or infinite"):
+        apply_dab(m, kind, backend="numpy", **params)
+    assert m.tobytes() == before.tobytes()

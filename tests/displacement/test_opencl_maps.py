@@ -96,3 +96,27 @@ def test_custom_kernel_identity_reproduction_and_compile_errors(opencl):
     with pytest.raises(TesseraError, match="failed to compile") as err:
         compile_custom(opencl, "image += ;")
     assert "error" in str(err.value).lower()
+
+
+def test_non_finite_results_never_reach_the_map_or_the_device(opencl):
+    """A custom kernel writing NaN over the whole map (the region that once aliased the map) and a dab that
+    overflows are refused; the host map and the device copy keep every bit."""
+    from tessera.kernels.displacement.map_buffer import MapBuffer
+    from tessera.kernels.displacement.map_edit import InvalidInputError, apply_custom, apply_dab, compile_custom
+
+    rng = np.random.default_rng(8)
+    m = (rng.uniform(-1, 1, size=(48, 40, 4)) * 3e38).astype(np.float32)
+    before = m.copy()
+    device = MapBuffer(opencl, m)
+    for dev in (None, device):
+        with pytest.raises(TesseraError, match="NaN or infinite"):
+            apply_custom(m, compile_custom(opencl, "image = (float4)(NAN);"), opencl, device=dev)
+        assert m.tobytes() == before.tobytes()
+    for dev, backend in ((None, "opencl"), (device, "auto")):
+        with pytest.raises(InvalidInputError, match="NaN or infinite"):
+            apply_dab(m, "DRAW", backend=backend, device=dev, pos=(20, 20), radius=30, strength=3e38,
+                      vector=(3e38, 3e38, 3e38, 3e38), falloff="CONSTANT")
+        assert m.tobytes() == before.tobytes()
+    on_device = np.empty_like(m)
+    opencl.cl.enqueue_copy(opencl.queue, on_device, device.buf)
+    assert on_device.tobytes() == before.tobytes()
