@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from ..kernels.common.errors import InvalidInputError
+from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.tolerances import FLAT_FACE_NORMAL_ATOL
 from ..kernels.displacement.tangent_space import triangle_tangents
@@ -233,9 +233,12 @@ def write_polygons(name, poly):
     Writes edges and corner edges directly when the kernel knows them (no edge computation). Faces are
     smooth except where corner normals differ from the point normal field (FLAT caps: those faces are
     marked sharp, so Blender's own normals keep the rim crisp). UVs go to the map "UVMap", materials to
-    ``material_index``. Removes the half-built mesh if anything fails.
+    ``material_index``. Removes the half-built mesh if anything fails. Raises `EmptyResultError` for a mesh
+    without faces (Blender's geometry writer needs at least one point).
     """
     n_f = len(poly.face_sizes)
+    if n_f == 0 or len(poly.positions) == 0:
+        raise EmptyResultError(f"Nothing to write for {name!r}: the result has no faces")
     starts = poly.face_offsets[:-1]  # a cumulative sum: computed once
     with _new_mesh(name) as mesh:
         _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts)
@@ -278,10 +281,10 @@ def read_curve_object(ob, radius_scale=1.0):
     notes = []
     try:
         data.bevel_depth, data.extrude, data.bevel_object, data.taper_object = 0.0, 0.0, None, None
-        wire = probe.to_mesh()
-        n_v = len(wire.vertices)
+        wire = probe.to_mesh()  # None for a curve without splines
+        n_v = len(wire.vertices) if wire is not None else 0
         if n_v == 0:
-            raise InvalidInputError(f"Curve {ob.name!r} has no points")
+            raise EmptyResultError(f"Curve {ob.name!r} has no points: add a spline, or select another curve")
         positions = _get(wire.attributes["position"].data, "vector", n_v, np.float32, 3)
         edges = _get(wire.edges, "vertices", len(wire.edges), np.int32, 2)
         counts, cyclic = wire_runs(n_v, edges)

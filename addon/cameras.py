@@ -12,12 +12,13 @@ CAMERA_ITEMS = (
 )
 
 
-def scene_camera(context):
-    """The scene camera at the render resolution. Raises `InvalidInputError` when the scene has none."""
+def scene_camera(context, purpose="Adaptive levels"):
+    """The scene camera at the render resolution. Raises `InvalidInputError` when the scene has none; the message
+    names ``purpose`` (what needs the camera)."""
     scene = context.scene
     ob = scene.camera
     if ob is None:
-        raise InvalidInputError("Adaptive levels need a camera: set the scene camera, or use the viewport")
+        raise InvalidInputError(f"{purpose} need a camera: set the scene camera, or use the viewport")
     render = scene.render
     width = max(1, round(render.resolution_x * render.resolution_percentage / 100))
     height = max(1, round(render.resolution_y * render.resolution_percentage / 100))
@@ -34,9 +35,9 @@ def viewport_camera(context):
     return Camera(np.array(rv3d.view_matrix), np.array(rv3d.window_matrix), region.width, region.height)
 
 
-def camera_for(context, source):
-    """``source``: ``"SCENE"`` or ``"VIEWPORT"``."""
-    return viewport_camera(context) if source == "VIEWPORT" else scene_camera(context)
+def camera_for(context, source, purpose="Adaptive levels"):
+    """``source``: ``"SCENE"`` or ``"VIEWPORT"``; ``purpose`` names what needs it, for the message."""
+    return viewport_camera(context) if source == "VIEWPORT" else scene_camera(context, purpose)
 
 
 def object_camera(camera, matrix_world):

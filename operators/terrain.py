@@ -6,10 +6,11 @@ import time
 import bpy
 
 from ..addon.cameras import camera_for, object_camera
+from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
-from ..kernels.common.errors import BudgetError, InvalidInputError, TesseraError
+from ..kernels.common.errors import BudgetError, EmptyResultError, InvalidInputError
 from ..kernels.terrain.lod import select
 from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
@@ -26,8 +27,9 @@ def _camera_or_none(context, source):
         return None
 
 
-def _bake_into(context, ob, camera, report):
-    """Select levels for ``camera``, check the budget, bake and write the mesh. Returns the selection."""
+def _bake_into(context, ob, camera, report, tx):
+    """Select levels for ``camera``, check the budget, bake and write the mesh (its new mesh tracked by the
+    `Transaction` ``tx``). Returns the selection. Raises `EmptyResultError` when the camera sees no tile."""
     s = ob.tessera.terrain
     wm = context.window_manager
     hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)))
@@ -35,6 +37,11 @@ def _bake_into(context, ob, camera, report):
     sel = select(hm, table, object_camera(camera, ob.matrix_world) if camera else None, lod_settings(s))
     t_select = time.perf_counter() - t0
     n_tris = triangle_count(sel)
+    if n_tris == 0 and sel.culled.all():
+        clip = f" (its clip end is {camera.clip_end:g})" if camera is not None else ""
+        raise EmptyResultError(
+            f"The camera sees no tile of this terrain{clip}: move or aim the camera at it, raise the camera's clip "
+            "end, or turn off Frustum Culling")
     budget = get_preferences(context).memory_budget_bytes
     if budget and n_tris * _BYTES_PER_TRIANGLE > budget:
         raise BudgetError(f"The terrain mesh would have {n_tris:,} triangles (about "
@@ -43,7 +50,7 @@ def _bake_into(context, ob, camera, report):
                           "the budget in the Tessera preferences.")
     wm.progress_update(85)
     mesh = bake(hm, table, sel)
-    terrain_data.write_terrain_mesh(ob, f"{ob.name}.terrain", mesh)
+    tx.track(terrain_data.write_terrain_mesh(ob, f"{ob.name}.terrain", mesh))
     full = 2 * (hm.width - 1) * (hm.height - 1)
     view = "for the camera" if camera is not None else "view-independent (no camera)"
     report({"INFO"}, f"Terrain {view}: {len(mesh.triangles):,} triangles, {100 * len(mesh.triangles) / full:.2f}% "
@@ -78,9 +85,11 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     def draw(self, context):
         draw_terrain_settings(self.layout, self)
 
-    def execute(self, context):
-        mesh = bpy.data.meshes.new("Terrain")
-        ob = bpy.data.objects.new("Terrain", mesh)
+    @guarded
+    def execute(self, context, tx):
+        mesh = tx.new_mesh("Terrain")
+        ob = tx.new_object("Terrain", mesh)
+        tx.on_rollback(lambda: terrain_data.forget(ob))
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
@@ -88,16 +97,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
             ob.tessera.terrain.is_terrain = True
             ob.location = context.scene.cursor.location
             context.collection.objects.link(ob)
-            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report)
-        except TesseraError as err:
-            terrain_data.forget(ob)
-            data = ob.data
-            bpy.data.objects.remove(ob)
-            for m in {data, mesh}:
-                if m.users == 0:
-                    bpy.data.meshes.remove(m)
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx)
         finally:
             wm.progress_end()
         select_only(context, [ob])
@@ -119,16 +119,14 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
             return False
         return True
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         ob = context.active_object
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            camera = camera_for(context, ob.tessera.terrain.camera_source)
-            _bake_into(context, ob, camera, self.report)
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+            camera = camera_for(context, ob.tessera.terrain.camera_source, "Baking a terrain for a camera")
+            _bake_into(context, ob, camera, self.report, tx)
         finally:
             wm.progress_end()
         return {"FINISHED"}

@@ -6,6 +6,7 @@ import numpy as np
 from ..addon import bridge
 from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
+from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..addon.tessellation.settings import (
     TessellateOptions,
@@ -15,7 +16,7 @@ from ..addon.tessellation.settings import (
     needs_camera,
     surface_options,
 )
-from ..kernels.common.errors import GPUContextError, TesseraError
+from ..kernels.common.errors import GPUContextError
 from ..kernels.tessellation.adaptive import adaptive_levels
 from ..kernels.tessellation.tessellate import check_budget, estimate, tessellate, uniform_levels
 from .selection import select_only
@@ -58,7 +59,8 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
     def draw(self, context):
         draw_settings(self.layout, self)
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         ob = context.active_object
         if self.use_object_settings:
             copy_settings(ob.tessera.tessellate, self)
@@ -66,16 +68,14 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         wm.progress_begin(0, 100)
         try:
             new_mesh, skipped, notes = self._build_mesh(context, ob, lambda f: wm.progress_update(int(100 * f)))
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
         finally:
             wm.progress_end()
+        tx.track(new_mesh)
         if skipped:
             self.report({"INFO"}, f"Not carried over (no interpolation for these types): {', '.join(skipped)}")
         for note in notes:
             self.report({"WARNING"}, note)
-        target = self._place(context, ob, new_mesh)
+        target = self._place(context, tx, ob, new_mesh)
         for holder in {ob, target}:
             copy_settings(self, holder.tessera.tessellate)
             holder.tessera.tessellate.stored = True
@@ -131,17 +131,18 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         method, alpha, quadratic = self.method, self.alpha, self.pn_normals == "QUADRATIC"
         return lambda ref, inputs: evaluate_on_gpu(ref, inputs, method, alpha, quadratic)
 
-    def _place(self, context, ob, mesh):
+    def _place(self, context, tx, ob, mesh):
         """Put the new mesh in the scene; returns the object that holds it."""
         if self.output == "REPLACE":
             old = ob.data
             ob.data = mesh
+            tx.on_rollback(lambda: setattr(ob, "data", old))
             if old.users == 0:
                 old_name = old.name
                 bpy.data.meshes.remove(old)
                 mesh.name = old_name
             return ob
-        new = bpy.data.objects.new(f"{ob.name}.tessellated", mesh)
+        new = tx.new_object(f"{ob.name}.tessellated", mesh)
         for collection in ob.users_collection:
             collection.objects.link(new)
         new.matrix_world = ob.matrix_world.copy()

@@ -4,10 +4,11 @@ import bpy
 
 from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
+from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..addon.tubes.settings import TubeOptions, copy_tube_settings, draw_tube_settings, kernel_settings
 from ..addon.tubes.sources import SOURCE_TYPES, read_lines
-from ..kernels.common.errors import BudgetError, TesseraError
+from ..kernels.common.errors import BudgetError, EmptyResultError
 from ..kernels.tubes.builder import build_tubes
 from .selection import select_only
 
@@ -40,17 +41,17 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
     def settings(self):
         return kernel_settings(self)
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         sources = [ob for ob in context.selected_objects if ob.type in SOURCE_TYPES]
         settings = self.settings()
         wm = context.window_manager
         wm.progress_begin(0, 100)
-        made = []
         try:
             camera = None
             if settings.sides_mode == "CAMERA" or settings.aa_clamp:
-                camera = camera_for(context, self.camera_source)
-            results = []
+                camera = camera_for(context, self.camera_source, "Camera sides and the pixel clamp")
+            results, empty = [], []
             for i, ob in enumerate(sources):
                 def progress(f, i=i):
                     wm.progress_update(int(100 * (i + f) / len(sources)))
@@ -58,22 +59,24 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
                 lines, notes = read_lines(ob, self)
                 cam = object_camera(camera, ob.matrix_world) if camera is not None else None
                 self._check_budget(context, lines, settings)
-                poly = build_tubes(lines, settings, cam, progress)
+                try:
+                    poly = build_tubes(lines, settings, cam, progress)
+                except EmptyResultError as err:
+                    empty.append(f"{ob.name}: {err}")
+                    continue
                 results.append((ob, poly, notes + poly.notes))
-            for ob, poly, notes in results:
-                made.append(self._place(context, ob, poly))
-                copy_tube_settings(self, ob.tessera.tubes)  # a batch script can re-run them
-                for note in notes:
-                    self.report({"WARNING"}, note)
-        except TesseraError as err:
-            for ob in made:  # leave the scene as it was
-                mesh = ob.data
-                bpy.data.objects.remove(ob)
-                bpy.data.meshes.remove(mesh)
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
         finally:
             wm.progress_end()
+        if not results:
+            raise EmptyResultError("; ".join(empty) if len(empty) == 1 else
+                                   f"No tubes from {len(empty)} sources. {empty[0]}")
+        made = [self._place(tx, ob, poly) for ob, poly, _ in results]  # every source built before any is placed
+        for ob, _, notes in results:
+            copy_tube_settings(self, ob.tessera.tubes)  # a batch script can re-run them
+            for note in notes:
+                self.report({"WARNING"}, note)
+        for note in empty:
+            self.report({"WARNING"}, f"No tubes from {note}")
         select_only(context, made)
         return {"FINISHED"}
 
@@ -87,11 +90,11 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
                               f"over the memory budget of {budget / 2**20:,.0f} MiB. Use fewer sides, or raise "
                               "the budget in the Tessera preferences.")
 
-    def _place(self, context, ob, poly):
-        mesh = bridge.write_polygons(f"{ob.data.name}.tubes", poly)
+    def _place(self, tx, ob, poly):
+        mesh = tx.track(bridge.write_polygons(f"{ob.data.name}.tubes", poly))
         for material in getattr(ob.data, "materials", ()):
             mesh.materials.append(material)
-        new = bpy.data.objects.new(f"{ob.name}.tubes", mesh)
+        new = tx.new_object(f"{ob.name}.tubes", mesh)
         for collection in ob.users_collection:
             collection.objects.link(new)
         new.matrix_world = ob.matrix_world.copy()

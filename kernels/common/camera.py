@@ -60,6 +60,14 @@ class Camera:
         return bool(np.asarray(self.projection)[3, 3] == 1.0)
 
     @property
+    def clip_end(self):
+        """Distance to the far clipping plane, from the projection (OpenGL convention): float."""
+        p = np.asarray(self.projection, np.float64)
+        if self.orthographic:
+            return float((p[2, 3] - 1.0) / -p[2, 2])
+        return float(p[2, 3] / (p[2, 2] + 1.0))
+
+    @property
     def eye(self):
         """Camera position in world space: (3,) float64."""
         return np.linalg.inv(np.asarray(self.view, np.float64))[:3, 3]

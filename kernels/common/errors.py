@@ -19,3 +19,8 @@ class OpenCLUnavailableError(TesseraError):
 
 class GPUContextError(TesseraError):
     """No GPU context could be created (background mode without EGL/Mesa or a GPU)."""
+
+
+class EmptyResultError(TesseraError):
+    """The input is valid but gives nothing to make (curves without length, a terrain the camera does not see);
+    the message says what to change."""

@@ -1,7 +1,9 @@
 """Image files through OpenImageIO, shared by height maps (terrain) and displacement maps.
 
 Arrays are (H, W, C) with row 0 at the bottom (Blender's image rows, UV v = 0); files store the top row
-first, so rows flip on the way in. Errors are `TesseraError` with OpenImageIO's own reason.
+first, so rows flip on the way in. Errors are `TesseraError` with OpenImageIO's own reason (or, where it gives
+none, what is known: a damaged file, a missing folder). Writes go to a temporary file beside the target that
+replaces it only when complete, so a failed write never leaves a half-written file.
 """
 
 import os
@@ -32,31 +34,52 @@ def read_pixels(path, what, pixel_type, n_channels=None):
     oiio = oiio_module()
     inp = oiio.ImageInput.open(path)
     if inp is None:
-        raise TesseraError(f"Cannot read {path}: {oiio.geterror()}")
+        raise TesseraError(f"Cannot read {path}: {_reason(oiio, None, 'not an image file OpenImageIO can read')}")
     try:
         spec = inp.spec()
         fmt = str(spec.format)
         n = n_channels or spec.nchannels
         data = inp.read_image(0, 0, 0, n, pixel_type(fmt))
+        if data is None:
+            raise TesseraError(f"Reading {path} failed: {_reason(oiio, inp, 'the file is damaged or truncated')}")
     finally:
         inp.close()
-    if data is None:
-        raise TesseraError(f"Reading {path} failed: {oiio.geterror()}")
     return np.asarray(data).reshape(spec.height, spec.width, n)[::-1], fmt
+
+
+def _reason(oiio, handle, fallback):
+    """OpenImageIO's error text (the handle's, then the global one), or ``fallback`` when it gives none."""
+    text = ""
+    if handle is not None and hasattr(handle, "geterror"):
+        text = handle.geterror() or ""
+    text = text or oiio.geterror() or ""
+    return text.strip() or fallback
 
 
 def write_pixels(path, rows, fmt, lossless_exr=False):
     """Write ``rows`` (H, W, C), already in file order (top row first), as sample format ``fmt`` ("float",
-    "uint16", ...); ``lossless_exr`` sets zip compression."""
+    "uint16", ...); ``lossless_exr`` sets zip compression. The file appears only when it is complete."""
     h, w, c = rows.shape
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise TesseraError(f"Cannot write {path}: the folder {folder} does not exist")
     oiio = oiio_module()
     spec = oiio.ImageSpec(w, h, c, fmt)
     if lossless_exr:
         spec.attribute("compression", "zip")  # lossless
-    out = oiio.ImageOutput.create(path)
-    if out is None or not out.open(path, spec):
-        raise TesseraError(f"Cannot write {path}: {oiio.geterror()}")
-    ok = out.write_image(rows)
-    out.close()
-    if not ok:
-        raise TesseraError(f"Writing {path} failed: {oiio.geterror()}")
+    stem, ext = os.path.splitext(os.path.basename(path))
+    partial = os.path.join(folder, f".{stem}.tessera-partial{ext}")  # same folder: the rename is atomic
+    out = oiio.ImageOutput.create(partial)
+    try:
+        if out is None or not out.open(partial, spec):
+            raise TesseraError(f"Cannot write {path}: {_reason(oiio, out, 'the folder may not be writable')}")
+        ok = out.write_image(rows)
+        closed = out.close()
+        if not ok or closed is False:
+            raise TesseraError(f"Writing {path} failed: {_reason(oiio, out, 'the disk may be full')}")
+        os.replace(partial, path)
+    except OSError as err:
+        raise TesseraError(f"Cannot write {path}: {err.strerror or err}") from err
+    finally:
+        if os.path.exists(partial):
+            os.remove(partial)

@@ -107,8 +107,11 @@ class DabParams:
         return _finite(name, default if value is None else value)
 
     def scaled_strength(self):
-        """strength x pressure (each 1 when not given)."""
-        return float(self.optional("strength", 1.0)) * float(self.optional("pressure", 1.0))
+        """strength x pressure (each 1 when not given); pressure outside [0, 1] is refused."""
+        pressure = float(self.optional("pressure", 1.0))
+        if not 0.0 <= pressure <= 1.0:
+            raise InvalidInputError(f"Pressure must lie in [0, 1]; got {pressure:g}")
+        return float(self.optional("strength", 1.0)) * pressure
 
 
 _PARAM_NAMES = {f.name for f in fields(DabParams)}

@@ -93,26 +93,39 @@ class HeightMap:
         return (self.offset + self.unit * n).astype(np.float32)
 
 
-def check_finite(samples, source=""):
-    """Raise `InvalidInputError` if float samples hold NaN or infinity (scanned in bands)."""
+def check_finite(samples, source="", top_first=True):
+    """Raise `InvalidInputError` if float samples hold NaN or infinity (scanned in bands).
+
+    samples: (H, W), row 0 at the bottom. The message gives the first bad sample's row and column as the source
+    counts them: from the top for files (``top_first``, their order on disk), from the bottom otherwise.
+    """
     if samples.dtype.kind != "f":
         return
-    for y0 in range(0, samples.shape[0], SCAN_ROWS):
+    h = samples.shape[0]
+    for y0 in range(0, h, SCAN_ROWS):
         band = samples[y0:y0 + SCAN_ROWS]
         if not np.isfinite(band).all():
-            bad = np.argwhere(~np.isfinite(band))[0]
+            bad = np.argwhere(~np.isfinite(band))
+            rows = y0 + bad[:, 0]
             where = f" in {source}" if source else ""
-            raise InvalidInputError(f"The height map{where} has NaN or infinity at row {y0 + bad[0]}, column {bad[1]}")
+            if top_first:
+                row = int(h - 1 - rows.max())  # the first bad row in the file's own order
+                col = int(bad[rows == rows.max()][0, 1])
+                raise InvalidInputError(f"The height map{where} has NaN or infinity at row {row} (counted from the "
+                                        f"top, as stored), column {col}")
+            raise InvalidInputError(f"The height map{where} has NaN or infinity at row {int(rows[0])} (counted "
+                                    f"from the bottom), column {int(bad[0, 1])}")
 
 
-def from_array(samples, texel_size=1.0, scale=1.0, offset=0.0, source=""):
-    """A `HeightMap` from an (H, W) or (H, W, C) array (channel 0 is used), checked for NaN."""
+def from_array(samples, texel_size=1.0, scale=1.0, offset=0.0, source="", top_first=False):
+    """A `HeightMap` from an (H, W) or (H, W, C) array (channel 0 is used; row 0 at the bottom), checked for NaN;
+    ``top_first``: the source stores its top row first (a file), for the rows that messages name."""
     a = np.asarray(samples)
     if a.ndim == 3:
         a = a[..., 0]
     if a.dtype.kind == "f" and a.dtype != np.float32:
         a = a.astype(np.float32)
-    check_finite(a, source)
+    check_finite(a, source, top_first)
     return HeightMap(a, float(texel_size), float(scale), float(offset), source)
 
 
@@ -139,7 +152,7 @@ def read_raw(path, width, height, dtype=None, texel_size=1.0, scale=1.0, offset=
         raise InvalidInputError(f"{name} has {actual} bytes; {width}x{height} {dt.name} samples need {expected}{hint}")
     mm = np.memmap(path, dtype=dt, mode="r", shape=(height, width))
     samples = mm if bottom_up else mm[::-1]
-    check_finite(samples, path)
+    check_finite(samples, path, top_first=not bottom_up)
     return HeightMap(samples, float(texel_size), float(scale), float(offset), path)
 
 
@@ -152,7 +165,24 @@ def read_image(path, texel_size=1.0, scale=1.0, offset=0.0):
         return kind
 
     data, _ = read_pixels(path, "height map", pixel_type, n_channels=1)
-    return from_array(np.ascontiguousarray(data[..., 0]), texel_size, scale, offset, path)
+    return from_array(np.ascontiguousarray(data[..., 0]), texel_size, scale, offset, path, top_first=True)
+
+
+def _raw_size_hint(path, dtype=None):
+    """What to tell a user who gave no size for a raw file: the byte count, and what it allows."""
+    name = os.path.basename(path)
+    if not os.path.isfile(path):
+        return f"No such height map file: {path}"
+    dt = np.dtype(dtype) if dtype is not None else RAW_TYPES.get(os.path.splitext(path)[1].lower(), np.dtype("<u2"))
+    size = os.path.getsize(path)
+    if size % dt.itemsize:
+        return (f"{name} is a raw height map of {size} bytes, an odd count: not a whole number of {dt.itemsize}-byte "
+                f"{dt.name} samples (is it truncated, or 8-bit?)")
+    n = size // dt.itemsize
+    side = int(round(n ** 0.5))
+    square = f"; as a square it would be {side}x{side}" if side * side == n else ""
+    return (f"{name} is a raw height map of {n} {dt.name} samples: give its width and height (Raw Width, "
+            f"Raw Height){square}")
 
 
 def read_heightmap(path, texel_size=1.0, scale=1.0, offset=0.0, raw_size=None, raw_dtype=None, raw_bottom_up=False):
@@ -160,7 +190,7 @@ def read_heightmap(path, texel_size=1.0, scale=1.0, offset=0.0, raw_size=None, r
     ext = os.path.splitext(path)[1].lower()
     if ext in RAW_TYPES or raw_dtype is not None:
         if raw_size is None:
-            raise InvalidInputError(f"{os.path.basename(path)} is a raw height map: give its width and height")
+            raise InvalidInputError(_raw_size_hint(path, raw_dtype))
         return read_raw(path, raw_size[0], raw_size[1], raw_dtype, texel_size, scale, offset, raw_bottom_up)
     if ext in IMAGE_EXTENSIONS:
         return read_image(path, texel_size, scale, offset)

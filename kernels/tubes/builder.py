@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..common.errors import InvalidInputError
+from ..common.errors import EmptyResultError, InvalidInputError
 from .caps import CapEnds, cap_pieces, cap_sizes
 from .curve_refine import catmull_rom, select_points
 from .frames import rotation_minimizing_frames, rotation_minimizing_frames_opencl
@@ -57,7 +57,8 @@ class TubeSettings:
         if not 3 <= self.sides <= 1024 or not 3 <= self.min_sides <= self.max_sides <= 1024:
             raise InvalidInputError("Tubes need 3 to 1024 sides, with min_sides <= max_sides")
         if (self.sides_mode == "CAMERA" or self.aa_clamp) and camera is None:
-            raise InvalidInputError("Level of detail from the camera and the anti-aliasing clamp need a camera")
+            raise InvalidInputError("Camera sides and the pixel clamp need a camera: set a scene camera, use the "
+                                    "viewport camera, or choose Fixed sides without the clamp")
         if self.edge_pixels <= 0:
             raise InvalidInputError("Edge length in pixels must be positive")
 
@@ -212,11 +213,15 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     Layout: tubes sorted by side count (stable, so FIXED keeps the curve order), bodies first, then caps.
     Output arrays are allocated once at their final size and written in chunks of curves, so memory stays
     close to the output itself. ``backend``: "auto" (OpenCL when a device with doubles exists, else numpy),
-    "numpy" or "opencl" (the same numbering; values equal within float32 rounding).
+    "numpy" or "opencl" (the same numbering; values equal within float32 rounding). Raises `EmptyResultError`
+    when no curve has two distinct points (nothing has a length to put a tube around).
     """
     settings.validate(camera)
     runtime = runtime_for(backend)
     lines = prepare_lines(lines, settings)
+    if lines.n_curves == 0 or len(lines.points) == 0:
+        raise EmptyResultError("These curves have no length: every curve has fewer than two distinct points, "
+                               "so there is no tube to build")
     report = progress or (lambda f: None)
     frames = _frames(lines, settings, camera, runtime)
     report(0.3)

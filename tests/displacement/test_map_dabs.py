@@ -167,3 +167,13 @@ def test_a_dab_that_would_overflow_is_refused_with_the_map_unchanged(kind, param
     with pytest.raises(InvalidInputError, match="NaN or infinite"):
         apply_dab(m, kind, backend="numpy", **params)
     assert m.tobytes() == before.tobytes()
+
+
+def test_pressure_outside_the_unit_range_is_refused():
+    m = zero_map()
+    for pressure in (5.0, -0.5):
+        with pytest.raises(InvalidInputError, match=r"Pressure must lie in \[0, 1\]"):
+            apply_dab(m, "DRAW", backend="numpy", pos=(20, 20), radius=5, strength=1.0, pressure=pressure)
+    assert not m.any()
+    apply_dab(m, "DRAW", backend="numpy", pos=(20, 20), radius=5, strength=1.0, pressure=0.5)
+    assert m.any()

@@ -55,3 +55,28 @@ def test_bad_files_and_values_are_refused(tmp_path):
         read_map(str(tmp_path / "nan.exr"))
     with pytest.raises(InvalidInputError):
         write_map(str(tmp_path / "m.jpg"), np.zeros((4, 4, 1), np.float32))
+
+
+def test_writes_are_whole_or_absent(tmp_path, monkeypatch):
+    """A missing folder is named; a write that fails at the last step leaves the old file as it was and no
+    partial file behind (writes go to a temporary file that replaces the target only when complete)."""
+    from tessera.kernels.common import image_io
+
+    m = np.random.default_rng(1).random((16, 20, 1)).astype(np.float32)
+    missing = tmp_path / "no" / "such" / "map.exr"
+    with pytest.raises(TesseraError, match="folder .* does not exist"):
+        write_map(str(missing), m)
+    target = tmp_path / "map.exr"
+    write_map(str(target), m)
+    before = target.read_bytes()
+
+    def disk_full(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(image_io.os, "replace", disk_full)
+    with pytest.raises(TesseraError, match="No space left on device"):
+        write_map(str(target), m * 2)
+    monkeypatch.undo()
+    assert target.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.exr"]  # no partial file left behind
+    assert np.array_equal(read_map(str(target)), m)

@@ -167,3 +167,30 @@ def test_opencl_ham_and_tile_table_equal_numpy(opencl):
     assert np.allclose(a.ham_max, b.ham_max, rtol=4 * FLOAT32_PATH_RTOL, atol=0)
     for key in ("h_min", "h_max", "peak_x", "peak_y"):
         assert np.array_equal(getattr(a, key), getattr(b, key)), key
+
+
+def test_messages_name_rows_as_the_file_stores_them_and_raw_byte_counts(tmp_path):
+    """NaN is reported at the file's own row (top first); a raw file without a size is told its byte count, and
+    that an odd count is not whole samples; a truncated image says why."""
+    data = np.zeros((64, 8), "<f4")  # bottom-up rows, as the kernels keep them
+    data[53, 2] = np.nan  # file row 64 - 1 - 53 = 10
+    path = tmp_path / "h.r32"
+    data[::-1].tofile(path)
+    with pytest.raises(InvalidInputError, match=r"row 10 \(counted from the top, as stored\), column 2"):
+        hio.read_heightmap(str(path), raw_size=(8, 64))
+    odd = tmp_path / "odd.r16"
+    odd.write_bytes(b"\0" * 1001)
+    with pytest.raises(InvalidInputError, match="1001 bytes, an odd count"):
+        hio.read_heightmap(str(odd))
+    square = tmp_path / "sq.r16"
+    np.zeros((16, 16), "<u2").tofile(square)
+    with pytest.raises(InvalidInputError, match="256 uint16 samples.*16x16"):
+        hio.read_heightmap(str(square))
+    good = tmp_path / "t.png"
+    _write(str(good), np.arange(64 * 64, dtype=np.uint16).reshape(64, 64), "uint16")
+    truncated = tmp_path / "trunc.png"
+    truncated.write_bytes(good.read_bytes()[:200])
+    with pytest.raises(TesseraError) as err:
+        hio.read_heightmap(str(truncated))
+    reason = str(err.value).split(str(truncated), 1)[1]
+    assert len(reason.strip(" :")) > 5, str(err.value)  # a reason, not an empty string after the colon

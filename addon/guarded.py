@@ -1,0 +1,104 @@
+"""The one guarded path every operator's ``execute`` runs through.
+
+`guarded` wraps ``execute(self, context, tx)``: the operator makes its new data blocks through the
+`Transaction` ``tx`` (or registers them with `Transaction.track`) and registers an undo for any change it makes
+to existing data (`Transaction.on_rollback`). When everything succeeded the result stands. On any failure every
+new block is removed and every registered undo runs, in reverse order, and the failure becomes a report:
+
+- a `TesseraError` (including `EmptyResultError`): its text, which says what to change;
+- anything else: "Tessera failed: <what> — nothing was changed", with the traceback printed to the console.
+
+Either way the operator returns ``{'CANCELLED'}``: no traceback escapes to the user and nothing is half-done.
+"""
+
+import functools
+import traceback
+
+import bpy
+
+from ..kernels.common.errors import TesseraError
+
+#: ID type -> its collection in bpy.data, for removal on rollback.
+_COLLECTIONS = (
+    (bpy.types.Object, "objects"), (bpy.types.Mesh, "meshes"), (bpy.types.Image, "images"),
+    (bpy.types.Material, "materials"), (bpy.types.NodeTree, "node_groups"), (bpy.types.Curve, "curves"),
+)
+
+
+class Transaction:
+    """New data blocks and undo steps of one operator run (see the module docstring)."""
+
+    def __init__(self):
+        self._blocks = []
+        self._undo = []
+
+    def track(self, block):
+        """Remove ``block`` (a new ID) if the run fails; returns it."""
+        self._blocks.append(block)
+        return block
+
+    def new_mesh(self, name):
+        return self.track(bpy.data.meshes.new(name))
+
+    def new_object(self, name, data):
+        return self.track(bpy.data.objects.new(name, data))
+
+    def on_rollback(self, undo):
+        """Call ``undo()`` if the run fails (after the new blocks are gone, last registered first)."""
+        self._undo.append(undo)
+
+    def rollback(self):
+        """Remove every tracked block that still exists and run the undo steps. Errors here are printed, not
+        raised: the operator is already reporting the failure that caused the rollback."""
+        for block in reversed(self._blocks):
+            try:
+                _remove(block)
+            except (ReferenceError, RuntimeError) as err:  # already removed, or Blender refused
+                print(f"Tessera: could not remove {block!r} after a failure: {err}")
+        for undo in reversed(self._undo):
+            try:
+                undo()
+            except Exception:  # noqa: BLE001 - every undo must get its chance
+                traceback.print_exc()
+        self._blocks.clear()
+        self._undo.clear()
+
+
+def _remove(block):
+    for id_type, name in _COLLECTIONS:
+        if isinstance(block, id_type):
+            collection = getattr(bpy.data, name)
+            if block.name in collection and collection[block.name] == block:
+                collection.remove(block)
+            return
+    raise RuntimeError(f"no collection for {type(block).__name__}")
+
+
+def failure_message(err):
+    """What the user reads for an unexpected exception."""
+    what = str(err) or type(err).__name__
+    return f"Tessera failed: {what} — nothing was changed (details in the system console)"
+
+
+def guarded(execute):
+    """Decorate ``execute(self, context, tx)`` into Blender's ``execute(self, context)`` (see the module)."""
+
+    @functools.wraps(execute)
+    def wrapper(self, context):
+        tx = Transaction()
+        try:
+            result = execute(self, context, tx)
+        except TesseraError as err:
+            tx.rollback()
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        except Exception as err:  # noqa: BLE001 - the guard: no traceback may escape to the user
+            traceback.print_exc()
+            tx.rollback()
+            self.report({"ERROR"}, failure_message(err))
+            return {"CANCELLED"}
+        if "CANCELLED" in result:
+            tx.rollback()
+        return result
+
+    return wrapper
