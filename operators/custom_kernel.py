@@ -13,6 +13,7 @@ import hashlib
 import bpy
 
 from ..addon.displacement.maps import channels_for, commit, map_state
+from ..addon.guarded import guarded
 from ..kernels.common.errors import TesseraError
 from ..kernels.common.opencl_runtime import get_runtime
 from ..kernels.displacement.map_edit import apply_custom, compile_custom
@@ -54,7 +55,8 @@ class TESSERA_OT_displacement_trust_kernel(bpy.types.Operator):
         return context.window_manager.invoke_confirm(self, event, message="Run OpenCL code from this file? "
                                                      "Only trust code you have read.")
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         _trusted_sources.add(_digest(_source(context)))
         self.report({"INFO"}, "Custom kernel trusted for this session")
         return {"FINISHED"}
@@ -74,29 +76,24 @@ class TESSERA_OT_displacement_custom(bpy.types.Operator):
             return False
         return True
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         ob = context.active_object
         settings = ob.tessera.displacement
         source = _source(context)
         if not is_trusted(context, source):
-            self.report({"ERROR"}, "This file's scripts are not trusted: enable Auto Run Python Scripts (or reload "
-                        "the file as trusted), or use Trust Custom Kernel after reading the code")
-            return {"CANCELLED"}
+            raise TesseraError("This file's scripts are not trusted: enable Auto Run Python Scripts (or reload "
+                               "the file as trusted), or use Trust Custom Kernel after reading the code")
         runtime = get_runtime()
         if runtime is None:
-            self.report({"ERROR"}, "Custom kernels need OpenCL, and no OpenCL device is available")
-            return {"CANCELLED"}
-        try:
-            kernel = compile_custom(runtime, source)
-            state = map_state(settings.image, channels_for(settings))
-            args = [tuple(settings.kernel_args[4 * i:4 * i + 4]) for i in range(4)]
-            h, w = state.host.shape[:2]
-            undo = TileUndo(state.host)
-            undo.record(state.host, (0, 0, w, h))
-            apply_custom(state.host, kernel, runtime, args=args, device=state.device)
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+            raise TesseraError("Custom kernels need OpenCL, and no OpenCL device is available")
+        kernel = compile_custom(runtime, source)
+        state = map_state(settings.image, channels_for(settings))
+        args = [tuple(settings.kernel_args[4 * i:4 * i + 4]) for i in range(4)]
+        h, w = state.host.shape[:2]
+        undo = TileUndo(state.host)
+        undo.record(state.host, (0, 0, w, h))
+        apply_custom(state.host, kernel, runtime, args=args, device=state.device)  # refuses non-finite output
         commit(state, settings.image, undo)
         return {"FINISHED"}
 

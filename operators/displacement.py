@@ -17,7 +17,11 @@ from ..addon.displacement import nodes as displace_nodes
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS
-from ..kernels.common.errors import TesseraError
+from ..addon.guarded import guarded
+from ..addon.preferences import get_preferences
+from ..kernels.common.errors import InvalidInputError, TesseraError
+from ..kernels.common.image_io import image_size
+from ..kernels.displacement.map_edit import check_map_budget
 from ..kernels.displacement.map_io import read_map, write_map
 from ..kernels.displacement.map_strokes import Brush
 
@@ -82,22 +86,31 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
             return False
         return True
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         ob = context.active_object
         channels = 1 if self.mode == "HEIGHT" else 3
         if self.mode == "VECTOR" and self.space == "TANGENT" and not displace_nodes.available():
-            self.report({"ERROR"}, "Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)")
-            return {"CANCELLED"}
+            raise InvalidInputError("Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)")
+        budget = get_preferences(context).memory_budget_bytes
         data = None
-        try:
-            if self.filepath:
-                data = read_map(bpy.path.abspath(self.filepath), channels=channels, low=self.low, high=self.high)
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+        if self.filepath:
+            path = bpy.path.abspath(self.filepath)
+            w, h, _ = image_size(path, "map")
+            check_map_budget(w, h, channels, budget)
+            data = read_map(path, channels=channels, low=self.low, high=self.high)
         h, w = data.shape[:2] if data is not None else (self.height, self.width)
-        image = new_map_image(f"{ob.name} Displacement", w, h, data)
+        check_map_budget(w, h, channels, budget)
+        image = tx.track(new_map_image(f"{ob.name} Displacement", w, h, data))
         settings = ob.tessera.displacement
+        previous = {name: getattr(settings, name) for name in ("mode", "space", "uv_map", "image")}
+
+        def restore():
+            for name, value in previous.items():
+                setattr(settings, name, value)
+            sync_modifier(ob)
+
+        tx.on_rollback(restore)
         settings.mode, settings.space = self.mode, self.space
         settings.uv_map = ob.data.uv_layers.active.name
         settings.image = image  # creates the modifier through the update callback
@@ -126,14 +139,11 @@ class TESSERA_OT_displacement_export(bpy.types.Operator):
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
 
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         settings = context.active_object.tessera.displacement
-        try:
-            state = map_state(settings.image, channels_for(settings))
-            clipped = write_map(bpy.path.abspath(self.filepath), state.host, low=self.low, high=self.high)
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+        state = map_state(settings.image, channels_for(settings))
+        clipped = write_map(bpy.path.abspath(self.filepath), state.host, low=self.low, high=self.high)
         if clipped:
             self.report({"WARNING"}, f"{clipped} values lay outside [{self.low:g}, {self.high:g}] and were clipped")
         return {"FINISHED"}
@@ -167,25 +177,22 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         return True
 
     # -- replay -------------------------------------------------------------------------------------------
-    def execute(self, context):
+    @guarded
+    def execute(self, context, tx):
         ob = context.active_object
+        session = _new_session(context)
+        samples = self._replay_samples(context, ob, session.state.host.shape)
+        wm = context.window_manager
+        wm.progress_begin(0, len(samples))
         try:
-            session = _new_session(context)
-            samples = self._replay_samples(context, ob, session.state.host.shape)
-            wm = context.window_manager
-            wm.progress_begin(0, len(samples))
-            try:
-                for i, sample in enumerate(samples):
-                    session.add(*sample)
-                    wm.progress_update(i)
-            except TesseraError:
-                session.cancel()
-                raise
-            finally:
-                wm.progress_end()
-        except TesseraError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
+            for i, sample in enumerate(samples):
+                session.add(*sample)
+                wm.progress_update(i)
+        except Exception:
+            session.cancel()  # every tile the stroke changed goes back (host and device)
+            raise
+        finally:
+            wm.progress_end()
         session.finish()
         return {"FINISHED"}
 

@@ -56,12 +56,12 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
                 def progress(f, i=i):
                     wm.progress_update(int(100 * (i + f) / len(sources)))
 
-                lines, notes = read_lines(ob, self)
                 cam = object_camera(camera, ob.matrix_world) if camera is not None else None
-                self._check_budget(context, lines, settings)
                 try:
+                    lines, notes = read_lines(ob, self)
+                    self._check_budget(context, lines, settings)
                     poly = build_tubes(lines, settings, cam, progress)
-                except EmptyResultError as err:
+                except EmptyResultError as err:  # this source has nothing to build; the others may
                     empty.append(f"{ob.name}: {err}")
                     continue
                 results.append((ob, poly, notes + poly.notes))

@@ -22,6 +22,21 @@ def oiio_module():
     return oiio
 
 
+def image_size(path, what="image"):
+    """``(width, height, channels)`` of an image file, from its header only (nothing is read)."""
+    if not os.path.isfile(path):
+        raise TesseraError(f"No such {what} file: {path}")
+    oiio = oiio_module()
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise TesseraError(f"Cannot read {path}: {_reason(oiio, None, 'not an image file OpenImageIO can read')}")
+    try:
+        spec = inp.spec()
+        return spec.width, spec.height, spec.nchannels
+    finally:
+        inp.close()
+
+
 def read_pixels(path, what, pixel_type, n_channels=None):
     """Pixels of an image file through OpenImageIO: ``(data (H, W, C) with row 0 at the bottom, the file's
     sample format name)``.

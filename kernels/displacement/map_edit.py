@@ -14,13 +14,30 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..common.errors import InvalidInputError, TesseraError
+from ..common.errors import BudgetError, InvalidInputError, TesseraError
 from ..common.opencl_runtime import backend_runtime
 from . import map_dabs as ref
 from .map_buffer import MapBuffer
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
+
+
+#: Memory per texel of a map being edited: Blender's float RGBA image (16 B), the RGBA mirror written to it
+#: (16 B), the pixels read at creation (16 B), plus per channel the host map and its device copy (8 B).
+MAP_BYTES_PER_TEXEL = 48
+MAP_BYTES_PER_CHANNEL = 8
+
+
+def check_map_budget(width, height, channels, budget_bytes):
+    """Raise `BudgetError` when a ``width`` x ``height`` map with ``channels`` would need more than
+    ``budget_bytes`` (0 or None: no limit) while edited."""
+    need = int(width) * int(height) * (MAP_BYTES_PER_TEXEL + MAP_BYTES_PER_CHANNEL * int(channels))
+    if budget_bytes and need > budget_bytes:
+        raise BudgetError(f"A {width} x {height} map needs about {need / 2**20:,.0f} MiB while it is edited, over "
+                          f"the memory budget of {budget_bytes / 2**20:,.0f} MiB. Use a smaller map, or raise the "
+                          "budget in the Tessera preferences.")
+    return need
 
 
 def check_map(dmap):
@@ -250,8 +267,9 @@ def _runtime(backend):
 
 
 def _backend_runtime(backend, device):
-    """The OpenCL runtime to use, or None for numpy; a device-resident map always runs on its device."""
-    return _runtime("opencl") if device is not None else _runtime(backend)
+    """The OpenCL runtime to use, or None for numpy; a device-resident map always runs on its device, with the
+    runtime (context, queue, programs) its buffer was made in, whatever the current runtime is."""
+    return device.runtime if device is not None else _runtime(backend)
 
 
 def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=None, **params):
