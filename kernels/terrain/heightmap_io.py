@@ -22,6 +22,9 @@ from ..common.errors import InvalidInputError, TesseraError
 from ..common.image_io import read_pixels
 
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
+#: Largest texel size, height scale or offset accepted: beyond it float32 positions carry no precision (and
+#: 3e38 overflows to infinity as soon as a sample is multiplied by it).
+MAX_WORLD_VALUE = 1e15
 RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
 _NORMALISE = {np.dtype(np.uint8): 1.0 / 255.0, np.dtype(np.uint16): 1.0 / 65535.0}
 #: Rows per band when a large map is scanned (NaN check, statistics): about 64 MiB of float32 at 16384 wide.
@@ -48,9 +51,11 @@ class HeightMap:
             raise InvalidInputError("Height samples must be a 2-D uint8, uint16 or float32 array")
         if min(s.shape) < 2:
             raise InvalidInputError(f"A height map needs at least 2x2 samples; got {s.shape[1]}x{s.shape[0]}")
-        for name in ("texel_size", "scale", "offset"):
-            if not np.isfinite(getattr(self, name)):
-                raise InvalidInputError(f"The height map's {name} must be a finite number")
+        for name, label in (("texel_size", "Texel Size"), ("scale", "Height Scale"), ("offset", "Height Offset")):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and abs(value) <= MAX_WORLD_VALUE):
+                raise InvalidInputError(f"{label} must be a finite number between {-MAX_WORLD_VALUE:g} and "
+                                        f"{MAX_WORLD_VALUE:g}; got {value!r}")
         if not self.texel_size > 0:
             raise InvalidInputError(f"The texel size must be positive; got {self.texel_size!r}")
 

@@ -194,3 +194,13 @@ def test_messages_name_rows_as_the_file_stores_them_and_raw_byte_counts(tmp_path
         hio.read_heightmap(str(truncated))
     reason = str(err.value).split(str(truncated), 1)[1]
     assert len(reason.strip(" :")) > 5, str(err.value)  # a reason, not an empty string after the colon
+
+
+@pytest.mark.parametrize("name, label", [("scale", "Height Scale"), ("offset", "Height Offset"),
+                                         ("texel_size", "Texel Size")])
+def test_absurd_scales_are_refused_with_the_setting_and_its_range(name, label):
+    for value in (3e38, -3e38, float("inf"), float("nan")):
+        with pytest.raises(InvalidInputError, match=f"{label} must be a finite number between -1e\\+15 and 1e\\+15"):
+            hio.from_array(np.zeros((4, 4), np.float32), **{name: value})
+    hm = hio.from_array(np.ones((4, 4), np.float32), **{name: 1e15 if name != "offset" else -1e15})
+    assert np.isfinite(hm.heights()).all()
