@@ -22,14 +22,20 @@ def oiio_module():
     return oiio
 
 
-def image_size(path, what="image"):
-    """``(width, height, channels)`` of an image file, from its header only (nothing is read)."""
+def _open(path, what):
+    """``(oiio module, ImageInput)`` for ``path``, or a `TesseraError` saying why it cannot be opened."""
     if not os.path.isfile(path):
         raise TesseraError(f"No such {what} file: {path}")
     oiio = oiio_module()
     inp = oiio.ImageInput.open(path)
     if inp is None:
         raise TesseraError(f"Cannot read {path}: {_reason(oiio, None, 'not an image file OpenImageIO can read')}")
+    return oiio, inp
+
+
+def image_size(path, what="image"):
+    """``(width, height, channels)`` of an image file, from its header only (nothing is read)."""
+    _, inp = _open(path, what)
     try:
         spec = inp.spec()
         return spec.width, spec.height, spec.nchannels
@@ -44,12 +50,7 @@ def read_pixels(path, what, pixel_type, n_channels=None):
     what: the kind of file, for messages; pixel_type(format) -> the type to read as ("float", "uint16",
     "uint8"), raising for formats the caller refuses; n_channels: read only the first ones (None: all).
     """
-    if not os.path.isfile(path):
-        raise TesseraError(f"No such {what} file: {path}")
-    oiio = oiio_module()
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        raise TesseraError(f"Cannot read {path}: {_reason(oiio, None, 'not an image file OpenImageIO can read')}")
+    oiio, inp = _open(path, what)
     try:
         spec = inp.spec()
         fmt = str(spec.format)
