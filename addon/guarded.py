@@ -3,7 +3,8 @@
 `guarded` wraps ``execute(self, context, tx)``: the operator makes its new data blocks through the
 `Transaction` ``tx`` (or registers them with `Transaction.track`) and registers an undo for any change it makes
 to existing data (`Transaction.on_rollback`). When everything succeeded the result stands. On any failure every
-new block is removed and every registered undo runs, in reverse order, and the failure becomes a report:
+registered undo runs (last first, while the new blocks still exist, so an undo may read them), then every new
+block is removed, and the failure becomes a report:
 
 - a `TesseraError` (including `EmptyResultError`): its text, which says what to change;
 - anything else: "Tessera failed: <what> — nothing was changed", with the traceback printed to the console.
@@ -44,32 +45,33 @@ class Transaction:
         return self.track(bpy.data.objects.new(name, data))
 
     def on_rollback(self, undo):
-        """Call ``undo()`` if the run fails (after the new blocks are gone, last registered first)."""
+        """Call ``undo()`` if the run fails (before the new blocks are removed, last registered first)."""
         self._undo.append(undo)
 
     def rollback(self):
-        """Remove every tracked block that still exists and run the undo steps. Errors here are printed, not
+        """Run the undo steps, then remove every tracked block that still exists. Errors here are printed, not
         raised: the operator is already reporting the failure that caused the rollback."""
-        for block in reversed(self._blocks):
-            try:
-                _remove(block)
-            except (ReferenceError, RuntimeError) as err:  # already removed, or Blender refused
-                print(f"Tessera: could not remove {block!r} after a failure: {err}")
         for undo in reversed(self._undo):
             try:
                 undo()
             except Exception:  # noqa: BLE001 - every undo must get its chance
                 traceback.print_exc()
+        for block in reversed(self._blocks):
+            try:
+                _remove(block)
+            except ReferenceError:  # removed already (a writer replaced it): nothing left to do
+                pass
+            except RuntimeError as err:
+                print(f"Tessera: could not remove {block!r} after a failure: {err}")
         self._blocks.clear()
         self._undo.clear()
 
 
 def _remove(block):
+    """Remove a new ID from its bpy.data collection (a ReferenceError when something removed it already)."""
     for id_type, name in _COLLECTIONS:
         if isinstance(block, id_type):
-            collection = getattr(bpy.data, name)
-            if block.name in collection and collection[block.name] == block:
-                collection.remove(block)
+            getattr(bpy.data, name).remove(block)
             return
     raise RuntimeError(f"no collection for {type(block).__name__}")
 

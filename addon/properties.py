@@ -11,31 +11,27 @@ roots, then the pointers, so the order is written here and nowhere else.
 import bpy
 
 from .displacement import settings as displacement_settings
-from .displacement.settings import TESSERA_PG_brush, TESSERA_PG_displacement, TESSERA_PG_image
 from .terrain import settings as terrain_settings
-from .terrain.settings import TESSERA_PG_terrain
 from .tessellation import settings as tessellation_settings
-from .tessellation.settings import TESSERA_PG_tessellate
 from .tubes import settings as tube_settings
-from .tubes.settings import TESSERA_PG_tubes
 
 _SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings)
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
-    tessellate: bpy.props.PointerProperty(type=TESSERA_PG_tessellate)
-    tubes: bpy.props.PointerProperty(type=TESSERA_PG_tubes)
-    displacement: bpy.props.PointerProperty(type=TESSERA_PG_displacement)
-    terrain: bpy.props.PointerProperty(type=TESSERA_PG_terrain)
+    tessellate: bpy.props.PointerProperty(type=tessellation_settings.TESSERA_PG_tessellate)
+    tubes: bpy.props.PointerProperty(type=tube_settings.TESSERA_PG_tubes)
+    displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement)
+    terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):
-    brush: bpy.props.PointerProperty(type=TESSERA_PG_brush)
+    brush: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_brush)
 
 
 classes = (TESSERA_PG_object, TESSERA_PG_scene)
 _ROOTS = ((bpy.types.Object, TESSERA_PG_object), (bpy.types.Scene, TESSERA_PG_scene),
-          (bpy.types.Image, TESSERA_PG_image))
+          (bpy.types.Image, displacement_settings.TESSERA_PG_image))
 
 
 def register():

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import bpy
 
 from ..gpu_shaders import loader
+from ..kernels.common.errors import TesseraError
 
 _previews = []  # every registered Preview
 _subscribers = {}  # topic -> [callback(owner)]
@@ -112,8 +113,15 @@ class PreviewCache:
 
     def forget(self, ob):
         """Drop ``ob``'s entry and error (it is rebuilt on the next draw)."""
-        self.entries.pop(ob.session_uid, None)
+        self._drop(ob.session_uid)
+
+    def forget_error(self, ob):
+        """Let a failed ``ob`` be tried again on the next draw (its settings changed)."""
         self.errors.pop(ob.session_uid, None)
+
+    def _drop(self, uid):
+        self.entries.pop(uid, None)
+        self.errors.pop(uid, None)
 
     def clear(self):
         self.entries.clear()
@@ -127,13 +135,10 @@ class PreviewCache:
             block = update.id.original if hasattr(update.id, "original") else update.id
             if isinstance(block, bpy.types.Object) and block.session_uid in self.entries:
                 if update.is_updated_geometry:
-                    self.entries.pop(block.session_uid, None)
-                    self.errors.pop(block.session_uid, None)
+                    self._drop(block.session_uid)
             elif isinstance(block, data_types):
-                stale = [uid for uid, entry in self.entries.items() if entry.data_uid == block.session_uid]
-                for uid in stale:
-                    self.entries.pop(uid, None)
-                    self.errors.pop(uid, None)
+                for uid in [uid for uid, entry in self.entries.items() if entry.data_uid == block.session_uid]:
+                    self._drop(uid)
 
 
 # --- previews ------------------------------------------------------------------------------------------------
@@ -188,8 +193,6 @@ class Preview:
     def entry(self, ob, build):
         """``ob``'s entry, built by ``build()`` (a `PreviewEntry`) on first use; None when building raised a
         `TesseraError` (remembered until ``ob`` or its settings change)."""
-        from ..kernels.common.errors import TesseraError
-
         entry = self.cache.get(ob)
         if entry is None and not self.cache.failed(ob):
             try:

@@ -96,11 +96,13 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
         data = None
         if self.filepath:
             path = bpy.path.abspath(self.filepath)
-            w, h, _ = image_size(path, "map")
+            w, h, _ = image_size(path, "map")  # the header: checked before anything is read
             check_map_budget(w, h, channels, budget)
             data = read_map(path, channels=channels, low=self.low, high=self.high)
-        h, w = data.shape[:2] if data is not None else (self.height, self.width)
-        check_map_budget(w, h, channels, budget)
+            h, w = data.shape[:2]
+        else:
+            w, h = self.width, self.height
+            check_map_budget(w, h, channels, budget)
         image = tx.track(new_map_image(f"{ob.name} Displacement", w, h, data))
         settings = ob.tessera.displacement
         previous = {name: getattr(settings, name) for name in ("mode", "space", "uv_map", "image")}

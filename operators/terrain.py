@@ -37,7 +37,7 @@ def _bake_into(context, ob, camera, report, tx):
     sel = select(hm, table, object_camera(camera, ob.matrix_world) if camera else None, lod_settings(s))
     t_select = time.perf_counter() - t0
     n_tris = triangle_count(sel)
-    if n_tris == 0 and sel.culled.all():
+    if n_tris == 0:  # every tile culled
         clip = f" (its clip end is {camera.clip_end:g})" if camera is not None else ""
         raise EmptyResultError(
             f"The camera sees no tile of this terrain{clip}: move or aim the camera at it, raise the camera's clip "

@@ -68,8 +68,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
         finally:
             wm.progress_end()
         if not results:
-            raise EmptyResultError("; ".join(empty) if len(empty) == 1 else
-                                   f"No tubes from {len(empty)} sources. {empty[0]}")
+            raise EmptyResultError(empty[0] if len(empty) == 1 else f"No tubes from {len(empty)} sources. {empty[0]}")
         made = [self._place(tx, ob, poly) for ob, poly, _ in results]  # every source built before any is placed
         for ob, _, notes in results:
             copy_tube_settings(self, ob.tessera.tubes)  # a batch script can re-run them

@@ -23,7 +23,7 @@ def settings_changed(ob):
     entry = PREVIEW.cache.get(ob)
     if entry is not None and entry.source == source_key(ob.tessera.terrain):
         entry.view = None
-        PREVIEW.cache.errors.pop(ob.session_uid, None)
+        PREVIEW.cache.forget_error(ob)
     else:
         PREVIEW.cache.forget(ob)
 

@@ -122,7 +122,7 @@ def _draw(context, region, view, proj):
 def _settings_changed(ob):
     """Uploads are keyed on the settings they depend on (`entry_for`); a change only lets a failed object retry."""
     if isinstance(ob, bpy.types.Object):
-        PREVIEW.cache.errors.pop(ob.session_uid, None)
+        PREVIEW.cache.forget_error(ob)
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, on_settings=_settings_changed)

@@ -64,7 +64,7 @@ class Camera:
         """Distance to the far clipping plane, from the projection (OpenGL convention): float."""
         p = np.asarray(self.projection, np.float64)
         if self.orthographic:
-            return float((p[2, 3] - 1.0) / -p[2, 2])
+            return float((p[2, 3] - 1.0) / p[2, 2])
         return float(p[2, 3] / (p[2, 2] + 1.0))
 
     @property

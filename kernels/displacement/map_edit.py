@@ -109,10 +109,6 @@ class DabParams:
                                     f"{', '.join(sorted(_PARAM_NAMES))}")
         return cls(**params)
 
-    def given(self):
-        """The parameters that were given, as keywords."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
-
     def required(self, kind, name):
         value = getattr(self, name)
         if value is None:

@@ -31,9 +31,6 @@ import numpy as np
 from ..common.topology import triangle_edges, validate_triangles
 from . import refine_templates
 from .refine_general import face_levels, interior_counts, refine_general
-from .refinement import Refinement
-
-__all__ = ["Refinement", "refine", "refinement_counts", "single_triangle_levels", "triangle_count"]
 
 
 def refinement_counts(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL"):
