@@ -11,7 +11,8 @@ Per tile, from the `terrain_analysis.TileTable`:
 - the distance law (5-5..5-7): ``T = T_max`` below ``d_max``, ``T_max·d_max²/d²`` up to
   ``d_min = d_max·sqrt(T_max/T_min)``, ``T_min`` beyond; i.e. ``clamp(T_max·d_max²/d², T_min, T_max)``.
 
-Levels never exceed the tile size in texels (a quad always covers at least a texel, seed §5.4.2).
+Levels never exceed the tile size in texels (a quad always covers at least a texel, seed §5.4.2), nor, per
+side, that side's length in texels (the last, partial tiles; a map smaller than one tile).
 Edge levels use the edge's midpoint (on the terrain surface) and ``max`` of the two tiles' T_max and T_min;
 every input is the same for both tiles, and only +, -, ×, / and sqrt touch it, so both tiles compute the
 same level bit for bit. The inner level uses the tile centre and the tile's own bounds. Tiles whose bounding
@@ -238,6 +239,15 @@ def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
     return np.clip(t, 1.0, t_max)
 
 
+def box_distance(hm, table, camera):
+    """Distance from ``camera``'s eye to the terrain's bounding box (terrain-local units): float, 0 inside."""
+    half = np.array([(hm.width - 1) * 0.5, (hm.height - 1) * 0.5]) * hm.texel_size
+    lo = np.array([-half[0], -half[1], float(table.h_min.min())])
+    hi = np.array([half[0], half[1], float(table.h_max.max())])
+    eye = camera.eye
+    return float(np.linalg.norm(eye - np.clip(eye, lo, hi)))
+
+
 def _culled(hm, table, camera, xs, ys):
     """Tiles whose bounding box lies outside one frustum plane: (nty, ntx) bool.
 
@@ -267,6 +277,14 @@ def _round(levels, settings):
         m, e = np.frexp(f)  # f = m·2^e, m in [0.5, 1): the next power of two is 2^e, or f itself when m = 0.5
         return np.minimum(np.ldexp(1.0, e - (m == 0.5)), settings.max_level)
     return f
+
+
+def _cap(texels, spacing):
+    """The highest level whose segment count fits ``texels`` (...) float64: the length itself, or its even
+    floor for FRACTIONAL_EVEN (at least 2, that spacing's fewest segments)."""
+    if spacing == "FRACTIONAL_EVEN":
+        return np.maximum(2.0 * np.floor(texels / 2.0), 2.0)
+    return np.maximum(texels, 1.0)
 
 
 def _neighbour(a, side, fill):
@@ -330,7 +348,11 @@ def select(hm, table, camera, settings=TerrainLod()):
         culled = _culled(hm, table, camera, xs, ys)
     else:
         culled = np.zeros((nty, ntx), bool)
-    rounded = _round(edge, settings)
+    # a side's level at most its length in texels, the inner level at most the shorter side: the tiles of a
+    # map smaller than one tile (or the last, partial row and column) never outgrow their full grid
+    wx, wy = x1 - x0, y1 - y0
+    rounded = np.minimum(_round(edge, settings), _cap(np.stack([wx, wy, wx, wy], -1), settings.spacing))
+    inner = np.minimum(_round(inner, settings), _cap(np.minimum(wx, wy), settings.spacing))
     h_edges = np.concatenate([rounded[:, :, 0], rounded[-1:, :, 2]], axis=0)
     v_edges = np.concatenate([rounded[:, :, 3], rounded[:, -1:, 1]], axis=1)
-    return Selection(t_max, t_min, edge, _round(inner, settings), culled, h_edges, v_edges, settings.spacing)
+    return Selection(t_max, t_min, edge, inner, culled, h_edges, v_edges, settings.spacing)

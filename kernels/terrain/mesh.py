@@ -3,8 +3,12 @@
 Each tile is a quad domain with four edge segment counts and one inner count (from `partition`). Its pattern:
 an inner grid of ``n - 1`` × ``n - 1`` points, each cell split along its (i, j)-(i+1, j+1) diagonal, and
 four strips that zip the edge points to the grid's outer ring (a monotone merge of two parallel rows of
-points). A tile whose edges all have one segment and whose inner count is 1 is two triangles; otherwise the
-inner count is at least 2, so a ring exists.
+points). A tile whose inner count is 1 and whose two opposite sides have one segment each (every tile one texel
+thick, since levels never exceed a side's length in texels) is one strip zipping its two other sides (two
+triangles when all four sides have one segment); otherwise the inner count is at least 2, so a ring exists.
+With `terrain_lod.select`'s caps (a side's level at most its length in texels, the inner level at most the
+shorter side) a tile never has more triangles than its full grid (EQUAL spacing; FRACTIONAL_EVEN needs two
+segments on a side one texel long).
 
 Vertices are welded by construction: a tile corner is one vertex for four tiles, an edge point one vertex
 for its two tiles (edges run +x or +y, so both tiles read the same points), inner points belong to their
@@ -59,6 +63,10 @@ def pattern(c0, c1, c2, c3, n):
         return np.array([(0, 1, 2), (0, 2, 3)], np.int32)
     starts = np.cumsum((4,) + tuple(c - 1 for c in counts))
     side = [list(range(starts[s], starts[s] + counts[s] - 1)) for s in range(4)]
+    if n == 1:  # a strip: zip the two long sides, both in +x (+y) order, counter-clockwise seen from +z
+        if c1 == c3 == 1:
+            return np.array(_zip([0] + side[0] + [1], [3] + side[2] + [2]), np.int32)
+        return np.array(_zip([1] + side[1] + [2], [0] + side[3] + [3]), np.int32)
     rows = [[0] + side[0] + [1], [1] + side[1] + [2], [2] + side[2][::-1] + [3], [3] + side[3][::-1] + [0]]
     m = n - 1
     grid = starts[4] + np.arange(m * m).reshape(m, m)  # grid[j - 1, i - 1]
@@ -78,14 +86,15 @@ def _tile_counts(selection):
     hc, vc = segment_counts(selection.h_edges, sp), segment_counts(selection.v_edges, sp)
     ec = np.stack([hc[:-1], vc[:, 1:], hc[1:], vc[:, :-1]], -1)  # per tile: BOTTOM, RIGHT, TOP, LEFT
     n = selection.inner_counts.astype(np.int64)
-    return ec, np.where((n == 1) & (ec.max(-1) > 1), 2, n)
+    strip = ((ec[..., 1] == 1) & (ec[..., 3] == 1)) | ((ec[..., 0] == 1) & (ec[..., 2] == 1))
+    return ec, np.where((n == 1) & ~strip, 2, n)
 
 
 def triangle_count(selection):
     """Triangles `bake` will make, without making them (for memory guards and benchmarks): int."""
     ec, n = _tile_counts(selection)
     m = n - 1
-    per_tile = np.where(m == 0, 2, ec.sum(-1) + 4 * (m - 1) + 2 * (m - 1) ** 2)
+    per_tile = np.where(m == 0, ec.sum(-1) - 2, ec.sum(-1) + 4 * (m - 1) + 2 * (m - 1) ** 2)
     return int(per_tile[~selection.culled].sum())
 
 
@@ -98,7 +107,7 @@ def pattern_codes(c0, c1, c2, c3, n):
     rows = [(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)]
     for s, c in enumerate((c0, c1, c2, c3)):
         rows += [(s + 1, k, 0) for k in range(1, c)]
-    if not (n == 1 and max(c0, c1, c2, c3) == 1):
+    if n > 1:
         rows += [(5, i, j) for j in range(1, n) for i in range(1, n)]
     return np.array(rows, np.float32)
 
@@ -165,7 +174,7 @@ def bake(hm, table, selection):
         for s in range(4):
             cols += [starts[s] + q for q in range(c[s] - 1)]
         mloc = key[4] - 1
-        if not (mloc == 0 and max(c) == 1):
+        if mloc > 0:
             cols += [base_in + inner_first[tiles] + q for q in range(mloc * mloc)]
         lmap = np.stack(cols, 1)
         tri_parts.append(lmap[:, tmpl].reshape(-1, 3))

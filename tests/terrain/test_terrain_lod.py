@@ -257,3 +257,34 @@ def test_bad_settings_are_refused():
     table = ta.tile_table(hm, 16, backend="numpy")
     with pytest.raises(InvalidInputError, match="different height map"):
         tl.select(_terrain(size=129), table, Camera.looking_at((0, -9, 9), (0, 0, 0)))
+
+
+@pytest.mark.parametrize("size, tile", [((7, 5), 64), ((2, 2), 16), ((66, 3), 64), ((40, 97), 32), ((33, 65), 8)])
+@pytest.mark.parametrize("mode, levels", [("UNIFORM", "INTEGER"), ("OURS", "POW2"), ("DISTANCE", "FRACTIONAL")])
+def test_a_mesh_never_outgrows_its_full_grid(size, tile, mode, levels):
+    """Tiles larger than the map, and the last partial row and column (one texel thick included), get no more
+    segments per side than the side has texels: never more triangles than the full grid, UNIFORM at the top
+    level over whole tiles *is* the full grid, and the mesh stays closed with no crack."""
+    w, h = size
+    rng = np.random.default_rng(w * 1000 + h)
+    hm = hio.from_array((rng.random((h, w)) * 30).astype(np.float32), texel_size=1.0)
+    table = ta.tile_table(hm, tile, backend="numpy")
+    cam = Camera.looking_at((0.0, -0.5, 3.0), (0.0, 0.0, 0.0), far=1e5)  # close: the highest levels
+    sel = tl.select(hm, table, cam, tl.TerrainLod(mode=mode, levels=levels, culling=False, ham_scale=64.0))
+    mesh, full = tm.bake(hm, table, sel), tm.full_grid(hm)
+    assert len(mesh.triangles) == tm.triangle_count(sel)
+    thin = 1 in ((w - 1) % tile, (h - 1) % tile, w - 1, h - 1)  # a side one texel long
+    if levels != "FRACTIONAL" or not thin:  # fractional-even spacing has two segments at least
+        assert len(mesh.triangles) <= len(full.triangles)
+    if mode == "UNIFORM" and (w - 1) % tile == (h - 1) % tile == 0:  # square tiles: an n x n inner grid fits
+        assert len(mesh.triangles) == len(full.triangles)
+        assert np.array_equal(np.unique(mesh.samples, axis=0), np.unique(full.samples, axis=0))
+    boundary, counts = _boundary_edges(mesh.triangles)
+    s = mesh.samples[boundary]
+    on_border = ((s[..., 0] == 0).all(1) | (s[..., 0] == w - 1).all(1)
+                 | (s[..., 1] == 0).all(1) | (s[..., 1] == h - 1).all(1))
+    assert on_border.all() and counts.max() == 2
+    p = mesh.samples[mesh.triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    assert cross.min() > 0 and cross.sum() / 2 == pytest.approx((w - 1) * (h - 1))
