@@ -18,7 +18,7 @@ def scene_camera(context, purpose="Adaptive levels"):
     scene = context.scene
     ob = scene.camera
     if ob is None:
-        raise InvalidInputError(f"{purpose} need a camera: set the scene camera, or use the viewport")
+        raise InvalidInputError(f"{purpose}: the scene has no camera; set the scene camera, or use the viewport")
     render = scene.render
     width = max(1, round(render.resolution_x * render.resolution_percentage / 100))
     height = max(1, round(render.resolution_y * render.resolution_percentage / 100))

@@ -10,14 +10,20 @@ block is removed, and the failure becomes a report:
 - anything else: "Tessera failed: <what> — nothing was changed", with the traceback printed to the console.
 
 Either way the operator returns ``{'CANCELLED'}``: no traceback escapes to the user and nothing is half-done.
+
+Before ``execute`` runs, `check_numbers` refuses any numeric property of the operator outside its hard range:
+Blender clamps what it is given to that range but lets NaN through (and every Tessera property has a finite
+range, `kernels.common.limits`). Settings an operator reads from a property group are checked the same way
+where it reads them.
 """
 
 import functools
+import math
 import traceback
 
 import bpy
 
-from ..kernels.common.errors import TesseraError
+from ..kernels.common.errors import InvalidInputError, TesseraError
 
 #: ID type -> its collection in bpy.data, for removal on rollback.
 _COLLECTIONS = (
@@ -76,6 +82,21 @@ def _remove(block):
     raise RuntimeError(f"no collection for {type(block).__name__}")
 
 
+def check_numbers(struct):
+    """Raise `InvalidInputError` naming the first FLOAT or INT property of ``struct`` (an operator or a property
+    group) that is NaN or outside its hard range, with that range."""
+    if isinstance(struct, bpy.types.Operator):
+        struct = struct.properties  # an operator's own settings live there, not on the Operator type
+    for prop in struct.bl_rna.properties:
+        if prop.type not in ("FLOAT", "INT") or prop.identifier == "rna_type":
+            continue
+        value = getattr(struct, prop.identifier)
+        for v in (value if prop.array_length else (value,)):
+            if not (math.isfinite(v) and prop.hard_min <= v <= prop.hard_max):
+                raise InvalidInputError(f"{prop.name} must be a finite number between {prop.hard_min:g} and "
+                                        f"{prop.hard_max:g}; got {v!r}")
+
+
 def failure_message(err):
     """What the user reads for an unexpected exception."""
     what = str(err) or type(err).__name__
@@ -89,6 +110,7 @@ def guarded(execute):
     def wrapper(self, context):
         tx = Transaction()
         try:
+            check_numbers(self)
             result = execute(self, context, tx)
         except TesseraError as err:
             tx.rollback()

@@ -13,7 +13,7 @@ import hashlib
 import bpy
 
 from ..addon.displacement.maps import channels_for, commit, map_state
-from ..addon.guarded import guarded
+from ..addon.guarded import check_numbers, guarded
 from ..kernels.common.errors import TesseraError
 from ..kernels.common.opencl_runtime import get_runtime
 from ..kernels.displacement.map_edit import apply_custom, compile_custom
@@ -80,6 +80,7 @@ class TESSERA_OT_displacement_custom(bpy.types.Operator):
     def execute(self, context, tx):
         ob = context.active_object
         settings = ob.tessera.displacement
+        check_numbers(settings)
         source = _source(context)
         if not is_trusted(context, source):
             raise TesseraError("This file's scripts are not trusted: enable Auto Run Python Scripts (or reload "

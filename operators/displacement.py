@@ -17,10 +17,11 @@ from ..addon.displacement import nodes as displace_nodes
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS
-from ..addon.guarded import guarded
+from ..addon.guarded import check_numbers, guarded
 from ..addon.preferences import get_preferences
 from ..kernels.common.errors import InvalidInputError, TesseraError
 from ..kernels.common.image_io import image_size
+from ..kernels.common.limits import MAX_WORLD_VALUE
 from ..kernels.displacement.map_edit import check_map_budget
 from ..kernels.displacement.map_io import read_map, write_map
 from ..kernels.displacement.map_strokes import Brush
@@ -37,6 +38,7 @@ def _map_object(context):
 
 def kernel_brush(b, channels):
     """`kernels.displacement.map_strokes.Brush` from ``Scene.tessera.brush``."""
+    check_numbers(b)
     vector = (*b.direction, 0.0) if channels > 1 else (0.0, 0.0, 1.0, 0.0)
     params = {"falloff": b.falloff, "vector": vector, "cell": b.noise_cell, "seed": b.noise_seed}
     if b.kind == "TEST":
@@ -72,8 +74,10 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
     space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL")
     filepath: bpy.props.StringProperty(name="From File", subtype="FILE_PATH",
                                        description="Read the map from this file instead (EXR, PNG, TIFF)")
-    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, description="Value of a 0 texel in integer files")
-    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, description="Value of a full texel")
+    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                 description="Value of a 0 texel in integer files")
+    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                  description="Value of a full texel")
 
     @classmethod
     def poll(cls, context):
@@ -128,8 +132,8 @@ class TESSERA_OT_displacement_export(bpy.types.Operator):
     bl_label = "Export Displacement Map"
 
     filepath: bpy.props.StringProperty(subtype="FILE_PATH")
-    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0)
-    high: bpy.props.FloatProperty(name="16-bit High", default=1.0)
+    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE)
+    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE)
 
     @classmethod
     def poll(cls, context):

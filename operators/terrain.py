@@ -6,12 +6,12 @@ import time
 import bpy
 
 from ..addon.cameras import camera_for, object_camera
-from ..addon.guarded import guarded
+from ..addon.guarded import check_numbers, guarded
 from ..addon.preferences import get_preferences
 from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
 from ..kernels.common.errors import BudgetError, EmptyResultError, InvalidInputError
-from ..kernels.terrain.lod import select
+from ..kernels.terrain.lod import box_distance, select
 from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
 
@@ -27,6 +27,18 @@ def _camera_or_none(context, source):
         return None
 
 
+def _nothing_seen(hm, table, camera):
+    """Why ``camera`` (terrain-local) sees no tile, and what to change."""
+    distance, clip = box_distance(hm, table, camera), camera.clip_end
+    if distance > clip:
+        return (f"The camera sees no tile of this terrain: the terrain is {distance:,.0f} away, beyond the "
+                f"camera's clip end (about {clip:,.4g}). Raise the camera's Clip End past {distance:,.0f}, move "
+                "the camera closer, or turn off Frustum Culling")
+    return ("The camera sees no tile of this terrain: it is within the clip end, but the camera looks away from "
+            "it or sits under its surface. Aim the camera at the terrain (or raise it above the heights), or turn "
+            "off Frustum Culling")
+
+
 def _bake_into(context, ob, camera, report, tx):
     """Select levels for ``camera``, check the budget, bake and write the mesh (its new mesh tracked by the
     `Transaction` ``tx``). Returns the selection. Raises `EmptyResultError` when the camera sees no tile."""
@@ -37,11 +49,8 @@ def _bake_into(context, ob, camera, report, tx):
     sel = select(hm, table, object_camera(camera, ob.matrix_world) if camera else None, lod_settings(s))
     t_select = time.perf_counter() - t0
     n_tris = triangle_count(sel)
-    if n_tris == 0:  # every tile culled
-        clip = f" (its clip end is {camera.clip_end:g})" if camera is not None else ""
-        raise EmptyResultError(
-            f"The camera sees no tile of this terrain{clip}: move or aim the camera at it, raise the camera's clip "
-            "end, or turn off Frustum Culling")
+    if n_tris == 0:  # every tile culled: say which of the camera's settings keeps the terrain out
+        raise EmptyResultError(_nothing_seen(hm, table, object_camera(camera, ob.matrix_world)))
     budget = get_preferences(context).memory_budget_bytes
     if budget and n_tris * _BYTES_PER_TRIANGLE > budget:
         raise BudgetError(f"The terrain mesh would have {n_tris:,} triangles (about "
@@ -122,6 +131,7 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
     @guarded
     def execute(self, context, tx):
         ob = context.active_object
+        check_numbers(ob.tessera.terrain)  # the settings the bake reads, as an operator's own are checked
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:

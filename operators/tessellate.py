@@ -6,7 +6,7 @@ import numpy as np
 from ..addon import bridge
 from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
-from ..addon.guarded import guarded
+from ..addon.guarded import check_numbers, guarded
 from ..addon.preferences import get_preferences
 from ..addon.tessellation.settings import (
     TessellateOptions,
@@ -64,6 +64,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         ob = context.active_object
         if self.use_object_settings:
             copy_settings(ob.tessera.tessellate, self)
+            check_numbers(self)  # the object's settings, as the operator's own were checked
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:

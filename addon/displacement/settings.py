@@ -4,6 +4,7 @@ applied to a map image; undo and redo restore the map to the serial that Blender
 
 import bpy
 
+from ...kernels.common.limits import MAX_FACTOR, MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.displacement.map_dabs import FALLOFFS
 from .maps import sync_modifier
 
@@ -44,20 +45,25 @@ class TESSERA_PG_displacement(bpy.types.PropertyGroup):
     uv_map: bpy.props.StringProperty(name="UV Map", description="UV map that places the map (empty: active)",
                                      update=_sync_modifier)
     mid_level: bpy.props.FloatProperty(name="Mid-Level", default=0.0, soft_min=0.0, soft_max=1.0,
+                                       min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
                                        description="Map value that means no displacement", update=_sync_modifier)
-    strength: bpy.props.FloatProperty(name="Strength", default=1.0, soft_min=-10.0, soft_max=10.0,
+    strength: bpy.props.FloatProperty(name="Strength", default=1.0, soft_min=-10.0, soft_max=10.0, min=-MAX_FACTOR,
+                                      max=MAX_FACTOR,
                                       description="Displacement per unit of map value", update=_sync_modifier)
     kernel_text: bpy.props.PointerProperty(name="Custom Kernel", type=bpy.types.Text,
                                            description="Text with an OpenCL body that edits `float4 image` at (x, y)")
-    kernel_args: bpy.props.FloatVectorProperty(name="Arguments", size=16, default=(0.0,) * 16,
+    kernel_args: bpy.props.FloatVectorProperty(name="Arguments", size=16, default=(0.0,) * 16, min=-MAX_WORLD_VALUE,
+                                               max=MAX_WORLD_VALUE,
                                                description="arg1..arg4 (four float4) of the custom kernel")
 
 
 class TESSERA_PG_brush(bpy.types.PropertyGroup):
     kind: bpy.props.EnumProperty(name="Brush", items=BRUSH_ITEMS, default="DRAW")
-    radius: bpy.props.FloatProperty(name="Radius", default=24.0, min=0.5, soft_max=512.0, subtype="PIXEL",
+    radius: bpy.props.FloatProperty(name="Radius", default=24.0, min=0.5, max=MAX_PIXELS, soft_max=512.0,
+                                    subtype="PIXEL",
                                     description="Brush radius in map texels")
-    strength: bpy.props.FloatProperty(name="Strength", default=0.05, soft_min=-1.0, soft_max=1.0,
+    strength: bpy.props.FloatProperty(name="Strength", default=0.05, soft_min=-1.0, soft_max=1.0, min=-MAX_FACTOR,
+                                      max=MAX_FACTOR,
                                       description="Change per dab (map units; smooth and flatten: the blend)")
     falloff: bpy.props.EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default="SMOOTH")
     spacing: bpy.props.FloatProperty(name="Spacing", default=0.25, min=0.01, max=4.0, subtype="FACTOR",
@@ -66,9 +72,10 @@ class TESSERA_PG_brush(bpy.types.PropertyGroup):
     use_pressure_radius: bpy.props.BoolProperty(name="Pressure Radius", default=False)
     mirror_x: bpy.props.BoolProperty(name="X Mirror", default=False,
                                      description="Mirror dabs across the map's vertical centre line (U = 0.5)")
-    direction: bpy.props.FloatVectorProperty(name="Direction", size=3, default=(0.0, 0.0, 1.0),
+    direction: bpy.props.FloatVectorProperty(name="Direction", size=3, default=(0.0, 0.0, 1.0), min=-MAX_FACTOR,
+                                             max=MAX_FACTOR,
                                              description="Vector maps: the offset direction (height maps use Z)")
-    noise_cell: bpy.props.FloatProperty(name="Noise Size", default=8.0, min=0.5, soft_max=256.0,
+    noise_cell: bpy.props.FloatProperty(name="Noise Size", default=8.0, min=0.5, max=MAX_PIXELS, soft_max=256.0,
                                         description="Noise lattice spacing in texels")
     noise_seed: bpy.props.IntProperty(name="Seed", default=0, min=0)
 

@@ -4,6 +4,7 @@
 
 import bpy
 
+from ...kernels.common.limits import MAX_FACTOR, MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.terrain.lod import TerrainLod
 from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator, with_update
@@ -43,22 +44,26 @@ class TerrainOptions:
     image_name: bpy.props.StringProperty(name="Image", description="Blender image with the heights")
     raw_width: bpy.props.IntProperty(name="Raw Width", default=0, min=0, description="Samples per row (raw files)")
     raw_height: bpy.props.IntProperty(name="Raw Height", default=0, min=0, description="Rows (raw files)")
-    texel_size: bpy.props.FloatProperty(name="Texel Size", default=1.0, min=1e-6, subtype="DISTANCE",
+    texel_size: bpy.props.FloatProperty(name="Texel Size", default=1.0, min=1e-6, max=MAX_WORLD_VALUE,
+                                        subtype="DISTANCE",
                                         description="Distance between neighbouring samples")
-    height_scale: bpy.props.FloatProperty(name="Height Scale", default=100.0, subtype="DISTANCE",
+    height_scale: bpy.props.FloatProperty(name="Height Scale", default=100.0, min=-MAX_WORLD_VALUE,
+                                          max=MAX_WORLD_VALUE, subtype="DISTANCE",
                                           description="Height of a full-scale integer sample (255 or 65535); "
                                           "the factor on float samples")
-    height_offset: bpy.props.FloatProperty(name="Height Offset", default=0.0, subtype="DISTANCE")
+    height_offset: bpy.props.FloatProperty(name="Height Offset", default=0.0, min=-MAX_WORLD_VALUE,
+                                           max=MAX_WORLD_VALUE, subtype="DISTANCE")
     tile_size: bpy.props.IntProperty(name="Tile Size", default=64, min=2, max=1024,
                                      description="Texels per tile side (64: one quad per texel at level 64)")
     mode: bpy.props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS")
     g: bpy.props.EnumProperty(name="T_max From HAM", items=G_ITEMS, default="SQRT")
-    ham_scale: bpy.props.FloatProperty(name="HAM Scale", default=4.0, min=1e-3, soft_max=64.0,
+    ham_scale: bpy.props.FloatProperty(name="HAM Scale", default=4.0, min=1e-3, max=MAX_FACTOR, soft_max=64.0,
                                        description="k in the T_max function")
-    epsilon: bpy.props.FloatProperty(name="Error (px)", default=3.0, min=0.05, soft_max=32.0,
+    epsilon: bpy.props.FloatProperty(name="Error (px)", default=3.0, min=0.05, max=MAX_PIXELS, soft_max=32.0,
                                      description="Allowed screen-space error of a tile's peak")
     t_min_rule: bpy.props.EnumProperty(name="T_min Rule", items=T_MIN_ITEMS, default="SEARCH")
-    d_max: bpy.props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, subtype="DISTANCE",
+    d_max: bpy.props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, max=MAX_WORLD_VALUE,
+                                   subtype="DISTANCE",
                                    description="Below this distance tiles get T_max (0: where a texel spans "
                                    "4 pixels)")
     levels: bpy.props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2")

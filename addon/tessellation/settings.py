@@ -8,6 +8,7 @@ into the kernels' dataclasses.
 
 import bpy
 
+from ...kernels.common.limits import MAX_FACTOR, MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.common.partition import MAX_LEVEL
 from ...kernels.tessellation.adaptive import AdaptiveSettings
 from ...kernels.tessellation.tessellate import SurfaceOptions
@@ -85,17 +86,17 @@ class TessellateOptions:
                                        default=16.0, min=1.0, max=float(MAX_LEVEL))
     power_of_two: bpy.props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE")
     edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", description="Target edge length on screen",
-                                         default=10.0, min=0.5, soft_max=100.0, subtype="PIXEL")
+                                         default=10.0, min=0.5, max=MAX_PIXELS, soft_max=100.0, subtype="PIXEL")
     distance_map: bpy.props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR")
     near: bpy.props.FloatProperty(name="Near", description="Distance that gets the maximum level",
-                                  default=1.0, min=1e-4, subtype="DISTANCE", unit="LENGTH")
+                                  default=1.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE", unit="LENGTH")
     far: bpy.props.FloatProperty(name="Far", description="Distance beyond which the level is 1",
-                                 default=20.0, min=1e-3, subtype="DISTANCE", unit="LENGTH")
+                                 default=20.0, min=1e-3, max=MAX_WORLD_VALUE, subtype="DISTANCE", unit="LENGTH")
     silhouette_beta: bpy.props.FloatProperty(
         name="Silhouette Ramp", description="How far inside a silhouette triangle extra levels reach (beta)",
         default=0.25, min=1e-4, max=1.0)
     curvature_gain: bpy.props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
-                                            default=10.0, min=0.0, soft_max=50.0)
+                                            default=10.0, min=0.0, max=MAX_FACTOR, soft_max=50.0)
     camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
     evaluate_on: bpy.props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU")
     output: bpy.props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT")

@@ -5,6 +5,7 @@ import math
 
 import bpy
 
+from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.tubes.builder import TubeSettings
 from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator, with_update
@@ -36,7 +37,7 @@ class TubeOptions:
 
     radius_source: bpy.props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT")
     radius: bpy.props.FloatProperty(name="Radius", description="Radius, or the factor on curve point radii",
-                                    default=0.05, min=0.0, soft_max=10.0, subtype="DISTANCE")
+                                    default=0.05, min=0.0, max=MAX_WORLD_VALUE, soft_max=10.0, subtype="DISTANCE")
     attribute: bpy.props.StringProperty(name="Attribute", description="Float point attribute with the radius",
                                         default="radius")
     caps: bpy.props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT")
@@ -45,12 +46,12 @@ class TubeOptions:
     min_sides: bpy.props.IntProperty(name="Min Sides", default=3, min=3, max=1024)
     max_sides: bpy.props.IntProperty(name="Max Sides", default=32, min=3, max=1024)
     edge_pixels: bpy.props.FloatProperty(name="Side Length (px)", description="Target length of a side on screen",
-                                         default=8.0, min=0.5, soft_max=64.0)
+                                         default=8.0, min=0.5, max=MAX_PIXELS, soft_max=64.0)
     camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
     aa_clamp: bpy.props.BoolProperty(name="Pixel Clamp", default=False, description="Keep every tube at least "
                                      "one pixel in radius for the camera (thin tubes stay visible far away)")
     max_radius: bpy.props.FloatProperty(name="Max Clamp Radius", description="Cap of the clamp's inflation "
-                                        "(0: none)", default=0.0, min=0.0, subtype="DISTANCE")
+                                        "(0: none)", default=0.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE")
     refine: bpy.props.IntProperty(name="Refine", description="Catmull-Rom segments per input segment (1: off)",
                                   default=1, min=1, max=64)
     refine_kind: bpy.props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL")

@@ -20,11 +20,9 @@ import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
 from ..common.image_io import read_pixels
+from ..common.limits import MAX_WORLD_VALUE
 
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
-#: Largest texel size, height scale or offset accepted: beyond it float32 positions carry no precision (and
-#: 3e38 overflows to infinity as soon as a sample is multiplied by it).
-MAX_WORLD_VALUE = 1e15
 RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
 _NORMALISE = {np.dtype(np.uint8): 1.0 / 255.0, np.dtype(np.uint16): 1.0 / 65535.0}
 #: Rows per band when a large map is scanned (NaN check, statistics): about 64 MiB of float32 at 16384 wide.

@@ -154,6 +154,42 @@ def test_terrain_the_camera_cannot_see(clean_scene, bpy_module):
                                        culling=False) == {"FINISHED"}  # what the message suggests works
 
 
+def _default_camera(bpy):
+    """Blender's startup-file camera: 7 m from the origin, 5 m up, looking at it; clip end as new cameras have."""
+    import math
+
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location = (7.3589, -6.9258, 4.9583)
+    cam.rotation_euler = (math.radians(63.6), 0.0, math.radians(46.7))
+    bpy.context.scene.camera = cam
+    return cam
+
+
+def test_a_real_sized_dem_with_the_default_camera(clean_scene, bpy_module, tmp_path):
+    """An SRTM-sized DEM (1201², 30 m texels: 36 km, 100 m to 1.1 km high) under the startup camera, which sits
+    below its surface: a message that says what to change, and what it suggests gives a terrain."""
+    import OpenImageIO as oiio
+
+    bpy = bpy_module
+    n = 1201
+    y, x = np.mgrid[0:n, 0:n] / n
+    h = 0.3 + 0.2 * np.sin(7 * x) * np.cos(5 * y) + 0.05 * np.random.default_rng(0).random((n, n))
+    path = tmp_path / "dem.png"
+    out = oiio.ImageOutput.create(str(path))
+    assert out.open(str(path), oiio.ImageSpec(n, n, 1, "uint16")) and out.write_image((h * 65535).astype(np.uint16))
+    out.close()
+    cam = _default_camera(bpy)
+    kw = dict(source="FILE", filepath=str(path), texel_size=30.0, height_scale=2000.0)
+    refused(bpy, bpy.ops.tessera.terrain_add, ["sees no tile", "under its surface", "Frustum Culling"], **kw)
+    cam.location.z = 1500.0  # above the heights, as suggested: within reach and looking down at it
+    assert bpy.ops.tessera.terrain_add(**kw) == {"FINISHED"}
+    assert len(bpy.context.active_object.data.polygons) > 0
+    bpy.data.objects.remove(bpy.context.active_object)
+    cam.location = (0.0, -80000.0, 3000.0)  # far away: the clip end is what to change, and by how much
+    refused(bpy, bpy.ops.tessera.terrain_add, ["is 62,0", "beyond the camera's clip end", "Clip End past 62,0"], **kw)
+
+
 def test_map_over_the_memory_budget_makes_nothing(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
     bpy.ops.mesh.primitive_plane_add()
@@ -211,3 +247,193 @@ def test_export_into_a_missing_folder_says_so(clean_scene, bpy_module, tmp_path)
     refused(bpy, bpy.ops.tessera.displacement_export, ["does not exist"],
             filepath=str(tmp_path / "missing" / "map.exr"))
     assert not (tmp_path / "missing").exists()
+
+
+# --- numbers: every setting has a finite range, and NaN (which Blender does not clamp) is refused by name ------
+
+def _float_props(rna):
+    return [p for p in rna.properties if p.type == "FLOAT" and p.identifier != "rna_type"]
+
+
+def _settings_groups(bpy):
+    """Every Tessera property group (``Object/Scene/Image.tessera`` and the groups inside): (path, rna)."""
+    found, todo = [], [(t, getattr(bpy.types, t).bl_rna.properties["tessera"].fixed_type)
+                       for t in ("Object", "Scene", "Image")]
+    while todo:
+        path, rna = todo.pop()
+        found.append((path, rna))
+        todo += [(f"{path}.{p.identifier}", p.fixed_type) for p in rna.properties
+                 if p.type == "POINTER" and p.identifier != "rna_type"
+                 and getattr(p.fixed_type.base, "identifier", "") == "PropertyGroup"]
+    return found
+
+
+def test_every_numeric_setting_has_a_finite_range(clean_scene, bpy_module):
+    """No float setting of an operator or a property group accepts 3e38: each has a hard range within the
+    limits of `kernels.common.limits` (so the range in a refusal message means something)."""
+    bpy = bpy_module
+    structs = [(f"tessera.{name}", getattr(bpy.ops.tessera, name).get_rna_type()) for name in dir(bpy.ops.tessera)]
+    structs += _settings_groups(bpy)
+    assert len(structs) >= 13
+    wide = [f"{where}.{p.identifier} [{p.hard_min:g}, {p.hard_max:g}]" for where, rna in structs
+            for p in _float_props(rna) if not -1e15 <= p.hard_min <= p.hard_max <= 1e15]
+    assert wide == []
+
+
+def _setup_for(bpy, name, tmp_path):
+    """Make the context ``tessera.<name>`` runs in; returns the keyword arguments it needs besides the NaN."""
+    if name in ("tessellate", "displacement_add"):
+        bpy.ops.mesh.primitive_monkey_add()
+        return {}
+    if name == "tubes":
+        select(bpy, poly_curve(bpy, [(0, 0, 0), (1, 0, 0), (1, 1, 0)]))
+        return {}
+    if name == "terrain_add":
+        _height_image(bpy)
+        return {"source": "IMAGE", "image_name": "hm"}
+    if name == "displacement_export":
+        bpy.ops.mesh.primitive_plane_add()
+        assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}
+        return {"filepath": str(tmp_path / "map.png")}
+    raise AssertionError(f"no setup for tessera.{name}: add one so its numeric settings are tried")
+
+
+def test_nan_in_any_operator_setting_is_refused_by_name(clean_scene, bpy_module, tmp_path):
+    bpy = bpy_module
+    tried = 0
+    for name in dir(bpy.ops.tessera):
+        op = getattr(bpy.ops.tessera, name)
+        props = _float_props(op.get_rna_type())
+        if not props:
+            continue
+        kw = _setup_for(bpy, name, tmp_path)
+        for p in props:
+            value = float("nan") if not p.array_length else (float("nan"),) * p.array_length
+            message = refused(bpy, op, [p.name, "must be a finite number between"], **kw, **{p.identifier: value})
+            assert f"{p.hard_min:g} and {p.hard_max:g}" in message
+            tried += 1
+        for item in list(bpy.data.objects):
+            bpy.data.objects.remove(item)
+    assert tried >= 20, tried
+    assert not (tmp_path / "map.png").exists()
+
+
+def test_nan_in_object_and_brush_settings_is_refused_by_name(clean_scene, bpy_module, tmp_path):
+    """Settings read from a property group (terrain bake, brush strokes, custom-kernel arguments, tessellate
+    with the object's settings) are checked where they are read."""
+    bpy = bpy_module
+    _height_image(bpy)
+    assert bpy.ops.tessera.terrain_add(source="IMAGE", image_name="hm", culling=False) == {"FINISHED"}
+    terrain = bpy.context.active_object
+    terrain.tessera.terrain.epsilon = float("nan")
+    refused(bpy, bpy.ops.tessera.terrain_bake, ["Error (px)", "between 0.05 and 100000"])
+    bpy.ops.mesh.primitive_monkey_add()
+    monkey = bpy.context.active_object
+    monkey.tessera.tessellate.near = float("nan")
+    refused(bpy, bpy.ops.tessera.tessellate, ["Near", "between"], use_object_settings=True)
+    bpy.ops.mesh.primitive_plane_add()
+    assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}
+    brush = bpy.context.scene.tessera.brush
+    old = brush.radius
+    brush.radius = float("nan")
+    try:
+        refused(bpy, bpy.ops.tessera.displacement_stroke, ["Radius", "between 0.5 and 100000"],
+                stroke=[_stroke_element((4.0, 4.0, 0.0))], map_space=True)
+    finally:
+        brush.radius = old
+
+
+def _stroke_element(location, first=True):
+    return {"name": "", "location": location, "mouse": (0, 0), "mouse_event": (0, 0), "pressure": 1.0,
+            "size": 0, "x_tilt": 0, "y_tilt": 0, "time": 0, "is_start": first}
+
+
+# --- degenerate inputs to every operator ------------------------------------------------------------------
+
+def _mesh_object(bpy, name, verts, faces, edges=()):
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, list(edges), faces)
+    ob = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(ob)
+    select(bpy, ob)
+    return ob
+
+
+@pytest.mark.parametrize("verts, faces, edges, words", [
+    ([], [], [], ["no faces"]),
+    ([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1)], ["no faces"]),
+    ([(0, 0, 0), (1, 0, 0), (float("nan"), 0, 0)], [(0, 1, 2)], [], ["NaN"]),
+])
+def test_tessellate_empty_and_degenerate_meshes(clean_scene, bpy_module, verts, faces, edges, words):
+    bpy = bpy_module
+    _mesh_object(bpy, "Bad", verts, faces, edges)
+    for output in ("NEW_OBJECT", "REPLACE"):
+        refused(bpy, bpy.ops.tessera.tessellate, words, output=output)
+
+
+@pytest.mark.parametrize("verts", [[(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 0, 0), (0, 0, 0), (0, 0, 0)],
+                                   [(0, 0, 0), (1, 0, 0), (1e38, 1e38, 0)]])
+def test_tessellate_degenerate_and_huge_triangles_give_finite_geometry(clean_scene, bpy_module, verts):
+    """Collinear, collapsed and huge triangles are not errors (Blender's own modifiers take them): the result has
+    the same faces as a regular triangle's, with finite positions and normals."""
+    bpy = bpy_module
+    counts = []
+    for name, v in (("Regular", [(0, 0, 0), (1, 0, 0), (0, 1, 0)]), ("Odd", verts)):
+        _mesh_object(bpy, name, v, [(0, 1, 2)])
+        assert bpy.ops.tessera.tessellate(level=4, method="PN") == {"FINISHED"}
+        out = bpy.context.active_object.data
+        co = np.empty(len(out.vertices) * 3, np.float32)
+        out.vertices.foreach_get("co", co)
+        normals = np.empty(len(out.loops) * 3, np.float32)
+        out.corner_normals.foreach_get("vector", normals)
+        assert np.isfinite(co).all() and np.isfinite(normals).all()
+        counts.append(len(out.polygons))
+    assert counts[0] == counts[1] > 1
+
+
+def test_strokes_on_a_map_with_nan_texels_are_refused(clean_scene, bpy_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_plane_add()
+    assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}
+    image = bpy.context.active_object.tessera.displacement.image
+    px = np.zeros(16 * 16 * 4, np.float32)
+    px[4 * (16 * 8 + 8)] = np.nan
+    image.pixels.foreach_set(px)
+    image.update()
+    refused(bpy, bpy.ops.tessera.displacement_stroke, ["NaN or infinite"],
+            stroke=[_stroke_element((8.0, 8.0, 0.0))], map_space=True)
+
+
+@pytest.mark.parametrize("content, name, extra, words", [
+    (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00", "cut.png", {}, ["cut.png"]),
+    (b"not an image at all", "text.exr", {}, ["text.exr"]),
+    (b"\x00" * 1001, "odd.r16", {}, ["1001 bytes", "odd"]),
+    (b"\x00" * 1000, "wrong.r16", {"raw_width": 30, "raw_height": 30}, ["30", "1000 bytes"]),
+    (None, "missing.png", {}, ["missing.png"]),
+])
+def test_terrain_from_broken_files(clean_scene, bpy_module, tmp_path, content, name, extra, words):
+    bpy = bpy_module
+    path = tmp_path / name
+    if content is not None:
+        path.write_bytes(content)
+    message = refused(bpy, bpy.ops.tessera.terrain_add, words, source="FILE", filepath=str(path), **extra)
+    assert not message.rstrip().endswith(":"), message  # a reason follows, not an empty string
+
+
+def test_a_refusal_leaves_no_undo_step_and_survives_save_and_reload(clean_scene, bpy_module, tmp_path):
+    """After a refused operator, undo takes back the user's last real step (the refusal made none), and the file
+    saved after the refusal reloads with exactly the scene from before it."""
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    bpy.ops.ed.undo_push(message="cube")
+    bpy.ops.mesh.primitive_monkey_add()
+    bpy.ops.ed.undo_push(message="monkey")
+    before = snapshot(bpy)
+    refused(bpy, bpy.ops.tessera.tessellate, ["Level", "between"], level=float("nan"))
+    path = tmp_path / "after_refusal.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    bpy.ops.ed.undo()
+    assert "Suzanne" not in bpy.data.objects and "Cube" in bpy.data.objects
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    scene = {name: sorted(b.name for b in getattr(bpy.data, name)) for name in ("objects", "meshes")}
+    assert scene == {name: before[0][name] for name in ("objects", "meshes")}  # orphans are not saved
