@@ -27,7 +27,7 @@ PLATFORMS = {
 }
 BINARY = ("pyopencl", "siphash24")
 PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl")
-IGNORE = shutil.ignore_patterns(".git", ".venv", "out", "dist", "wheels", "__pycache__", ".pytest_cache",
+IGNORE = shutil.ignore_patterns(".git", ".venv*", "out", "dist", "wheels", "__pycache__", ".pytest_cache",
                                 ".ruff_cache", ".hypothesis", "*.zip")
 
 
