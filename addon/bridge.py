@@ -15,6 +15,7 @@ from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.tolerances import FLAT_FACE_NORMAL_ATOL
 from ..kernels.displacement.tangent_space import triangle_tangents
+from . import compat
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
 # the number of channels.
@@ -134,13 +135,10 @@ def _new_attribute(mesh, name, dtype, domain):
 def _set_custom_normals(mesh, normals, domain="CORNER"):
     """Corner (L, 3) or point (V, 3) float32 normals as custom normals, with the fastest API this Blender has."""
     normals = np.ascontiguousarray(normals, dtype=np.float32)
-    if bpy.app.version >= (5, 0, 0):
-        attr = _new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", domain)
-        attr.data.foreach_set("vector", normals.ravel())
-    elif domain == "POINT":
-        mesh.normals_split_custom_set_from_vertices(normals)
+    if compat.FLOAT_CUSTOM_NORMALS:
+        _new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", domain).data.foreach_set("vector", normals.ravel())
     else:
-        mesh.normals_split_custom_set(normals)
+        compat.set_split_custom_normals(mesh, normals, domain)
 
 
 def _add_geometry(mesh, positions, corner_verts, loop_starts):

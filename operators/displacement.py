@@ -13,6 +13,7 @@ import mathutils
 import numpy as np
 
 from ..addon import bridge
+from ..addon.compat import UV_TANGENT_MESSAGE
 from ..addon.displacement import nodes as displace_nodes
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
@@ -95,7 +96,7 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
         ob = context.active_object
         channels = 1 if self.mode == "HEIGHT" else 3
         if self.mode == "VECTOR" and self.space == "TANGENT" and not displace_nodes.available():
-            raise InvalidInputError("Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)")
+            raise InvalidInputError(UV_TANGENT_MESSAGE)
         budget = get_preferences(context).memory_budget_bytes
         data = None
         if self.filepath:

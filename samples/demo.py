@@ -201,9 +201,10 @@ def stroke(points, **brush):
     b = bpy.context.scene.tessera.brush
     for key, value in brush.items():
         setattr(b, key, value)
-    elements = [{"name": "", "location": (x, y, 0.0), "mouse": (0, 0), "mouse_event": (0, 0), "pressure": p,
-                 "size": 0, "x_tilt": 0, "y_tilt": 0, "time": 0, "is_start": i == 0}
-                for i, (x, y, p) in enumerate(points)]
+    import importlib
+
+    element = importlib.import_module("bl_ext.tessera_demo.tessera.addon.compat").stroke_element
+    elements = [element((x, y, 0.0), p, first=i == 0) for i, (x, y, p) in enumerate(points)]
     if bpy.ops.tessera.displacement_stroke(stroke=elements, map_space=True) != {"FINISHED"}:
         sys.exit("demo: a displacement stroke failed")
     return 1

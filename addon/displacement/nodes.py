@@ -9,6 +9,7 @@ bitangent sign from the orientation of the corner's face in UV space (the sign o
 import bpy
 
 from ...kernels.common.errors import TesseraError
+from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node, set_modifier_input
 
 GROUP_NAME = "Tessera Tangent Displacement"
 INPUTS = (("Image", "NodeSocketImage"), ("UV Map", "NodeSocketString"), ("Mid-Level", "NodeSocketFloat"),
@@ -18,7 +19,7 @@ _VERSION = 1  # bump when the graph changes: older groups in a file are rebuilt
 
 def available():
     """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
-    return hasattr(bpy.types, "GeometryNodeUVTangent")
+    return has_uv_tangent_node()
 
 
 class _Graph:
@@ -108,7 +109,7 @@ def _build(tree):
 def node_group():
     """The group, built on first use (and rebuilt when an older version is in the file)."""
     if not available():
-        raise TesseraError("Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)")
+        raise TesseraError(UV_TANGENT_MESSAGE)
     tree = bpy.data.node_groups.get(GROUP_NAME)
     if tree is not None and tree.get("tessera_version") == _VERSION:
         return tree
@@ -126,4 +127,4 @@ def set_inputs(mod, values):
     """Set a Nodes modifier's group inputs from ``{socket name: value}``."""
     for item in mod.node_group.interface.items_tree:
         if item.item_type == "SOCKET" and item.in_out == "INPUT" and item.name in values:
-            mod[item.identifier] = values[item.name]
+            set_modifier_input(mod, item.identifier, values[item.name])

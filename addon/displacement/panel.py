@@ -2,6 +2,7 @@
 
 import bpy
 
+from ..compat import UV_TANGENT_MESSAGE
 from ..sidebar import Sidebar
 from . import nodes as displace_nodes
 from .brush_tool import draw_brush_settings
@@ -24,7 +25,7 @@ class TESSERA_PT_displacement(Sidebar, bpy.types.Panel):
         if settings.mode == "VECTOR":
             layout.prop(settings, "space")
             if settings.space == "TANGENT" and not displace_nodes.available():
-                layout.label(text="Tangent space needs Blender 5.0 or newer: the map is not shown", icon="ERROR")
+                layout.label(text=f"{UV_TANGENT_MESSAGE}: the map is not shown", icon="ERROR")
         layout.prop_search(settings, "uv_map", context.active_object.data, "uv_layers")
         layout.prop(settings, "mid_level")
         layout.prop(settings, "strength")

@@ -4,6 +4,7 @@ scene, images and maps are as they were (tier: blender). Each case names the wor
 
 import numpy as np
 import pytest
+from blender_helpers import stroke_elements
 
 pytestmark = pytest.mark.blender
 
@@ -338,14 +339,9 @@ def test_nan_in_object_and_brush_settings_is_refused_by_name(clean_scene, bpy_mo
     brush.radius = float("nan")
     try:
         refused(bpy, bpy.ops.tessera.displacement_stroke, ["Radius", "between 0.5 and 100000"],
-                stroke=[_stroke_element((4.0, 4.0, 0.0))], map_space=True)
+                stroke=stroke_elements([(4.0, 4.0, 1.0)]), map_space=True)
     finally:
         brush.radius = old
-
-
-def _stroke_element(location, first=True):
-    return {"name": "", "location": location, "mouse": (0, 0), "mouse_event": (0, 0), "pressure": 1.0,
-            "size": 0, "x_tilt": 0, "y_tilt": 0, "time": 0, "is_start": first}
 
 
 # --- degenerate inputs to every operator ------------------------------------------------------------------
@@ -401,7 +397,7 @@ def test_strokes_on_a_map_with_nan_texels_are_refused(clean_scene, bpy_module):
     image.pixels.foreach_set(px)
     image.update()
     refused(bpy, bpy.ops.tessera.displacement_stroke, ["NaN or infinite"],
-            stroke=[_stroke_element((8.0, 8.0, 0.0))], map_space=True)
+            stroke=stroke_elements([(8.0, 8.0, 1.0)]), map_space=True)
 
 
 @pytest.mark.parametrize("content, name, extra, words", [

@@ -3,6 +3,7 @@ the operator's compute-shader path (tier: gpu)."""
 
 import numpy as np
 import pytest
+from blender_helpers import compat, refuses_tangent_space
 
 pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 
@@ -82,7 +83,8 @@ def test_operator_compute_path_equals_cpu(gpu_renderer, addon_module, clean_scen
     cpu, gpu = results["CPU"], results["GPU"]
     assert np.array_equal(cpu.triangles, gpu.triangles)
     assert np.abs(cpu.positions - gpu.positions).max() <= 1e-5 * np.abs(cpu.positions).max()
-    assert np.abs(cpu.corner_normals - gpu.corner_normals).max() <= 1e-4
+    stored = compat().CUSTOM_NORMAL_STORAGE_ERROR  # both were stored: each within this of what was written
+    assert np.abs(cpu.corner_normals - gpu.corner_normals).max() <= 1e-4 + 2 * stored
 
 
 def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, addon_module, clean_scene,
@@ -94,8 +96,9 @@ def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, a
     preview = addon_module("addon.tessellation.preview")
     offscreen = addon_module("gpu_shaders.offscreen")
     bridge = addon_module("addon.bridge")
-    if not addon_module("addon.displacement.nodes").available():
-        pytest.skip("this Blender has no UV Tangent node")
+    if not addon_module("addon.displacement.nodes").available():  # before 5.0: refused, with what is needed
+        refuses_tangent_space(bpy)
+        return
     Camera = addon_module("kernels.common.camera").Camera
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=24, y_subdivisions=24, size=2, rotation=(0.4, 0.2, 0.0))
     ob = bpy.context.active_object

@@ -1,0 +1,74 @@
+"""What differs between the supported Blenders (4.2 LTS, 4.5 LTS, 5.0, 5.1, 5.2), in one place.
+
+Everything else calls these instead of testing ``bpy.app.version``; a feature is detected where Blender lets us
+ask for it, and the version is compared only where the difference cannot be seen any other way.
+
+- custom normals: 5.0+ keeps them as a float ``custom_normal`` attribute (exact); before, as two 16-bit angles in
+  each corner fan's normal space, set through ``normals_split_custom_set`` (`FLOAT_CUSTOM_NORMALS`,
+  `set_split_custom_normals`, `CUSTOM_NORMAL_STORAGE_ERROR`);
+- stroke elements: 4.2's `OperatorStrokeElement` requires ``pen_flip`` when built from Python (`stroke_element`);
+- geometry-nodes modifier inputs: ``mod[identifier] = value`` until 5.1, ``mod.properties.inputs`` from 5.2
+  (`set_modifier_input`, `get_modifier_input`);
+- the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`).
+"""
+
+import math
+
+import bpy
+
+#: 5.0+ stores custom normals as a float vector attribute (what is written is what is read back).
+FLOAT_CUSTOM_NORMALS = bpy.app.version >= (5, 0, 0)
+
+#: Largest change, per component, that storing a unit custom normal makes. None in 5.0+. Before 5.0 a corner
+#: normal is kept as two 16-bit angles in its fan's normal space: the angle from the fan's reference normal comes
+#: from ``acosf``, whose resolution near 1 is sqrt(2 * 2^-24) ≈ 3.45e-4 rad, and the two angles are rounded to
+#: half a step of π/32767 and 2π/32767. Measured: 3.3e-4 on Suzanne (4.2.23, 4.5.15). Tests add it to their own
+#: tolerance for every stored normal they compare, so the 5.x tolerances stay what they were.
+CUSTOM_NORMAL_STORAGE_ERROR = 0.0 if FLOAT_CUSTOM_NORMALS else math.sqrt(2.0 * 2.0 ** -24) + 3.0 * math.pi / 65534
+
+UV_TANGENT_MESSAGE = "Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)"
+
+
+def set_split_custom_normals(mesh, normals, domain="CORNER"):
+    """Before 5.0: corner (L, 3) or point (V, 3) float32 unit normals as ``mesh``'s custom normals (Blender
+    encodes them; see `CUSTOM_NORMAL_STORAGE_ERROR`). 5.0+ writes the ``custom_normal`` attribute instead."""
+    if domain == "POINT":
+        mesh.normals_split_custom_set_from_vertices(normals)
+    else:
+        mesh.normals_split_custom_set(normals)
+
+
+def stroke_element(location, pressure=1.0, first=False, mouse=(0.0, 0.0)):
+    """One element of a paint stroke (the ``stroke`` collection of a stroke operator) as a dict holding every
+    field this Blender's `OperatorStrokeElement` has (4.2 refuses a dict without ``pen_flip``)."""
+    element = {"name": "", "location": tuple(location), "mouse": tuple(mouse), "mouse_event": tuple(mouse),
+               "pressure": float(pressure), "size": 0.0, "x_tilt": 0.0, "y_tilt": 0.0, "time": 0.0,
+               "is_start": bool(first), "pen_flip": False}
+    known = set(bpy.types.OperatorStrokeElement.bl_rna.properties.keys())
+    return {key: value for key, value in element.items() if key in known}
+
+
+def _inputs(mod):
+    """5.2+: the struct whose attributes are the modifier's inputs by identifier; None before."""
+    props = getattr(mod, "properties", None)
+    return getattr(props, "inputs", None)
+
+
+def set_modifier_input(mod, identifier, value):
+    """Set a geometry-nodes modifier's group input ``identifier`` (e.g. ``"Socket_2"``) to ``value``."""
+    inputs = _inputs(mod)
+    if inputs is None:
+        mod[identifier] = value
+    else:
+        getattr(inputs, identifier).value = value
+
+
+def get_modifier_input(mod, identifier):
+    """The value of a geometry-nodes modifier's group input ``identifier``."""
+    inputs = _inputs(mod)
+    return mod[identifier] if inputs is None else getattr(inputs, identifier).value
+
+
+def has_uv_tangent_node():
+    """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
+    return hasattr(bpy.types, "GeometryNodeUVTangent")
