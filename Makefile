@@ -1,10 +1,11 @@
-# Tessera: `make demo` (the main job) and `make test` (every tier). Both set up .venv first.
+# Tessera: `make demo` (the main job), `make test` (every tier, on the newest Blender this machine's Pythons run)
+# and `make test-all` (every tier on each supported Blender: 4.2, 4.5, 5.0, 5.1, 5.2). Each sets up its venvs.
 PY := .venv/bin/python
 # Keep Blender's user folder and caches out of $HOME for the demo and the build.
 export BLENDER_USER_RESOURCES ?= $(CURDIR)/out/.blender_user
 export XDG_CACHE_HOME ?= $(CURDIR)/out/.cache
 
-.PHONY: setup demo test lint build bench clean
+.PHONY: setup demo test test-all lint build bench clean
 
 setup:
 	@bash tools/setup.sh
@@ -18,6 +19,9 @@ lint: setup
 test: setup
 	$(PY) -m ruff check .
 	$(PY) -m pytest
+
+test-all:
+	@bash tools/matrix.sh
 
 build: setup
 	$(PY) tools/build_extension.py

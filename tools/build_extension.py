@@ -1,9 +1,10 @@
 """Build the Tessera extension zips with Blender's own builder, one per platform, wheels bundled.
 
 Steps: validate the source manifest (tags checked against Blender's list); download the wheels of
-pyopencl and its pure-Python needs for each platform, at the versions installed in this venv (the
-ones the tests ran with); stage a copy of the tree whose manifest lists them; build with
-``blender_ext.py build --split-platforms``; validate each zip. numpy is not bundled: Blender ships it.
+pyopencl and its pure-Python needs for each platform and for each Python the supported Blenders use (3.11 for
+4.2-5.0, 3.13 for 5.1 and 5.2), at the versions installed in this venv (the ones the tests ran with); stage a copy
+of the tree whose manifest lists them; build with ``blender_ext.py build --split-platforms``; validate each zip.
+Blender installs the wheels that match its own Python. numpy is not bundled: Blender ships it.
 
 Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
 """
@@ -18,7 +19,7 @@ from importlib import metadata
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-# Blender platform -> pip platform tags for cp311 binary wheels.
+# Blender platform -> pip platform tags for the binary wheels.
 PLATFORMS = {
     "linux-x64": ["manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux_2_17_x86_64", "manylinux2014_x86_64"],
     "windows-x64": ["win_amd64"],
@@ -27,6 +28,8 @@ PLATFORMS = {
 }
 BINARY = ("pyopencl", "siphash24")
 PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl")
+#: The Pythons of the supported Blenders: 4.2, 4.5 and 5.0 use 3.11; 5.1 and 5.2 use 3.13.
+PYTHONS = ("3.11", "3.13")
 IGNORE = shutil.ignore_patterns(".git", ".venv*", "out", "dist", "wheels", "__pycache__", ".pytest_cache",
                                 ".ruff_cache", ".hypothesis", "*.zip")
 
@@ -38,10 +41,10 @@ def blender_ext(*args):
     subprocess.run([sys.executable, "-c", code, *args], check=True)
 
 
-def pip_download(spec, dest, platforms=None):
+def pip_download(spec, dest, platforms=None, python=None):
     cmd = [sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--only-binary=:all:", "-d", str(dest)]
     if platforms:
-        cmd += ["--python-version", "3.11", "--implementation", "cp"]
+        cmd += ["--python-version", python, "--implementation", "cp"]
         for tag in platforms:
             cmd += ["--platform", tag]
     subprocess.run(cmd + [spec], check=True)
@@ -53,11 +56,13 @@ def fetch_wheels(dest):
     for name in PURE:
         pip_download(f"{name}=={metadata.version(name)}", dest)
     for platform, tags in PLATFORMS.items():
-        for name in BINARY:
-            try:
-                pip_download(f"{name}=={metadata.version(name)}", dest, tags)
-            except subprocess.CalledProcessError as err:
-                raise SystemExit(f"No {name} wheel for {platform} (cp311); the zip cannot be built") from err
+        for python in PYTHONS:
+            for name in BINARY:
+                try:
+                    pip_download(f"{name}=={metadata.version(name)}", dest, tags, python)
+                except subprocess.CalledProcessError as err:
+                    raise SystemExit(f"No {name} wheel for {platform} (Python {python}); the zip cannot be "
+                                     "built") from err
     return sorted(p.name for p in dest.glob("*.whl"))
 
 

@@ -1,0 +1,106 @@
+"""One SHA-256 per kernel family over the bytes of its outputs on fixed inputs (numpy backend).
+
+`make test-all` runs this in every Blender's environment (NumPy 1.26 on Python 3.11, NumPy 2.x on 3.13) and fails
+when two environments disagree: the kernels must give the same bytes whatever NumPy they run on.
+
+Usage: python tools/kernel_digest.py   (prints one JSON object: family -> hex digest)
+"""
+
+import hashlib
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _import_tessera():
+    folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
+    (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
+    sys.path.insert(0, str(folder))
+
+
+def _digest(*arrays):
+    h = hashlib.sha256()
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _torus(major=12, minor=8, seed=3):
+    u = np.linspace(0, 2 * np.pi, major, endpoint=False)[:, None]
+    w = np.linspace(0, 2 * np.pi, minor, endpoint=False)[None, :]
+    x, y = (1 + 0.35 * np.cos(w)) * np.cos(u), (1 + 0.35 * np.cos(w)) * np.sin(u)
+    z = np.broadcast_to(0.35 * np.sin(w), x.shape)
+    v = np.stack([x, y, z], -1).reshape(-1, 3)
+    v = (v + np.random.default_rng(seed).normal(scale=0.02, size=v.shape)).astype(np.float32)
+    i, j = np.meshgrid(np.arange(major), np.arange(minor), indexing="ij")
+    a, b = i * minor + j, ((i + 1) % major) * minor + j
+    c, d = ((i + 1) % major) * minor + (j + 1) % minor, i * minor + (j + 1) % minor
+    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return v, f.astype(np.int32)
+
+
+def tessellation():
+    from tessera.kernels.common.mesh_arrays import MeshArrays
+    from tessera.kernels.tessellation.tessellate import tessellate, uniform_levels
+
+    v, f = _torus()
+    n = v / np.linalg.norm(v, axis=1, keepdims=True)
+    mesh = MeshArrays(v, f, point_normals=n.astype(np.float32))
+    out = []
+    for method in ("PN", "PHONG"):
+        levels = uniform_levels(mesh, 3.0) + np.random.default_rng(1).random(len(uniform_levels(mesh, 3.0))) * 4
+        for spacing in ("EQUAL", "FRACTIONAL_EVEN"):
+            t = tessellate(mesh, levels, spacing=spacing, method=method, backend="numpy").mesh
+            out += [t.positions, t.triangles, t.corner_normals if t.corner_normals is not None else t.point_normals]
+    return _digest(*out)
+
+
+def tubes():
+    from tessera.kernels.tubes.builder import TubeSettings, build_tubes
+    from tessera.kernels.tubes.polylines import Polylines
+
+    rng = np.random.default_rng(5)
+    pts = np.cumsum(rng.normal(size=(40 * 12, 3)), axis=0).astype(np.float32)
+    lines = Polylines.build(pts, np.arange(0, 40 * 12 + 1, 12), radius=0.1)
+    out = []
+    for caps in ("NONE", "ROUND"):
+        m = build_tubes(lines, TubeSettings(sides=7, caps=caps, uvs=True), backend="numpy")
+        out += [np.asarray(getattr(m, name)) for name in ("positions", "normals", "uvs") if getattr(m, name, None)
+                is not None]
+    return _digest(*out)
+
+
+def terrain():
+    from tessera.kernels.common.camera import Camera
+    from tessera.kernels.terrain import heightmap_io as hio
+    from tessera.kernels.terrain.analysis import tile_table
+    from tessera.kernels.terrain.lod import TerrainLod, select
+    from tessera.kernels.terrain.mesh import bake
+    from tessera.kernels.terrain.synth import ridged_terrain
+
+    hm = hio.from_array(ridged_terrain(129, seed=2), texel_size=2.0, scale=60.0)
+    table = tile_table(hm, 16, backend="numpy")
+    cam = Camera.looking_at((10.0, -150.0, 90.0), (0.0, 0.0, 10.0), far=1e4)
+    out = []
+    for levels in ("POW2", "FRACTIONAL"):
+        sel = select(hm, table, cam, TerrainLod(levels=levels))
+        m = bake(hm, table, sel)
+        out += [sel.edge, sel.inner, m.positions, m.triangles]
+    return _digest(*out)
+
+
+def main():
+    _import_tessera()
+    print(json.dumps({"numpy": np.__version__, "tessellation": tessellation(), "tubes": tubes(),
+                      "terrain": terrain()}))
+
+
+if __name__ == "__main__":
+    main()
