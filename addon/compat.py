@@ -8,7 +8,7 @@ ask for it, and the version is compared only where the difference cannot be seen
   `set_split_custom_normals`, `CUSTOM_NORMAL_STORAGE_ERROR`);
 - stroke elements: 4.2's `OperatorStrokeElement` requires ``pen_flip`` when built from Python (`stroke_element`);
 - geometry-nodes modifier inputs: ``mod[identifier] = value`` until 5.1, ``mod.properties.inputs`` from 5.2
-  (`set_modifier_input`, `get_modifier_input`);
+  (`set_modifier_input`);
 - the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`).
 """
 
@@ -61,12 +61,6 @@ def set_modifier_input(mod, identifier, value):
         mod[identifier] = value
     else:
         getattr(inputs, identifier).value = value
-
-
-def get_modifier_input(mod, identifier):
-    """The value of a geometry-nodes modifier's group input ``identifier``."""
-    inputs = _inputs(mod)
-    return mod[identifier] if inputs is None else getattr(inputs, identifier).value
 
 
 def has_uv_tangent_node():

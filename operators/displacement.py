@@ -13,8 +13,7 @@ import mathutils
 import numpy as np
 
 from ..addon import bridge
-from ..addon.compat import UV_TANGENT_MESSAGE
-from ..addon.displacement import nodes as displace_nodes
+from ..addon.compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS
@@ -95,7 +94,7 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
     def execute(self, context, tx):
         ob = context.active_object
         channels = 1 if self.mode == "HEIGHT" else 3
-        if self.mode == "VECTOR" and self.space == "TANGENT" and not displace_nodes.available():
+        if self.mode == "VECTOR" and self.space == "TANGENT" and not has_uv_tangent_node():
             raise InvalidInputError(UV_TANGENT_MESSAGE)
         budget = get_preferences(context).memory_budget_bytes
         data = None

@@ -46,11 +46,12 @@ def _bake_into(context, ob, camera, report, tx):
     wm = context.window_manager
     hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)))
     t0 = time.perf_counter()
-    sel = select(hm, table, object_camera(camera, ob.matrix_world) if camera else None, lod_settings(s))
+    local_camera = object_camera(camera, ob.matrix_world) if camera else None
+    sel = select(hm, table, local_camera, lod_settings(s))
     t_select = time.perf_counter() - t0
     n_tris = triangle_count(sel)
     if n_tris == 0:  # every tile culled: say which of the camera's settings keeps the terrain out
-        raise EmptyResultError(_nothing_seen(hm, table, object_camera(camera, ob.matrix_world)))
+        raise EmptyResultError(_nothing_seen(hm, table, local_camera))
     budget = get_preferences(context).memory_budget_bytes
     if budget and n_tris * _BYTES_PER_TRIANGLE > budget:
         raise BudgetError(f"The terrain mesh would have {n_tris:,} triangles (about "

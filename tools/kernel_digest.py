@@ -18,9 +18,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _import_tessera():
+    """The source tree as the package ``tessera``, and the tests' mesh builders as ``meshes``."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(folder))
+    sys.path[:0] = [str(folder), str(ROOT / "tests")]
 
 
 def _digest(*arrays):
@@ -32,30 +33,18 @@ def _digest(*arrays):
     return h.hexdigest()
 
 
-def _torus(major=12, minor=8, seed=3):
-    u = np.linspace(0, 2 * np.pi, major, endpoint=False)[:, None]
-    w = np.linspace(0, 2 * np.pi, minor, endpoint=False)[None, :]
-    x, y = (1 + 0.35 * np.cos(w)) * np.cos(u), (1 + 0.35 * np.cos(w)) * np.sin(u)
-    z = np.broadcast_to(0.35 * np.sin(w), x.shape)
-    v = np.stack([x, y, z], -1).reshape(-1, 3)
-    v = (v + np.random.default_rng(seed).normal(scale=0.02, size=v.shape)).astype(np.float32)
-    i, j = np.meshgrid(np.arange(major), np.arange(minor), indexing="ij")
-    a, b = i * minor + j, ((i + 1) % major) * minor + j
-    c, d = ((i + 1) % major) * minor + (j + 1) % minor, i * minor + (j + 1) % minor
-    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    return v, f.astype(np.int32)
-
-
 def tessellation():
+    from meshes import random_closed
     from tessera.kernels.common.mesh_arrays import MeshArrays
     from tessera.kernels.tessellation.tessellate import tessellate, uniform_levels
 
-    v, f = _torus()
+    v, f = random_closed(3, major=12, minor=8)
     n = v / np.linalg.norm(v, axis=1, keepdims=True)
     mesh = MeshArrays(v, f, point_normals=n.astype(np.float32))
+    base = uniform_levels(mesh, 3.0)
+    levels = base + np.random.default_rng(1).random(len(base)) * 4
     out = []
     for method in ("PN", "PHONG"):
-        levels = uniform_levels(mesh, 3.0) + np.random.default_rng(1).random(len(uniform_levels(mesh, 3.0))) * 4
         for spacing in ("EQUAL", "FRACTIONAL_EVEN"):
             t = tessellate(mesh, levels, spacing=spacing, method=method, backend="numpy").mesh
             out += [t.positions, t.triangles, t.corner_normals if t.corner_normals is not None else t.point_normals]

@@ -19,6 +19,7 @@ from ...kernels.common.opencl_runtime import get_runtime
 from ...kernels.displacement.map_buffer import MapBuffer
 from ...kernels.displacement.map_strokes import TileUndo, run_stroke, stroke_dabs, union_region
 from .. import bridge
+from ..compat import has_uv_tangent_node
 from . import nodes as displace_nodes
 
 MODIFIER_NAME = "Tessera Displacement"
@@ -157,7 +158,7 @@ def sync_modifier(ob):
     settings = ob.tessera.displacement
     mod = ob.modifiers.get(MODIFIER_NAME)
     kind = modifier_kind(settings)
-    if settings.image is None or (kind == "NODES" and not displace_nodes.available()):
+    if settings.image is None or (kind == "NODES" and not has_uv_tangent_node()):
         if mod is not None:
             mod.show_viewport = mod.show_render = False
         return None

@@ -17,11 +17,6 @@ INPUTS = (("Image", "NodeSocketImage"), ("UV Map", "NodeSocketString"), ("Mid-Le
 _VERSION = 1  # bump when the graph changes: older groups in a file are rebuilt
 
 
-def available():
-    """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
-    return has_uv_tangent_node()
-
-
 class _Graph:
     """Small helper to add nodes and links to a node tree."""
 
@@ -108,7 +103,7 @@ def _build(tree):
 
 def node_group():
     """The group, built on first use (and rebuilt when an older version is in the file)."""
-    if not available():
+    if not has_uv_tangent_node():
         raise TesseraError(UV_TANGENT_MESSAGE)
     tree = bpy.data.node_groups.get(GROUP_NAME)
     if tree is not None and tree.get("tessera_version") == _VERSION:

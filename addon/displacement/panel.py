@@ -2,9 +2,8 @@
 
 import bpy
 
-from ..compat import UV_TANGENT_MESSAGE
+from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
 from ..sidebar import Sidebar
-from . import nodes as displace_nodes
 from .brush_tool import draw_brush_settings
 
 
@@ -24,7 +23,7 @@ class TESSERA_PT_displacement(Sidebar, bpy.types.Panel):
         layout.prop(settings, "mode")
         if settings.mode == "VECTOR":
             layout.prop(settings, "space")
-            if settings.space == "TANGENT" and not displace_nodes.available():
+            if settings.space == "TANGENT" and not has_uv_tangent_node():
                 layout.label(text=f"{UV_TANGENT_MESSAGE}: the map is not shown", icon="ERROR")
         layout.prop_search(settings, "uv_map", context.active_object.data, "uv_layers")
         layout.prop(settings, "mid_level")
