@@ -6,8 +6,9 @@ Cases on a smooth-shaded Suzanne (968 triangles):
   evaluated to about the same triangle count (level 5), rates compared in triangles per second.
 - ``floor``: writing the kernel's output arrays once (positions, normals, triangles, UVs) into preallocated
   arrays; the kernel's time over it is the distance from the memory-bandwidth floor.
-- ``operator``: ``tessera.tessellate`` end to end (read, tessellate, write a new object) against adding the
-  modifier and applying it to the mesh, triangles per second.
+- ``operator_<method>_<shading>``: ``tessera.tessellate`` end to end (read, tessellate, write a new object) against
+  adding the modifier and applying it to the mesh, triangles per second, on the smooth-shaded Suzanne and on the
+  flat-shaded one (what *Add > Monkey* gives: every edge sharp, split corner normals written as custom normals).
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tessellation.py
 """
 
@@ -127,15 +128,19 @@ def main():
                  "pn_seconds": pn["seconds"], "phong_speedup": round(pn["seconds"] / phong["seconds"], 2)})
 
     enable_extension()  # the operator, registered as for an installed extension
-    apply_seconds, apply_tris = subsurf_apply(bpy, ob)
-    for method in ("PHONG", "PN"):
-        seconds, n = operator_run(bpy, ob, method)
-        rate, base = n / seconds, apply_tris / apply_seconds
-        rows.append({"bench": "tessellation", "case": f"operator_{method.lower()}", "output_triangles": n,
-                     "seconds": round(seconds, 4), "triangles_per_second": round(rate),
-                     "baseline": f"SUBSURF level {SUBSURF_LEVEL} add + apply", "baseline_triangles": apply_tris,
-                     "baseline_seconds": round(apply_seconds, 4), "speedup": round(rate / base, 2),
-                     "speedup_vs_evaluation_only": round(rate / sub_rate, 2)})
+    for shading in ("smooth", "flat"):  # flat: what Add > Monkey gives (every edge sharp, split corner normals)
+        bpy.context.view_layer.objects.active = ob
+        ob.select_set(True)
+        getattr(bpy.ops.object, f"shade_{shading}")()
+        apply_seconds, apply_tris = subsurf_apply(bpy, ob)
+        for method in ("PHONG", "PN"):
+            seconds, n = operator_run(bpy, ob, method)
+            rate, base = n / seconds, apply_tris / apply_seconds
+            rows.append({"bench": "tessellation", "case": f"operator_{method.lower()}_{shading}",
+                         "output_triangles": n, "seconds": round(seconds, 4), "triangles_per_second": round(rate),
+                         "baseline": f"SUBSURF level {SUBSURF_LEVEL} add + apply ({shading}-shaded)",
+                         "baseline_triangles": apply_tris, "baseline_seconds": round(apply_seconds, 4),
+                         "speedup": round(rate / base, 2), "speedup_vs_evaluation_only": round(rate / sub_rate, 2)})
     for row in rows:
         print(json.dumps(row))
 

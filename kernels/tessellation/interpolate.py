@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common.errors import TesseraError
 from ..common.opencl_runtime import get_runtime
-from .refine_templates import scatter_rows, stamp
+from .refine_templates import scatter_rows, stamp, triangle_starts
 
 #: Below this many output rows the numpy path is used even when OpenCL is available (launch overhead).
 OPENCL_MIN_ROWS = 1 << 15
@@ -151,10 +151,7 @@ def _corner_values_by_class(ref, values):
     if len(ref.classes) == 1:
         cls = ref.classes[0]
         return stamp(_slot_values(ref, cls, flat), cls.triangles.ravel()).reshape((ref.n_triangles, 3) + tail)
-    counts = np.zeros(n_faces, np.int64)
-    for cls in ref.classes:
-        counts[cls.faces] = len(cls.triangles)
-    starts = np.cumsum(counts) - counts
+    starts = triangle_starts(ref.classes, n_faces)
     out = np.empty((ref.n_triangles, 3, flat.shape[2]), dtype=np.float32)
     for cls in ref.classes:
         block = stamp(_slot_values(ref, cls, flat), cls.triangles.ravel())

@@ -207,6 +207,24 @@ def scatter_rows(out, cls, starts, block):
         out[(starts[cls.faces][:, None] + np.arange(k)).ravel()] = block.reshape((f * k,) + out.shape[1:])
 
 
+def triangle_starts(classes, n_faces):
+    """First output triangle of every face of a class-built refinement: (T,) int64 (faces in order, each
+    face's triangles contiguous, as `refine_by_class` writes them)."""
+    counts = np.zeros(n_faces, np.int64)
+    for cls in classes:
+        counts[cls.faces] = len(cls.triangles)
+    return np.cumsum(counts) - counts
+
+
+def slot_bary(cls):
+    """Barycentric coordinates of every vertex slot of a class's pattern: (slots, 3) float64, taken from the
+    pattern's corner barycentrics (so a slot's value equals what a per-corner evaluation would give)."""
+    n_slots = 3 + len(cls.slot_edge) + len(cls.interior_bary)
+    out = np.zeros((n_slots, 3))
+    out[cls.triangles.ravel()] = cls.corner_bary.reshape(-1, 3)
+    return out
+
+
 def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing):
     """Same contract as `kernels.tessellation.refine.refine`, built per pattern class. Returns a `Refinement`."""
     edge_f, edge_n, inner_f, inner_n = levels

@@ -25,7 +25,7 @@ from . import patches
 from .interpolate import corner_values, face_values, normalized, point_values
 from .normals import NORMAL_MODES, shared_vertex_normals, split_by_normals, split_corners
 from .refine import refine, refinement_counts
-from .surface_eval import evaluate_corners, evaluate_surface
+from .surface_eval import evaluate_corners, evaluate_corners_by_class, evaluate_surface
 
 METHODS = ("LINEAR", "PHONG", "PN")
 NORMAL_FIELDS = ("QUADRATIC", "LINEAR")
@@ -238,9 +238,14 @@ def _shading_normals(ref, method, options, positions, vertex_normals, corner_nor
                                   face_fn(positions[ref.faces], vertex_normals[ref.faces]), face_basis, unit=True)
     if split is None or not split.any():
         return points, None
-    corners = points[ref.triangles]
     faces = np.flatnonzero(split.any(axis=1))
     own = face_fn(positions[ref.faces[faces]], corner_normals[faces])  # the split faces' own normal fields
+    if ref.classes:  # once per vertex slot of each split face, stamped onto its corners
+        every = len(faces) == len(ref.faces)  # flat shading: no corner takes the point normal
+        corners = np.empty((ref.n_triangles, 3, points.shape[1]), np.float32) if every else points[ref.triangles]
+        evaluate_corners_by_class(ref, faces, own, face_basis, corners, unit=True)
+        return points, corners
+    corners = points[ref.triangles]
     control = np.zeros((len(ref.faces),) + own.shape[1:])
     control[faces] = own
     out_tris = np.flatnonzero(np.isin(ref.triangle_face, faces))

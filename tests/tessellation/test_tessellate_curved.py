@@ -159,6 +159,30 @@ def test_class_path_equals_point_path(method, monkeypatch):
     np.testing.assert_allclose(by_class.point_normals, by_point.point_normals, rtol=1e-6, atol=1e-6)
 
 
+@pytest.mark.parametrize("method", ["PN", "PHONG"])
+@pytest.mark.parametrize("flat_share", [0.5, 1.0])
+def test_split_corner_normals_per_class_equal_the_general_path(method, flat_share, monkeypatch):
+    """Split faces' normal fields evaluated once per vertex slot and stamped equal the per-corner evaluation of the
+    general refinement; positions and topology are the same bytes (flat_share 1.0: every face flat, Add > Monkey)."""
+    from tessera.kernels.tessellation import refine_templates
+
+    mesh = sharp_mesh(5)
+    if flat_share == 1.0:
+        face_n = face_unit_normals(mesh.positions, mesh.triangles)
+        mesh.corner_normals = np.repeat(face_n[:, None, :], 3, axis=1).astype(np.float32)
+    levels = uniform_levels(mesh, 6)
+    levels[::4] = 3.0  # several classes, faces of a class not consecutive
+    by_class = tessellate(mesh, levels, method=method, backend="numpy")
+    assert len(by_class.refinement.classes) > 1
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
+    general = tessellate(mesh, levels, method=method, backend="numpy")
+    assert not general.refinement.classes
+    assert by_class.mesh.positions.tobytes() == general.mesh.positions.tobytes()
+    assert by_class.mesh.triangles.tobytes() == general.mesh.triangles.tobytes()
+    np.testing.assert_allclose(by_class.mesh.corner_normals, general.mesh.corner_normals, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(np.linalg.norm(by_class.mesh.corner_normals, axis=2), 1.0, atol=1e-6)
+
+
 def test_per_vertex_alpha_attribute():
     mesh = sharp_mesh(4)
     levels = uniform_levels(mesh, 4)
