@@ -42,7 +42,7 @@ class MapState:
         self.steps = {}  # serial -> TileUndo of the stroke that produced it
         runtime = get_runtime()
         self.device = MapBuffer(runtime, self.host) if runtime is not None else None
-        self.backend = "opencl" if self.device is not None else "numpy"
+        self.backend = "auto" if self.device is not None else "numpy"  # with a device: per dab, by footprint
 
     def to_image(self, image, region=None):
         """Write the map (or the rows/columns of ``region``) into the image pixels and tag its users."""

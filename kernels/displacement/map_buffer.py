@@ -26,6 +26,7 @@ class MapBuffer:
         self._scratch = None
         self._scratch_bytes = 0
         self._stamp = (None, None)  # (host array, device buffer) of the last stamp
+        self._stale = None  # bounding box of host-side edits not yet on the device (see `mark_stale`)
 
     @property
     def row_bytes(self):
@@ -57,9 +58,24 @@ class MapBuffer:
         self.host[y0:y1, x0:x1] = tile
         return True
 
+    def mark_stale(self, region):
+        """Note a host-side edit of ``region`` (x0, y0, x1, y1) that the device does not have yet; the next device
+        operation copies it over first (`sync`). Many small edits then cost one copy, not one call each."""
+        s = self._stale
+        self._stale = region if s is None else (min(s[0], region[0]), min(s[1], region[1]), max(s[2], region[2]),
+                                                max(s[3], region[3]))
+
+    def sync(self):
+        """Bring the device up to date with the host edits noted by `mark_stale`; returns the device buffer."""
+        if self._stale is not None:
+            self.push(self._stale)
+        return self.buf
+
     def push(self, region=None):
         """Copy the host rectangle (default: all of it) to the device after a host-side edit."""
         h, w = self.host.shape[:2]
+        if region is None or region == self._stale:
+            self._stale = None
         origin, size = self._rect(region or (0, 0, w, h))
         self.runtime.cl.enqueue_copy(self.runtime.queue, self.buf, self.host, buffer_origin=origin,
                                      host_origin=origin, region=size, buffer_pitches=(self.row_bytes,),
@@ -85,6 +101,7 @@ class MapBuffer:
         """
         cl = self.runtime.cl
         h, w, c = self.host.shape
+        self.sync()
         if self._scratch_bytes != self.host.nbytes:
             self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, self.host.nbytes)
             self._scratch_bytes = self.host.nbytes

@@ -21,6 +21,11 @@ from .map_buffer import MapBuffer
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
+#: With a device-resident map and the ``auto`` backend, dabs whose footprint has fewer texels than this run in numpy
+#: on the host. Measured with `bench/brushes.py` on PoCL (2 CPU cores): a device dab costs about 0.25 ms before
+#: its first texel, numpy about 0.02 µs a texel, so numpy wins below ~10k texels and ties around radius 64 (16.6k
+#: texels); the limit sits past the tie, at radius 90, so a stroke never runs slower than numpy.
+NUMPY_MAX_TEXELS = 181 * 181
 
 
 #: Memory per texel of a map being edited: Blender's float RGBA image (16 B), the RGBA mirror written to it
@@ -274,8 +279,12 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     The dab's parameters are a `DabParams` (``dab``) or its fields as keywords.
 
     ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
-    footprint moves; without it the footprint tile is uploaded and read back. ``before_write(region)`` is
-    called once every check has passed and before anything is written (undo records the region there).
+    footprint moves; without it the footprint tile is uploaded and read back. With a device, ``backend`` picks
+    per dab: ``"opencl"`` always runs on the device; ``"auto"`` runs footprints of fewer than `NUMPY_MAX_TEXELS`
+    texels in numpy on the host (a launch and read-back cost more than the arithmetic there) and marks them for
+    the device, which gets them before its next operation (`MapBuffer.mark_stale`); ``"numpy"`` always does that.
+    ``before_write(region)`` is called once every check has passed and before anything is written (undo records
+    the region there).
     """
     check_map(dmap)
     if device is not None and device.host is not dmap:
@@ -292,6 +301,9 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
     runtime = _backend_runtime(backend, device)
+    on_host = device is not None and (backend == "numpy" or (backend == "auto" and _area(region) < NUMPY_MAX_TEXELS))
+    if on_host:
+        runtime = None
     if before_write is not None:
         before_write(region)
     if runtime is None:
@@ -303,9 +315,16 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
             else:
                 numpy_fn(tile, x0, y0)
         _commit(dmap, region, tile)
+        if on_host:
+            device.mark_stale(region)
     else:
         _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
     return region
+
+
+def _area(region):
+    x0, y0, x1, y1 = region
+    return (x1 - x0) * (y1 - y0)
 
 
 def smooth_map(dmap, strength=1.0, backend="auto", device=None):
@@ -353,7 +372,7 @@ def _run_opencl(runtime, dmap, region, name, args, halo, device):
     x0, y0, x1, y1 = region
     w, h, channels = x1 - x0, y1 - y0, dmap.shape[2]
     if device is not None:
-        buf, base, mem_w = device.buf, (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
+        buf, base, mem_w = device.sync(), (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
     else:
         tile = dmap[y0:y1, x0:x1].copy()  # scratch (a copy even when the region is the whole map)
         buf, base, mem_w = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w

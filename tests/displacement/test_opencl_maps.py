@@ -56,16 +56,46 @@ def test_device_resident_map_equals_the_numpy_reference(opencl):
         b = a.copy()
         device = MapBuffer(opencl, a)
         for kind, params in _random_dabs(rng, channels):
-            assert apply_dab(a, kind, device=device, **params) == apply_dab(b, kind, backend="numpy", **params)
+            assert apply_dab(a, kind, device=device, backend="opencl", **params) == apply_dab(b, kind, backend="numpy",
+                                                                                               **params)
         smooth_map(a, 0.7, device=device)
         smooth_map(b, 0.7, backend="numpy")
         assert np.allclose(a, b, rtol=0, atol=1e-5), np.abs(a - b).max()
         b[3:9, 5:40] = 2.5  # a host-side edit (undo, a file) pushed to the device is seen by the next dab
         a[...] = b
         device.push()
-        apply_dab(a, "SMOOTH", device=device, pos=(20, 6), radius=9, strength=1.0)
+        apply_dab(a, "SMOOTH", device=device, backend="opencl", pos=(20, 6), radius=9, strength=1.0)
         apply_dab(b, "SMOOTH", backend="numpy", pos=(20, 6), radius=9, strength=1.0)
         assert np.allclose(a, b, rtol=0, atol=FLOAT32_PATH_ATOL)
+
+
+def test_auto_backend_picks_per_dab_and_keeps_the_device_in_step(opencl, monkeypatch):
+    """With a device and ``auto``, small footprints run in numpy on the host and are copied to the device, large
+    ones run on the device: the map ends where the reference ends, and the device copy equals the host."""
+    from tessera.kernels.displacement import map_edit
+    from tessera.kernels.displacement.map_buffer import MapBuffer
+    from tessera.kernels.displacement.map_strokes import Brush, run_stroke
+
+    monkeypatch.setattr(map_edit, "NUMPY_MAX_TEXELS", 15 * 15)  # radius 7 and under on the host
+    launches = []
+    run = map_edit._run_opencl
+    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args: (launches.append(args[2]), run(*args))[1])
+    rng = np.random.default_rng(12)
+    a = rng.normal(size=(70, 90, 1)).astype(np.float32)
+    b = a.copy()
+    device = MapBuffer(opencl, a)
+    for kind, radius in (("DRAW", 4.0), ("SMOOTH", 12.0), ("SMOOTH", 3.0), ("FLATTEN", 10.0), ("DRAW", 20.0)):
+        brush = Brush(kind=kind, radius=radius, strength=0.3, spacing=0.3)
+        path = rng.uniform(0, 70, size=(4, 3))
+        path[:, 2] = rng.uniform(0.2, 1.0, 4)
+        run_stroke(a, brush, path, backend="auto", device=device)
+        run_stroke(b, brush, path, backend="numpy")
+    assert np.allclose(a, b, rtol=0, atol=FLOAT32_PATH_ATOL), np.abs(a - b).max()
+    on_device = np.empty_like(a)
+    opencl.cl.enqueue_copy(opencl.queue, on_device, device.sync())
+    assert on_device.tobytes() == a.tobytes()
+    big = [r for r in launches if (r[2] - r[0]) * (r[3] - r[1]) >= 15 * 15]
+    assert launches and len(big) == len(launches)  # the device ran the large dabs, and only those
 
 
 def test_morphing_kernel_equals_numpy(opencl):
@@ -112,7 +142,7 @@ def test_non_finite_results_never_reach_the_map_or_the_device(opencl):
         with pytest.raises(TesseraError, match="NaN or infinite"):
             apply_custom(m, compile_custom(opencl, "image = (float4)(NAN);"), opencl, device=dev)
         assert m.tobytes() == before.tobytes()
-    for dev, backend in ((None, "opencl"), (device, "auto")):
+    for dev, backend in ((None, "opencl"), (device, "auto"), (device, "opencl")):
         with pytest.raises(InvalidInputError, match="NaN or infinite"):
             apply_dab(m, "DRAW", backend=backend, device=dev, pos=(20, 20), radius=30, strength=3e38,
                       vector=(3e38, 3e38, 3e38, 3e38), falloff="CONSTANT")
