@@ -17,6 +17,8 @@ OPENCL_MIN_ROWS = 1 << 15
 BACKENDS = ("auto", "numpy", "opencl")
 #: Faces per float64 product in `_slot_values` (keeps the temporary in cache).
 CHUNK_FACES = 256
+#: Rows per block of `gather_weighted_numpy` (its float64 temporaries stay in cache).
+GATHER_CHUNK = 1 << 14
 
 
 def gather_weighted_numpy(values, idx, weights):
@@ -25,10 +27,16 @@ def gather_weighted_numpy(values, idx, weights):
     values: (K, C) float; idx: (n, q) int; weights: (n, q) float. Returns (n, C) float32, accumulated in
     float64 and rounded once.
     """
-    acc = np.zeros((len(idx), values.shape[1]), dtype=np.float64)
-    for tap in range(idx.shape[1]):
-        acc += weights[:, tap, None] * values[idx[:, tap]]
-    return acc.astype(np.float32)
+    n, channels = len(idx), values.shape[1]
+    out = np.empty((n, channels), dtype=np.float32)
+    for lo in range(0, n, GATHER_CHUNK):  # the same products and sums, row block by row block (stays in cache)
+        hi = min(n, lo + GATHER_CHUNK)
+        i, w = idx[lo:hi], weights[lo:hi]
+        acc = np.zeros((hi - lo, channels), dtype=np.float64)
+        for tap in range(idx.shape[1]):
+            acc += w[:, tap, None] * values[i[:, tap]]
+        out[lo:hi] = acc
+    return out
 
 
 def gather_weighted_opencl(runtime, values, idx, weights):
