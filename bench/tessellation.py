@@ -9,6 +9,10 @@ Cases on a smooth-shaded Suzanne (968 triangles):
 - ``operator_<method>_<shading>``: ``tessera.tessellate`` end to end (read, tessellate, write a new object) against
   adding the modifier and applying it to the mesh, triangles per second, on the smooth-shaded Suzanne and on the
   flat-shaded one (what *Add > Monkey* gives: every edge sharp, split corner normals written as custom normals).
+- ``operator_pn_adaptive``: adaptive PN (fractional-even, projected edge length of 3 px for a 1920x1080 camera)
+  end to end against the operator at the uniform level giving about as many triangles, per output triangle.
+- ``first_call``: in a fresh process, importing bpy, enabling Tessera and the first operator call, against a warm
+  call of the same operator.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tessellation.py
 """
 
@@ -70,12 +74,13 @@ def subsurf_apply(bpy, ob):
     return best, n
 
 
-def operator_run(bpy, ob, method):
+def operator_run(bpy, ob, method, **options):
     best, n = float("inf"), 0
+    options = {"level": LEVEL, **options}
     for _ in range(REPEAT):
         bpy.context.view_layer.objects.active = ob
         t = time.perf_counter()
-        bpy.ops.tessera.tessellate(method=method, level=LEVEL)
+        bpy.ops.tessera.tessellate(method=method, **options)
         best = min(best, time.perf_counter() - t)
         new = bpy.context.active_object
         n = len(new.data.polygons)
@@ -141,8 +146,74 @@ def main():
                          "baseline": f"SUBSURF level {SUBSURF_LEVEL} add + apply ({shading}-shaded)",
                          "baseline_triangles": apply_tris, "baseline_seconds": round(apply_seconds, 4),
                          "speedup": round(rate / base, 2), "speedup_vs_evaluation_only": round(rate / sub_rate, 2)})
+    rows.append(adaptive_case(bpy, ob))
+    rows.append(first_call_case())
     for row in rows:
         print(json.dumps(row))
+
+
+def adaptive_case(bpy, ob):
+    """Adaptive PN (fractional-even spacing, projected edge length for a camera) end to end, against the operator at
+    the uniform level that gives about as many triangles, in triangles per second."""
+    import mathutils
+
+    bpy.ops.object.shade_smooth()
+    cam = bpy.data.objects.new("bench_camera", bpy.data.cameras.new("bench_camera"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location = (0.0, -2.6, 0.4)
+    cam.rotation_euler = (mathutils.Vector((0, 0, 0)) - cam.location).to_track_quat("-Z", "Y").to_euler()
+    bpy.context.scene.camera = cam
+    render = bpy.context.scene.render
+    render.resolution_x, render.resolution_y, render.resolution_percentage = 1920, 1080, 100
+    adaptive = {"level_mode": "ADAPTIVE", "spacing": "FRACTIONAL_EVEN", "metrics": {"PROJECTED"}, "edge_pixels": 3.0,
+                "max_level": 64.0}
+    seconds, n = operator_run(bpy, ob, "PN", **adaptive)
+    level = np.sqrt(n / len(ob.data.loop_triangles) / 1.5)  # floor(3 l^2 / 2) triangles a face
+    uniform_seconds, uniform_n = operator_run(bpy, ob, "PN", level=float(np.ceil(level)))
+    rate, base = n / seconds, uniform_n / uniform_seconds
+    return {"bench": "tessellation", "case": "operator_pn_adaptive", "output_triangles": n,
+            "seconds": round(seconds, 4), "triangles_per_second": round(rate),
+            "baseline": f"the operator at uniform level {int(np.ceil(level))} (PN, equal spacing)",
+            "baseline_triangles": uniform_n, "baseline_seconds": round(uniform_seconds, 4),
+            "per_triangle_ratio": round(base / rate, 2), "target_per_triangle_ratio": 1.3}
+
+
+FIRST_CALL = """
+import sys, time
+t0 = time.perf_counter()
+sys.path.insert(0, {bench!r})
+from _setup import enable_extension, import_path
+import_path()
+import bpy
+t1 = time.perf_counter()
+bpy.ops.wm.read_factory_settings(use_empty=True)
+enable_extension()
+t2 = time.perf_counter()
+bpy.ops.mesh.primitive_monkey_add()
+times = []
+for _ in range(3):
+    t = time.perf_counter()
+    bpy.ops.tessera.tessellate(method="PN", level=8)
+    times.append(time.perf_counter() - t)
+    bpy.context.view_layer.objects.active = bpy.data.objects["Suzanne"]
+print(t1 - t0, t2 - t1, times[0], min(times[1:]))
+"""
+
+
+def first_call_case():
+    """A fresh process: importing bpy, enabling Tessera, the first ``tessera.tessellate`` (modules imported,
+    worker threads started), against a warm call of the same operator."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = FIRST_CALL.format(bench=str(Path(__file__).resolve().parent))
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    imp, enable, first, warm = (float(x) for x in out.stdout.split()[-4:])
+    return {"bench": "tessellation", "case": "first_call", "import_bpy_seconds": round(imp, 3),
+            "enable_seconds": round(enable, 3), "first_operator_seconds": round(first, 4),
+            "baseline": "a warm call of the same operator (PN level 8 on Suzanne)", "baseline_seconds": round(warm, 4),
+            "first_over_warm": round(first / warm, 1)}
 
 
 if __name__ == "__main__":

@@ -110,11 +110,36 @@ def corner_values(ref, values, backend="auto"):
         raise TesseraError(f"Corner attribute has shape {values.shape}; expected ({n_faces}, 3, ...)")
     if ref.face_class is not None and backend != "opencl":
         return _corner_values_by_class(ref, values)
+    if backend not in BACKENDS:
+        raise TesseraError(f"Unknown compute backend {backend!r}; expected one of {', '.join(BACKENDS)}")
+    if backend != "opencl":  # numpy wins here: no (3M, 3) index to build or upload
+        return _corner_values_by_triangle(ref, values)
     flat = values.reshape(n_faces * 3, -1)
     source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)  # (M, 3) source corners
     idx = np.repeat(source, 3, axis=0)  # one row per output corner
     out = gather_weighted(flat, idx, ref.corner_bary.reshape(-1, 3), backend)
     return out.reshape((ref.n_triangles, 3) + values.shape[2:])
+
+
+def _corner_values_by_triangle(ref, values):
+    """`corner_values` on the general refinement, in numpy: each output corner weighs its face's three corner values
+    by its barycentrics, in blocks of output triangles. The same products and sums, in the same order, as
+    `gather_weighted_numpy` over the corners, without building the (3M, 3) gather index."""
+    n_faces = len(ref.faces)
+    flat = np.asarray(values).reshape(n_faces, 3, -1)
+    tail = values.shape[2:]
+    out = np.empty((ref.n_triangles, 3, flat.shape[2]), dtype=np.float32)
+    faces, bary = ref.triangle_face, ref.corner_bary
+    step = max(1, GATHER_CHUNK // 3)
+    for lo in range(0, ref.n_triangles, step):
+        hi = min(ref.n_triangles, lo + step)
+        src = flat[faces[lo:hi]]  # (n, 3, C): the face's corner values
+        w = bary[lo:hi]  # (n, 3 output corners, 3 face corners)
+        acc = np.zeros((hi - lo, 3, flat.shape[2]), dtype=np.float64)
+        for tap in range(3):
+            acc += w[:, :, tap, None] * src[:, None, tap, :]
+        out[lo:hi] = acc
+    return out.reshape((ref.n_triangles, 3) + tail)
 
 
 def _slot_values(ref, cls, values):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from meshes import random_closed, torus
-from tessera.kernels.common.errors import BudgetError, InvalidInputError
+from tessera.kernels.common.errors import BudgetError, InvalidInputError, TesseraError
 from tessera.kernels.common.mesh_arrays import MeshArrays
 from tessera.kernels.common.tolerances import LINEAR_REPRODUCTION_ATOL
 from tessera.kernels.common.topology import triangle_edges
@@ -120,6 +120,24 @@ def test_corner_values_by_class_equal_the_gather(monkeypatch):
     from tessera.kernels.tessellation.interpolate import gather_weighted_numpy
     gathered = gather_weighted_numpy(flat, np.repeat(source, 3, axis=0), ref.corner_bary.reshape(-1, 3))
     np.testing.assert_allclose(by_class.reshape(-1, 2), gathered, rtol=1e-6, atol=1e-6)
+
+
+def test_corner_values_on_the_general_path_equal_the_gather_bit_for_bit(monkeypatch):
+    from tessera.kernels.tessellation import refine_templates
+    from tessera.kernels.tessellation.interpolate import gather_weighted_numpy
+
+    mesh, *_ = mesh_with_attributes(3)
+    levels = np.random.default_rng(4).uniform(1, 9, len(triangle_edges(mesh.triangles)[0]))
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
+    ref = refine(mesh.triangles, len(mesh.positions), levels, spacing="FRACTIONAL_EVEN")
+    assert ref.face_class is None
+    uv = mesh.corner_attributes["uv"]
+    source = ref.triangle_face.astype(np.int64)[:, None] * 3 + np.arange(3)
+    gathered = gather_weighted_numpy(uv.reshape(-1, 2), np.repeat(source, 3, axis=0), ref.corner_bary.reshape(-1, 3))
+    for backend in ("auto", "numpy"):
+        assert corner_values(ref, uv, backend=backend).tobytes() == gathered.tobytes()
+    with pytest.raises(TesseraError, match="backend"):
+        corner_values(ref, uv, backend="cuda")
 
 
 def one_value_per_vertex(triangles, corner):
