@@ -157,7 +157,7 @@ def adaptive_case(bpy, ob):
     the uniform level that gives about as many triangles, in triangles per second."""
     import mathutils
 
-    bpy.ops.object.shade_smooth()
+    ob.data.shade_smooth()  # the loops above left it flat-shaded
     cam = bpy.data.objects.new("bench_camera", bpy.data.cameras.new("bench_camera"))
     bpy.context.scene.collection.objects.link(cam)
     cam.location = (0.0, -2.6, 0.4)

@@ -111,15 +111,21 @@ def evaluate_surface(ref, corner_values, edge_control, edge_basis, face_control,
     return out
 
 
-def evaluate_corners(ref, triangles, face_control, face_basis):
-    """A face field at the corners of some output triangles: (m,) ids -> (m, 3, C) float64.
+def evaluate_corners(ref, triangles, face_control, face_basis, out, unit=False):
+    """A face field at the corners of some output triangles, written into ``out`` (M, 3, C) at rows ``triangles``.
 
-    Uses ``ref.corner_bary``; for fields that differ between the faces of a shared vertex (split normals).
+    triangles: (m,) output triangle ids; face_control: (T, k, C); face_basis as in `evaluate_surface`. Evaluated per
+    corner from ``ref.corner_bary`` in float64 blocks, normalised when ``unit``, rounded once into ``out``; for
+    fields that differ between the faces of a shared vertex (split normals) on any refinement.
     """
-    faces = ref.triangle_face[triangles]
-    bary = ref.corner_bary[triangles].reshape(-1, 3)
-    b = face_basis(bary).reshape(len(triangles), 3, -1)
-    return np.einsum("mck,mkd->mcd", b, face_control[faces])
+    step = max(1, CHUNK // 3)
+    for lo in range(0, len(triangles), step):  # blocks: the gathered controls and products stay small
+        tris = triangles[lo : lo + step]
+        b = face_basis(ref.corner_bary[tris].reshape(-1, 3)).reshape(len(tris), 3, -1)
+        vals = np.einsum("mck,mkd->mcd", b, face_control[ref.triangle_face[tris]])
+        if unit:
+            normalize_channels([vals[..., c] for c in range(vals.shape[2])])
+        out[tris] = vals
 
 
 def evaluate_corners_by_class(ref, faces, face_control, face_basis, out, unit=False):

@@ -249,7 +249,7 @@ def _shading_normals(ref, method, options, positions, vertex_normals, corner_nor
     control = np.zeros((len(ref.faces),) + own.shape[1:])
     control[faces] = own
     out_tris = np.flatnonzero(np.isin(ref.triangle_face, faces))
-    corners[out_tris] = normalized(evaluate_corners(ref, out_tris, control, face_basis))
+    evaluate_corners(ref, out_tris, control, face_basis, corners, unit=True)
     return points, corners
 
 
