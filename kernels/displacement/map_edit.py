@@ -300,10 +300,8 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     if kind == "SMOOTH":
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
-    runtime = _backend_runtime(backend, device)
     on_host = device is not None and (backend == "numpy" or (backend == "auto" and _area(region) < NUMPY_MAX_TEXELS))
-    if on_host:
-        runtime = None
+    runtime = None if on_host else _backend_runtime(backend, device)
     if before_write is not None:
         before_write(region)
     if runtime is None:

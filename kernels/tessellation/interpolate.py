@@ -21,6 +21,15 @@ CHUNK_FACES = 256
 GATHER_CHUNK = 1 << 14
 
 
+def _weighted_sum(terms, shape):
+    """``sum(w * v)`` over the ``(w, v)`` pairs of ``terms`` in order, from a float64 zero of ``shape``: the one
+    summation of the numpy gathers, so every path that uses it gives the same bits."""
+    acc = np.zeros(shape, dtype=np.float64)
+    for w, v in terms:
+        acc += w * v
+    return acc
+
+
 def gather_weighted_numpy(values, idx, weights):
     """Reference weighted gather.
 
@@ -32,10 +41,8 @@ def gather_weighted_numpy(values, idx, weights):
     for lo in range(0, n, GATHER_CHUNK):  # the same products and sums, row block by row block (stays in cache)
         hi = min(n, lo + GATHER_CHUNK)
         i, w = idx[lo:hi], weights[lo:hi]
-        acc = np.zeros((hi - lo, channels), dtype=np.float64)
-        for tap in range(idx.shape[1]):
-            acc += w[:, tap, None] * values[i[:, tap]]
-        out[lo:hi] = acc
+        out[lo:hi] = _weighted_sum(((w[:, tap, None], values[i[:, tap]]) for tap in range(idx.shape[1])),
+                                   (hi - lo, channels))
     return out
 
 
@@ -135,10 +142,8 @@ def _corner_values_by_triangle(ref, values):
         hi = min(ref.n_triangles, lo + step)
         src = flat[faces[lo:hi]]  # (n, 3, C): the face's corner values
         w = bary[lo:hi]  # (n, 3 output corners, 3 face corners)
-        acc = np.zeros((hi - lo, 3, flat.shape[2]), dtype=np.float64)
-        for tap in range(3):
-            acc += w[:, :, tap, None] * src[:, None, tap, :]
-        out[lo:hi] = acc
+        out[lo:hi] = _weighted_sum(((w[:, :, tap, None], src[:, None, tap, :]) for tap in range(3)),
+                                   (hi - lo, 3, flat.shape[2]))
     return out.reshape((ref.n_triangles, 3) + tail)
 
 

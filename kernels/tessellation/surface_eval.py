@@ -139,14 +139,12 @@ def evaluate_corners_by_class(ref, faces, face_control, face_basis, out, unit=Fa
     """
     if len(faces) == 0:
         return
-    chosen = np.zeros(len(ref.faces), bool)
-    chosen[faces] = True
-    row_of = np.full(len(ref.faces), -1, np.int64)
+    row_of = np.full(len(ref.faces), -1, np.int64)  # row of each chosen face in face_control, -1 elsewhere
     row_of[faces] = np.arange(len(faces))
     starts = triangle_starts(ref.classes, len(ref.faces))
     channels = face_control.shape[2]
     for cls in ref.classes:
-        sub = cls.faces[chosen[cls.faces]]
+        sub = cls.faces[row_of[cls.faces] >= 0]
         if len(sub) == 0:
             continue
         basis_t = np.ascontiguousarray(face_basis(slot_bary(cls)).T)  # (k, slots)
