@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up the virtual environment of one supported Blender and, on Debian as root, the system pieces:
-# Blender's X/GL libraries, Mesa EGL + llvmpipe (headless GPU context) and the PoCL OpenCL ICD.
+# Blender's X/GL libraries, Mesa EGL + llvmpipe (headless GPU context), the PoCL OpenCL ICD, and OpenSubdiv
+# (libosd-dev) with g++ for the subdivision oracle the tests build (out/osd/libosd_loop.so).
 #
 #   tools/setup.sh          .venv for the newest Blender this machine's Pythons can run (5.2 with Python 3.13,
 #                           else 5.0 with Python 3.11): `make demo` and `make test` use it
@@ -41,6 +42,7 @@ system_packages=(
   libx11-6 libxext6 libxrender1 libxfixes3 libxi6 libxkbcommon0 libxxf86vm1 libsm6 libice6
   libgl1 libegl1 libegl-mesa0 libgl1-mesa-dri
   ocl-icd-libopencl1 pocl-opencl-icd
+  libosd-dev g++
 )
 
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -56,6 +58,15 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
   fi
 else
   echo "setup: not root on Debian; make sure these are installed: ${system_packages[*]} (tiers missing them are skipped)"
+fi
+
+# The OpenSubdiv Loop oracle of the tests and benches (tools/osd_oracle), rebuilt when its source changes.
+osd_src=tools/osd_oracle/osd_loop.cpp osd_lib=out/osd/libosd_loop.so
+if [ -f /usr/include/opensubdiv/far/topologyRefiner.h ] && command -v g++ >/dev/null 2>&1 \
+    && { [ ! -f "$osd_lib" ] || [ "$osd_src" -nt "$osd_lib" ]; }; then
+  mkdir -p out/osd
+  g++ -O2 -std=c++14 -shared -fPIC "$osd_src" -o "$osd_lib.tmp" -losdCPU && mv "$osd_lib.tmp" "$osd_lib"
+  echo "setup: built $osd_lib"
 fi
 
 version=${1:-}
