@@ -258,7 +258,7 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
 
     out_points = {}
     at = 3
-    for name, w in zip(point_data, widths):
+    for name, w in zip(point_data, widths, strict=True):
         out_points[name] = data[:, at : at + w].astype(dtype).reshape((-1, *point_shapes[name]))
         at += w
     return LoopResult(

@@ -40,8 +40,8 @@ def load():
         lib = ctypes.CDLL(str(LIBRARY))
         p = ctypes.c_void_p
         lib.osd_loop_refine.restype = p
-        lib.osd_loop_refine.argtypes = [ctypes.c_int] * 2 + [p, ctypes.c_int, p, ctypes.c_int, p, p, ctypes.c_int, p, p] + [
-            ctypes.c_int] * 3 + [ctypes.c_int, p, p, ctypes.c_int]
+        i = ctypes.c_int
+        lib.osd_loop_refine.argtypes = [i, i, p, i, p, i, p, p, i, p, p, i, i, i, i, p, p, i]
         lib.osd_loop_sizes.argtypes = [p, p, p, p, p]
         lib.osd_loop_fetch.argtypes = [p, p, p, p, p]
         lib.osd_loop_free.argtypes = [p]
@@ -78,10 +78,10 @@ def loop_refine(values, triangles, level, creases=None, corners=None, boundary="
         fv = np.ascontiguousarray(fv, np.float64)
         fi = np.ascontiguousarray(fi, np.int32)
     handle = lib.osd_loop_refine(
-        len(values), len(tris), _ptr(tris), values.shape[1], _ptr(values), len(pairs), _ptr(pairs), _ptr(sharp), len(cv),
-        _ptr(cv), _ptr(cs),
-        BOUNDARY[boundary], int(level), 0 if fv is None else fv.shape[1], 0 if fv is None else len(fv), _ptr(fi),
-        _ptr(fv), FVAR[fvar_interp])
+        len(values), len(tris), _ptr(tris), values.shape[1], _ptr(values), len(pairs), _ptr(pairs), _ptr(sharp),
+        len(cv), _ptr(cv), _ptr(cs),
+        BOUNDARY[boundary], int(level), 0 if fv is None else fv.shape[1], 0 if fv is None else len(fv),
+        _ptr(fi), _ptr(fv), FVAR[fvar_interp])
     if not handle:
         raise ValueError("OpenSubdiv refused the topology")
     try:
