@@ -32,6 +32,7 @@ MAX_LEVELS = 6
 BOUNDARY_RULES = ("EDGE_ONLY", "EDGE_AND_CORNER")
 #: Bytes per output vertex, triangle and channel the estimate counts (float64 work arrays, int64 topology).
 BYTES_PER_VERTEX, BYTES_PER_TRIANGLE, BYTES_PER_CHANNEL = 8 * 3 * 3, 8 * 3 * 4, 8 * 3
+BLOCK = 1 << 14  # rows per block of the edge rule
 
 
 @dataclass
@@ -114,6 +115,8 @@ def _even(lv, values, lin, cf):
     smooth = values + cf[n][:, None] * (averaged - values)  # correction factor
     s_parent = lv.edge_sharpness
     sharp_p = s_parent > 0
+    if not sharp_p.any() and not lv.vertex_sharpness.any():  # no crease, corner or boundary: all smooth
+        return np.where((n == 0)[:, None], values, smooth)
     count_p = np.bincount(e0, sharp_p, lv.n_vertices) + np.bincount(e1, sharp_p, lv.n_vertices)
     rule_p = vertex_rule(lv.vertex_sharpness, count_p)
     rule_p[n == 0] = RULE_CORNER
@@ -146,19 +149,19 @@ def _odd(lv, values, lin):
     """New vertices on the level's edges (E, D): smooth edges by averaging over the 6 neighbours of the linear
     midpoint (a, b and the midpoints of the 4 other edges of the two faces) and cf(6); sharp ones stay at the
     midpoint; semi-sharp ones (0 < s < 1) blend the two."""
-    f0, f1 = lv.edge_faces[:, 0], lv.edge_faces[:, 1]
-    k0, k1 = lv.edge_local[:, 0], lv.edge_local[:, 1]
-    inner = f1 >= 0
-    f1, k1 = np.where(inner, f1, f0), np.where(inner, k1, k0)
-    t = lv.triangles
-    opp = np.stack([t[f0, (k0 + 2) % 3], t[f1, (k1 + 2) % 3]], axis=1)
+    inner = ~lv.boundary
+    opp = lv.opposite()
     opp.sort(axis=1)  # the two opposite vertices by id: the same sums whichever face comes first
-    pa, pb = values[lv.edges[:, 0]], values[lv.edges[:, 1]]
-    ring = pa + pb
-    for c in (values[opp[:, 0]], values[opp[:, 1]]):
-        ring += 0.5 * (pa + c) + 0.5 * (pb + c)  # the linear midpoints of the other edges of the two faces
-    averaged = 0.25 * lin + (0.75 / 6.0) * ring
-    smooth = lin + correction_factor(6) * (averaged - lin)
+    cf6 = correction_factor(6)
+    smooth = np.empty_like(lin)
+    for lo in range(0, len(lin), BLOCK):  # blocks keep the temporaries in cache
+        hi = min(lo + BLOCK, len(lin))
+        pa, pb = values[lv.edges[lo:hi, 0]], values[lv.edges[lo:hi, 1]]
+        ring = pa + pb
+        for c in (values[opp[lo:hi, 0]], values[opp[lo:hi, 1]]):
+            ring += 0.5 * (pa + c) + 0.5 * (pb + c)  # the linear midpoints of the other edges of the two faces
+        m = lin[lo:hi]
+        smooth[lo:hi] = m + cf6 * ((0.25 * m + (0.75 / 6.0) * ring) - m)  # averaging, correction factor
     s = lv.edge_sharpness.astype(np.float64)
     out = np.where((s >= 1.0)[:, None] | ~inner[:, None], lin, smooth)
     semi = inner & (s > 0) & (s < 1)
@@ -245,13 +248,13 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
     total = levels * (1 + len(fvars))
     for step in range(levels):
         data = loop_step(lv, data, correction_table(lv.valence.max(initial=6)))
-        lv = refine_level(lv)
+        lv = refine_level(lv, final=step == levels - 1)
         if progress is not None:
             progress(step * (1 + len(fvars)) + 1, total)
     for i, (name, (flv, fv)) in enumerate(fvars.items()):
         for step in range(levels):
             fv = loop_step(flv, fv, correction_table(flv.valence.max(initial=6)))
-            flv = refine_level(flv)
+            flv = refine_level(flv, final=step == levels - 1)
             if progress is not None:
                 progress(step * (1 + len(fvars)) + 2 + i, total)
         fvars[name] = fv[flv.triangles].astype(dtype).reshape((len(flv.triangles), 3, *corner_shapes[name]))
@@ -263,9 +266,9 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
         at += w
     return LoopResult(
         positions=data[:, :3].astype(dtype),
-        triangles=lv.triangles.astype(np.int32),
-        edges=lv.edges.astype(np.int32),
-        corner_edges=lv.face_edges.astype(np.int32),
+        triangles=lv.triangles.astype(np.int32, copy=False),
+        edges=lv.edges.astype(np.int32, copy=False),
+        corner_edges=lv.face_edges.astype(np.int32, copy=False),
         edge_sharpness=lv.edge_sharpness,
         point_attributes=out_points,
         corner_attributes=fvars,

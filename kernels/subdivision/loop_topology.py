@@ -20,25 +20,23 @@ from ..common.errors import InvalidInputError
 from ..common.topology import triangle_edges
 from .loop_rules import SHARPNESS_INFINITE, child_sharpness
 
-#: Child slot of the corner child at corners 0, 1, 2 (T, L, R); C is slot 2.
-CORNER_SLOT = np.array([0, 1, 3])
-
-
 @dataclass
 class LoopLevel:
     """One level's topology and creases.
 
-    triangles: (F, 3) int64; edges: (E, 2) int64 endpoints; face_edges: (F, 3) int64 edge of each local edge;
-    edge_faces: (E, 2) int64 the faces on each side (second -1 on a boundary); edge_local: (E, 2) int64 the
-    local edge index in those faces (-1); edge_sharpness: (E,) float32 OpenSubdiv sharpness (boundaries
-    infinite); vertex_sharpness: (V,) float32; valence: (V,) int64 incident faces.
+    triangles: (F, 3) int32; edges: (E, 2) int32 endpoints; face_edges: (F, 3) int32 edge of each local edge;
+    flip: (F, 3) bool, the local edge runs from ``edges[e, 1]`` to ``edges[e, 0]``; side: (F, 3) bool, the face
+    is the edge's second face; boundary: (E,) bool, edges with one face; edge_sharpness: (E,) float32
+    OpenSubdiv sharpness (boundaries infinite); vertex_sharpness: (V,) float32; valence: (V,) int64 incident
+    faces.
     """
 
     triangles: np.ndarray
     edges: np.ndarray
     face_edges: np.ndarray
-    edge_faces: np.ndarray
-    edge_local: np.ndarray
+    flip: np.ndarray
+    side: np.ndarray
+    boundary: np.ndarray
     edge_sharpness: np.ndarray
     vertex_sharpness: np.ndarray
     valence: np.ndarray
@@ -47,10 +45,13 @@ class LoopLevel:
     def n_vertices(self):
         return len(self.valence)
 
-    @property
-    def boundary(self):
-        """(E,) bool: edges with one face."""
-        return self.edge_faces[:, 1] < 0
+    def opposite(self):
+        """(E, 2) int64: the vertex opposite each edge in its first and second face (the first again on a
+        boundary)."""
+        opp = np.empty((len(self.edges), 2), np.int64)
+        opp[self.face_edges.ravel(), self.side.ravel().view(np.int8)] = self.triangles[:, [2, 0, 1]].ravel()
+        opp[self.boundary, 1] = opp[self.boundary, 0]
+        return opp
 
 
 def coarse_level(triangles, n_vertices, creases=None, vertex_sharpness=None, sharp_corners=False):
@@ -62,7 +63,7 @@ def coarse_level(triangles, n_vertices, creases=None, vertex_sharpness=None, sha
     Raises `InvalidInputError` for an edge with more than two faces.
     """
     tris = np.asarray(triangles, dtype=np.int64)
-    edges, face_edges, _ = triangle_edges(tris)
+    edges, face_edges, flipped = triangle_edges(tris)
     n_e = len(edges)
     flat = face_edges.ravel().astype(np.int64)
     count = np.bincount(flat, minlength=n_e)
@@ -74,11 +75,9 @@ def coarse_level(triangles, n_vertices, creases=None, vertex_sharpness=None, sha
         )
     order = np.argsort(flat, kind="stable")
     starts = np.cumsum(count) - count
-    edge_faces = np.full((n_e, 2), -1, np.int64)
-    edge_local = np.full((n_e, 2), -1, np.int64)
-    edge_faces[:, 0], edge_local[:, 0] = np.divmod(order[starts], 3)
+    side = np.zeros(len(flat), bool)
     two = count == 2
-    edge_faces[two, 1], edge_local[two, 1] = np.divmod(order[starts[two] + 1], 3)
+    side[order[starts[two] + 1]] = True
 
     sharp = np.zeros(n_e, np.float32)
     if creases is not None and len(creases[0]):
@@ -97,66 +96,68 @@ def coarse_level(triangles, n_vertices, creases=None, vertex_sharpness=None, sha
         on_boundary = np.zeros(n_vertices, bool)
         on_boundary[edges[~two].ravel()] = True
         vs[on_boundary & (valence == 1)] = SHARPNESS_INFINITE
-    return LoopLevel(tris, edges.astype(np.int64), face_edges.astype(np.int64), edge_faces, edge_local, sharp, vs,
-                     valence)
+    return LoopLevel(tris.astype(np.int32), edges.astype(np.int32), face_edges.astype(np.int32), flipped,
+                     side.reshape(-1, 3), ~two, sharp, vs, valence)
 
 
-def _half(lv, e, corner_vertex):
-    """Id of the half of edge ``e`` (K,) that touches ``corner_vertex`` (K,) on the next level."""
-    return 2 * e + (lv.edges[e, 0] != corner_vertex)
+# Children of a face, per slot (T, L, C, R) and local edge: the parent local edge it is a half of (-1: an inner
+# edge).
+_HALF_OF = np.array([[0, -1, 2], [0, 1, -1], [-1, -1, -1], [-1, 1, 2]])
 
 
-def refine_level(lv):
-    """The next `LoopLevel` (4 F triangles, V + E vertices, 2 E + 3 F edges), computed without sorting."""
+_TRIANGLE_PATTERN = np.array([0, 3, 5, 3, 1, 4, 3, 4, 5, 5, 4, 2])  # columns of (a, b, c, m0, m1, m2) per child
+_EDGE_PATTERN = np.array([0, 8, 5, 3, 1, 6, 6, 7, 8, 7, 4, 2])  # columns of (start0..2, end0..2, inner0..2)
+
+
+def refine_level(lv, final=False):
+    """The next `LoopLevel` (4 F triangles, V + E vertices, 2 E + 3 F edges), computed without sorting, int32.
+    final: only triangles, edges, face_edges and edge_sharpness (the last level: nothing is refined from it)."""
     n_f, n_v, n_e = len(lv.triangles), lv.n_vertices, len(lv.edges)
-    t, fe = lv.triangles, lv.face_edges
-    a, b, c = t[:, 0], t[:, 1], t[:, 2]
-    m0, m1, m2 = n_v + fe[:, 0], n_v + fe[:, 1], n_v + fe[:, 2]
-    tris = np.empty((n_f, 4, 3), np.int64)
-    tris[:, 0] = np.stack([a, m0, m2], axis=1)
-    tris[:, 1] = np.stack([m0, b, m1], axis=1)
-    tris[:, 2] = np.stack([m0, m1, m2], axis=1)
-    tris[:, 3] = np.stack([m2, m1, c], axis=1)
+    i32 = np.int32
+    fe = lv.face_edges
+    cols = np.empty((n_f, 9), i32)
+    cols[:, :3] = lv.triangles
+    np.add(fe, n_v, out=cols[:, 3:6])  # m0 = m_ab, m1 = m_bc, m2 = m_ca
+    tris = np.take(cols[:, :6], _TRIANGLE_PATTERN, axis=1).reshape(-1, 3)
 
-    inner = 2 * n_e + 3 * np.arange(n_f, dtype=np.int64)  # + k: edges (m0, m1), (m1, m2), (m2, m0)
-    face_edges = np.empty((n_f, 4, 3), np.int64)
-    face_edges[:, 0] = np.stack([_half(lv, fe[:, 0], a), inner + 2, _half(lv, fe[:, 2], a)], axis=1)
-    face_edges[:, 1] = np.stack([_half(lv, fe[:, 0], b), _half(lv, fe[:, 1], b), inner], axis=1)
-    face_edges[:, 2] = np.stack([inner, inner + 1, inner + 2], axis=1)
-    face_edges[:, 3] = np.stack([inner + 1, _half(lv, fe[:, 1], c), _half(lv, fe[:, 2], c)], axis=1)
+    # Halves: local edge k of face f (corner k -> k + 1) is edge e; its half at corner k is 2 e + flip, at
+    # corner k + 1 it is 2 e + 1 - flip. Inner edges 2 E + 3 f + k: (m0, m1), (m1, m2), (m2, m0).
+    m = cols[:, 3:6].copy()
+    np.multiply(fe, 2, out=cols[:, 3:6])
+    cols[:, 3:6] += lv.flip
+    np.multiply(fe, 2, out=cols[:, 6:9])
+    cols[:, 6:9] += 1
+    cols[:, 6:9] -= lv.flip
+    cols3 = np.empty((n_f, 12), i32)
+    cols3[:, :6] = cols[:, 3:9]
+    inner = cols3[:, 6:9]
+    inner[:] = np.arange(2 * n_e, 2 * n_e + 3 * n_f, 3, dtype=i32)[:, None]
+    inner += np.arange(3, dtype=i32)
+    face_edges = np.take(cols3[:, :9], _EDGE_PATTERN, axis=1).reshape(-1, 3)
 
-    edges = np.empty((2 * n_e + 3 * n_f, 2), np.int64)
-    mid = n_v + np.arange(n_e, dtype=np.int64)
-    edges[0 : 2 * n_e : 2] = np.stack([lv.edges[:, 0], mid], axis=1)
-    edges[1 : 2 * n_e : 2] = np.stack([mid, lv.edges[:, 1]], axis=1)
-    edges[2 * n_e :] = np.stack([m0, m1, m1, m2, m2, m0], axis=1).reshape(-1, 2)
+    edges = np.empty((2 * n_e + 3 * n_f, 2), i32)
+    halves = edges[: 2 * n_e].reshape(n_e, 2, 2)
+    halves[:, 0, 0] = lv.edges[:, 0]
+    halves[:, 1, 1] = lv.edges[:, 1]
+    halves[:, 0, 1] = halves[:, 1, 0] = np.arange(n_v, n_v + n_e, dtype=i32)
+    inner_edges = edges[2 * n_e :].reshape(n_f, 3, 2)
+    inner_edges[:, :, 0] = m
+    inner_edges[:, :, 1] = m[:, [1, 2, 0]]
+    sharp = np.repeat(child_sharpness(lv.edge_sharpness), 2)
+    sharp = np.concatenate([sharp, np.zeros(3 * n_f, np.float32)])
+    if final:
+        return LoopLevel(tris, edges, face_edges, None, None, None, sharp, None, None)
 
-    # Faces beside each half edge: in old face f with local edge k, the half at endpoint p lies in the corner
-    # child of p's corner, at local index k.
-    edge_faces = np.full((len(edges), 2), -1, np.int64)
-    edge_local = np.full((len(edges), 2), -1, np.int64)
-    for side in (0, 1):
-        f, k = lv.edge_faces[:, side], lv.edge_local[:, side]
-        ok = f >= 0
-        f, k = f[ok], k[ok]
-        e = np.flatnonzero(ok)
-        for end in (0, 1):
-            corner = np.where(t[f, k] == lv.edges[e, end], k, (k + 1) % 3)
-            edge_faces[2 * e + end, side] = 4 * f + CORNER_SLOT[corner]
-            edge_local[2 * e + end, side] = k
-    # Inner edge k of face f: the C child at local k, and the corner child L (k=0, local 2), R (k=1, local 0) or
-    # T (k=2, local 1).
-    f = np.arange(n_f, dtype=np.int64)
-    for k, (slot, local) in enumerate(((1, 2), (3, 0), (0, 1))):
-        edge_faces[inner + k, 0], edge_local[inner + k, 0] = 4 * f + 2, k
-        edge_faces[inner + k, 1], edge_local[inner + k, 1] = 4 * f + slot, local
-
-    sharp = np.zeros(len(edges), np.float32)
-    sharp[: 2 * n_e] = np.repeat(child_sharpness(lv.edge_sharpness), 2)
+    # Halves keep their parent's direction and side; the C child is the first face of every inner edge and runs
+    # along it, the corner child is the second and runs against it.
+    half = _HALF_OF >= 0
+    of = np.maximum(_HALF_OF, 0)
+    new_flip = np.where(half, lv.flip[:, of], np.arange(4)[:, None] != 2).reshape(-1, 3)
+    new_side = np.where(half, lv.side[:, of], np.arange(4)[:, None] != 2).reshape(-1, 3)
+    boundary = np.concatenate([np.repeat(lv.boundary, 2), np.zeros(3 * n_f, bool)])
     valence = np.concatenate([lv.valence, np.where(lv.boundary, 3, 6)])
     vs = np.concatenate([child_sharpness(lv.vertex_sharpness), np.zeros(n_e, np.float32)])
-    return LoopLevel(tris.reshape(-1, 3), edges, face_edges.reshape(-1, 3), edge_faces, edge_local, sharp, vs,
-                     valence)
+    return LoopLevel(tris, edges, face_edges, new_flip, new_side, boundary, sharp, vs, valence)
 
 
 def level_counts(n_vertices, n_edges, n_faces, levels):
