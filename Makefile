@@ -27,6 +27,7 @@ build: setup
 	$(PY) tools/build_extension.py
 
 bench: setup
+	$(PY) -m pip install -q -r requirements/bench.txt
 	@for f in bench/*.py; do $(PY) $$f || exit 1; done
 
 clean:

@@ -64,7 +64,7 @@ def read_mesh(mesh):
     mesh.calc_loop_triangles()
     n_tris = len(mesh.loop_triangles)
     if n_tris == 0:
-        raise InvalidInputError(f"Mesh {mesh.name!r} has no faces to tessellate")
+        raise InvalidInputError(f"Mesh {mesh.name!r} has no faces to work on")
     n_verts = len(mesh.vertices)
     tri_verts = _get(mesh.loop_triangles, "vertices", n_tris, np.int32, 3)
     tri_loops = _get(mesh.loop_triangles, "loops", n_tris, np.int32, 3)
@@ -100,6 +100,45 @@ def read_mesh(mesh):
             continue
         arrays.attribute_types[name] = dtype
     return arrays, info
+
+
+@dataclass
+class EdgeMarks:
+    """What a subdivision keeps sharp, as Blender marks it.
+
+    pairs: (K, 2) int32 vertex ids of the marked edges; crease: (K,) float32 in 0..1 (an edge marked sharp
+    counts as crease 1); vertex_crease: (V,) float32 or None; n_gons: faces with more than three corners (they
+    are triangulated when read); loose_edges: edges in no face.
+    """
+
+    pairs: np.ndarray
+    crease: np.ndarray
+    vertex_crease: np.ndarray | None
+    n_gons: int
+    loose_edges: int
+
+
+def read_edge_marks(mesh):
+    """`EdgeMarks` of a `bpy.types.Mesh`: the ``crease_edge`` and ``sharp_edge`` edge attributes, the
+    ``crease_vert`` point attribute, the count of n-gons and of loose edges."""
+    n_e, n_p = len(mesh.edges), len(mesh.polygons)
+    crease = np.zeros(n_e, np.float32)
+    attr = mesh.attributes.get("crease_edge")
+    if attr is not None and attr.domain == "EDGE" and attr.data_type == "FLOAT":
+        crease = _get(attr.data, "value", n_e, np.float32)
+    attr = mesh.attributes.get("sharp_edge")
+    if attr is not None and attr.domain == "EDGE" and attr.data_type == "BOOLEAN":
+        crease = np.where(_get(attr.data, "value", n_e, bool), np.float32(1.0), crease)
+    marked = np.flatnonzero(crease > 0)
+    pairs = _get(mesh.attributes[".edge_verts"].data, "value", n_e, np.int32, 2)[marked] if n_e else np.zeros((0, 2))
+    vertex_crease = None
+    attr = mesh.attributes.get("crease_vert")
+    if attr is not None and attr.domain == "POINT" and attr.data_type == "FLOAT":
+        vertex_crease = _get(attr.data, "value", len(mesh.vertices), np.float32)
+    sizes = _get(mesh.polygons, "loop_total", n_p, np.int32)
+    corner_edge = _get(mesh.attributes[".corner_edge"].data, "value", len(mesh.loops), np.int32)
+    loose = n_e - int(np.count_nonzero(np.bincount(corner_edge, minlength=n_e)))
+    return EdgeMarks(pairs.astype(np.int32), crease[marked], vertex_crease, int(np.count_nonzero(sizes > 3)), loose)
 
 
 def corner_tangents(mesh, uv_map):

@@ -1,4 +1,9 @@
-"""What an operator leaves selected: its results, the last one active."""
+"""What a mesh operator reads and leaves: the source mesh (the evaluated object for a new object, its own mesh for
+Replace), the result placed beside the source or swapped into it, and the results selected, the last one active."""
+
+import bpy
+
+from ..addon import bridge
 
 
 def select_only(context, objects):
@@ -9,3 +14,48 @@ def select_only(context, objects):
         ob.select_set(True)
     if objects:
         context.view_layer.objects.active = objects[-1]
+
+
+def read_source(context, ob, output):
+    """`bridge.read_mesh` of what the operator works on: the object with its modifiers evaluated for a new
+    object, its own mesh data for ``output == "REPLACE"``. Returns ``(arrays, info, marks)`` (marks:
+    `bridge.read_edge_marks`)."""
+    if output == "NEW_OBJECT":
+        evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
+        source = evaluated.to_mesh()
+    else:
+        evaluated, source = None, ob.data
+    try:
+        arrays, info = bridge.read_mesh(source)
+        marks = bridge.read_edge_marks(source)
+    finally:
+        if evaluated is not None:
+            evaluated.to_mesh_clear()
+    return arrays, info, marks
+
+
+def place_mesh(context, tx, ob, mesh, output, suffix):
+    """Put ``mesh`` in the scene: swapped into ``ob`` (REPLACE; the old mesh removed if nothing else uses it,
+    undone on rollback) or as a new object ``<ob.name>.<suffix>`` in ``ob``'s collections with its transform and
+    object-linked materials, selected and active. Returns the object that holds it."""
+    for material in ob.data.materials:
+        mesh.materials.append(material)
+    if output == "REPLACE":
+        old = ob.data
+        ob.data = mesh
+        tx.on_rollback(lambda: setattr(ob, "data", old))
+        if old.users == 0:
+            old_name = old.name
+            bpy.data.meshes.remove(old)
+            mesh.name = old_name
+        return ob
+    new = tx.new_object(f"{ob.name}.{suffix}", mesh)
+    for collection in ob.users_collection:
+        collection.objects.link(new)
+    new.matrix_world = ob.matrix_world.copy()
+    for src_slot, dst_slot in zip(ob.material_slots, new.material_slots, strict=False):
+        if src_slot.link == "OBJECT":
+            dst_slot.link = "OBJECT"
+            dst_slot.material = src_slot.material
+    select_only(context, [new])
+    return new

@@ -19,7 +19,7 @@ from ..addon.tessellation.settings import (
 from ..kernels.common.errors import GPUContextError
 from ..kernels.tessellation.adaptive import adaptive_levels
 from ..kernels.tessellation.tessellate import check_budget, estimate, tessellate, uniform_levels
-from .selection import select_only
+from .selection import place_mesh, read_source
 
 
 def _world_positions(positions, matrix):
@@ -76,7 +76,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
             self.report({"INFO"}, f"Not carried over (no interpolation for these types): {', '.join(skipped)}")
         for note in notes:
             self.report({"WARNING"}, note)
-        target = self._place(context, tx, ob, new_mesh)
+        target = place_mesh(context, tx, ob, new_mesh, self.output, "tessellated")
         for holder in {ob, target}:
             copy_settings(self, holder.tessera.tessellate)
             holder.tessera.tessellate.stored = True
@@ -91,16 +91,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
 
     def _build_mesh(self, context, ob, progress):
         """Read, tessellate and write; returns ``(mesh, skipped, notes)``. Creates nothing on failure."""
-        if self.output == "NEW_OBJECT":
-            evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
-            source = evaluated.to_mesh()
-        else:
-            evaluated, source = None, ob.data
-        try:
-            arrays, info = bridge.read_mesh(source)
-        finally:
-            if evaluated is not None:
-                evaluated.to_mesh_clear()
+        arrays, info, _ = read_source(context, ob, self.output)
         progress(0.1)
         edge_levels, inner_levels = self._levels(context, ob, arrays)
         budget = get_preferences(context).memory_budget_bytes
@@ -113,8 +104,6 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         )
         mesh = bridge.write_mesh(f"{ob.data.name}.tessellated", result.mesh, info,
                                  edges=result.refinement.output_edges())
-        for material in ob.data.materials:
-            mesh.materials.append(material)
         progress(1.0)
         return mesh, info.skipped, notes + result.notes
 
@@ -131,28 +120,6 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
 
         method, alpha, quadratic = self.method, self.alpha, self.pn_normals == "QUADRATIC"
         return lambda ref, inputs: evaluate_on_gpu(ref, inputs, method, alpha, quadratic)
-
-    def _place(self, context, tx, ob, mesh):
-        """Put the new mesh in the scene; returns the object that holds it."""
-        if self.output == "REPLACE":
-            old = ob.data
-            ob.data = mesh
-            tx.on_rollback(lambda: setattr(ob, "data", old))
-            if old.users == 0:
-                old_name = old.name
-                bpy.data.meshes.remove(old)
-                mesh.name = old_name
-            return ob
-        new = tx.new_object(f"{ob.name}.tessellated", mesh)
-        for collection in ob.users_collection:
-            collection.objects.link(new)
-        new.matrix_world = ob.matrix_world.copy()
-        for src_slot, dst_slot in zip(ob.material_slots, new.material_slots, strict=False):
-            if src_slot.link == "OBJECT":
-                dst_slot.link = "OBJECT"
-                dst_slot.material = src_slot.material
-        select_only(context, [new])
-        return new
 
 
 classes = (TESSERA_OT_tessellate,)

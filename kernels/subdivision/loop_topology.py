@@ -20,6 +20,7 @@ from ..common.errors import InvalidInputError
 from ..common.topology import triangle_edges
 from .loop_rules import SHARPNESS_INFINITE, child_sharpness
 
+
 @dataclass
 class LoopLevel:
     """One level's topology and creases.

@@ -363,8 +363,25 @@ def _mesh_object(bpy, name, verts, faces, edges=()):
 def test_tessellate_empty_and_degenerate_meshes(clean_scene, bpy_module, verts, faces, edges, words):
     bpy = bpy_module
     _mesh_object(bpy, "Bad", verts, faces, edges)
+    for op in (bpy.ops.tessera.tessellate, bpy.ops.tessera.loop_subdivide):
+        for output in ("NEW_OBJECT", "REPLACE"):
+            refused(bpy, op, words, output=output)
+
+
+def test_loop_subdivide_refuses_non_manifold_edges_and_oversized_results(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    fin = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1)]
+    _mesh_object(bpy, "Fins", fin, [(0, 1, 2), (1, 0, 3), (0, 1, 4)])
     for output in ("NEW_OBJECT", "REPLACE"):
-        refused(bpy, bpy.ops.tessera.tessellate, words, output=output)
+        refused(bpy, bpy.ops.tessera.loop_subdivide, ["1 edge", "non-manifold"], output=output)
+    bpy.ops.mesh.primitive_monkey_add()
+    prefs = addon_module("addon.preferences").get_preferences()
+    old = prefs.memory_budget_mb
+    prefs.memory_budget_mb = 64
+    try:
+        refused(bpy, bpy.ops.tessera.loop_subdivide, ["3,964,928 triangles", "budget"], levels=6)
+    finally:
+        prefs.memory_budget_mb = old
 
 
 @pytest.mark.parametrize("verts", [[(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 0, 0), (0, 0, 0), (0, 0, 0)],
@@ -376,6 +393,9 @@ def test_tessellate_degenerate_and_huge_triangles_give_finite_geometry(clean_sce
     counts = []
     for name, v in (("Regular", [(0, 0, 0), (1, 0, 0), (0, 1, 0)]), ("Odd", verts)):
         _mesh_object(bpy, name, v, [(0, 1, 2)])
+        assert bpy.ops.tessera.loop_subdivide(levels=3) == {"FINISHED"}
+        assert np.all(np.isfinite(np.array([p.co for p in bpy.context.active_object.data.vertices])))
+        select(bpy, bpy.data.objects[name])
         assert bpy.ops.tessera.tessellate(level=4, method="PN") == {"FINISHED"}
         out = bpy.context.active_object.data
         co = np.empty(len(out.vertices) * 3, np.float32)

@@ -1,0 +1,161 @@
+"""Loop subdivision (seed 002 §A.9, B3 and B6) against OpenSubdiv, VTK, trimesh and Blender, in one run.
+
+Cases (Suzanne, 968 triangles, smooth, except where said):
+- ``kernel_level_<L>`` for L = 1..6 (B3, time against output triangles): `kernels.subdivision.loop.loop_subdivide`
+  (positions, welded triangles, edges and corner edges) against OpenSubdiv's CPU Loop refinement of the same
+  mesh (Far::TopologyRefiner uniform refinement + PrimvarRefiner in double, the seconds its C++ measures, through
+  tools/osd_oracle); ``speedup`` > 1: Tessera is faster.
+- ``vtk_level_<L>``: the kernel against VTK's vtkLoopSubdivisionFilter (the Update call only) at L = 3..5.
+- ``trimesh_level_<L>``: the kernel against trimesh.remesh.subdivide_loop at L = 3..5.
+- ``operator_level_5`` (B6): ``tessera.loop_subdivide`` end to end (read, subdivide, write a new object) on the
+  flat-shaded Suzanne *Add > Monkey* gives, against adding Subdivision Surface level 5 and applying it, per output
+  triangle (Loop 991,232 triangles, Catmull-Clark 1,007,616).
+Timings are the best of REPEAT, the cases interleaved round by round. Prints one JSON object per case.
+Run: make bench, or .venv/bin/python bench/loop.py
+"""
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from _setup import enable_extension, import_path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools" / "osd_oracle"))
+REPEAT = 5
+SUBSURF_LEVEL, LOOP_LEVEL = 5, 5
+
+
+def suzanne(bpy, smooth):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.mesh.primitive_monkey_add()
+    if smooth:
+        bpy.ops.object.shade_smooth()
+    return bpy.context.active_object
+
+
+def timed(fn):
+    t = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t, out
+
+
+def vtk_filter(v, f, level):
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.ascontiguousarray(v, np.float64), deep=True))
+    cells = vtk.vtkCellArray()
+    conn = np.hstack([np.full((len(f), 1), 3), f]).astype(np.int64).ravel()
+    cells.SetCells(len(f), numpy_to_vtkIdTypeArray(conn, deep=True))
+    poly = vtk.vtkPolyData()
+    poly.SetPoints(points)
+    poly.SetPolys(cells)
+    filt = vtk.vtkLoopSubdivisionFilter()
+    filt.SetNumberOfSubdivisions(level)
+    filt.SetInputData(poly)
+
+    def run():
+        filt.Modified()
+        filt.Update()
+        return filt.GetOutput().GetNumberOfPolys()
+
+    return run
+
+
+def subsurf_apply(bpy, ob):
+    copy = ob.copy()
+    copy.data = ob.data.copy()
+    bpy.context.scene.collection.objects.link(copy)
+    bpy.context.view_layer.objects.active = copy
+    t = time.perf_counter()
+    mod = copy.modifiers.new("Subdivision", "SUBSURF")
+    mod.levels = SUBSURF_LEVEL
+    bpy.ops.object.modifier_apply(modifier=mod.name)
+    seconds = time.perf_counter() - t
+    n = 2 * len(copy.data.polygons)  # quads from level 1 on
+    me = copy.data
+    bpy.data.objects.remove(copy)
+    bpy.data.meshes.remove(me)
+    return seconds, n
+
+
+def loop_operator(bpy, ob):
+    bpy.context.view_layer.objects.active = ob
+    t = time.perf_counter()
+    assert bpy.ops.tessera.loop_subdivide(levels=LOOP_LEVEL) == {"FINISHED"}
+    seconds = time.perf_counter() - t
+    new = bpy.context.active_object
+    n = len(new.data.polygons)
+    me = new.data
+    bpy.data.objects.remove(new)
+    bpy.data.meshes.remove(me)
+    return seconds, n
+
+
+def row(case, seconds, n, base_name, base_seconds, base_n, **extra):
+    rate, base_rate = n / seconds, base_n / base_seconds
+    return {"bench": "loop", "case": case, "output_triangles": int(n), "seconds": round(seconds, 4),
+            "triangles_per_second": round(rate), "baseline": base_name, "baseline_triangles": int(base_n),
+            "baseline_seconds": round(base_seconds, 4), "baseline_triangles_per_second": round(base_rate),
+            "speedup": round(rate / base_rate, 2), **extra}
+
+
+def main():
+    import_path()
+    import bpy
+    import osd_oracle
+    from tessera.addon import bridge
+    from tessera.kernels.subdivision.loop import loop_subdivide
+    from trimesh.remesh import subdivide_loop
+
+    ob = suzanne(bpy, smooth=True)
+    arrays, _ = bridge.read_mesh(ob.data)
+    v, f = arrays.positions.astype(np.float64), arrays.triangles
+    rows = []
+    for level in range(1, 7):
+        best = {"ours": np.inf, "osd": np.inf, "vtk": np.inf, "trimesh": np.inf}
+        vtk_run = vtk_filter(v, f, level) if 3 <= level <= 5 else None
+        n = 0
+        for _ in range(REPEAT if level < 6 else 3):  # interleaved rounds
+            seconds, res = timed(lambda lv=level: loop_subdivide(v, f, lv))
+            best["ours"], n = min(best["ours"], seconds), len(res.triangles)
+            del res
+            ref = osd_oracle.loop_refine(v, f, level)
+            best["osd"] = min(best["osd"], ref.seconds_topology + ref.seconds_primvar)
+            assert len(ref.triangles) == n
+            del ref
+            if vtk_run is not None:
+                seconds, count = timed(vtk_run)
+                best["vtk"] = min(best["vtk"], seconds)
+                assert count == n
+                seconds, (_, tf) = timed(lambda lv=level: subdivide_loop(v, f, iterations=lv))
+                best["trimesh"] = min(best["trimesh"], seconds)
+        rows.append(row(f"kernel_level_{level}", best["ours"], n, "OpenSubdiv Far Loop (topology + primvar, C++)",
+                        best["osd"], n))
+        if vtk_run is not None:
+            rows.append(row(f"vtk_level_{level}", best["ours"], n, "vtkLoopSubdivisionFilter", best["vtk"], n))
+            rows.append(row(f"trimesh_level_{level}", best["ours"], n, "trimesh.remesh.subdivide_loop",
+                            best["trimesh"], n))
+        print(json.dumps(rows[-1 if vtk_run is None else -3]), flush=True)
+        if vtk_run is not None:
+            print(json.dumps(rows[-2]), flush=True)
+            print(json.dumps(rows[-1]), flush=True)
+
+    ob = suzanne(bpy, smooth=False)
+    enable_extension()  # after the factory settings are read
+    best_op, best_sub, n_op, n_sub = np.inf, np.inf, 0, 0
+    for _ in range(REPEAT):
+        seconds, n_op = loop_operator(bpy, ob)
+        best_op = min(best_op, seconds)
+        seconds, n_sub = subsurf_apply(bpy, ob)
+        best_sub = min(best_sub, seconds)
+    print(json.dumps(row(f"operator_level_{LOOP_LEVEL}", best_op, n_op,
+                         f"Subdivision Surface level {SUBSURF_LEVEL} add + apply", best_sub, n_sub,
+                         input="flat-shaded Suzanne (Add > Monkey)")), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,107 @@
+"""``tessera.loop_subdivide`` on Blender meshes (tier: blender): the kernel's result written as it is, creases
+from Blender's marks, UVs carried, open meshes, bad input refused with nothing changed."""
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+def select(bpy, ob):
+    for other in bpy.context.selected_objects:
+        other.select_set(False)
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+
+
+def arrays_of(me):
+    n_v, n_c, n_e = len(me.vertices), len(me.loops), len(me.edges)
+    pos = np.empty(n_v * 3, np.float32)
+    me.attributes["position"].data.foreach_get("vector", pos)
+    corners = np.empty(n_c, np.int32)
+    me.attributes[".corner_vert"].data.foreach_get("value", corners)
+    corner_edge = np.empty(n_c, np.int32)
+    me.attributes[".corner_edge"].data.foreach_get("value", corner_edge)
+    return pos.reshape(-1, 3), corners.reshape(-1, 3), np.bincount(corner_edge, minlength=n_e)
+
+
+def kernel_of(addon_module, bpy, ob, levels, **kw):
+    """The kernel's result on what the operator reads (the object's mesh, triangulated by Blender)."""
+    bridge = addon_module("addon.bridge")
+    loop = addon_module("kernels.subdivision.loop")
+    rules = addon_module("kernels.subdivision.loop_rules")
+    arrays, _ = bridge.read_mesh(ob.data)
+    marks = bridge.read_edge_marks(ob.data)
+    return loop.loop_subdivide(arrays.positions, arrays.triangles, levels,
+                               creases=(marks.pairs, rules.crease_to_sharpness(marks.crease)),
+                               corner_data=arrays.corner_attributes, **kw), marks
+
+
+def test_suzanne_gives_the_kernels_mesh_with_uvs(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_monkey_add()
+    ob = bpy.context.active_object
+    ob.data.materials.append(bpy.data.materials.new("Skin"))
+    assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
+    out = bpy.context.active_object
+    assert out is not ob and out.name == "Suzanne.loop" and out.data.materials[0].name == "Skin"
+    ref, marks = kernel_of(addon_module, bpy, ob, 2)
+    assert marks.n_gons == 468
+    pos, tris, use = arrays_of(out.data)
+    assert np.array_equal(pos, ref.positions) and np.array_equal(tris, ref.triangles)
+    assert not out.data.validate(verbose=False)  # the kernel's edges need no fixing
+    # Suzanne's eyes are open: every coarse boundary edge became 4 boundary edges, the rest is manifold
+    _, _, coarse_use = arrays_of(ob.data)
+    assert np.count_nonzero(use == 1) == 4 * np.count_nonzero(coarse_use == 1) and use.max() == 2
+    uv = np.empty(len(out.data.loops) * 2, np.float32)
+    out.data.uv_layers["UVMap"].data.foreach_get("uv", uv)
+    assert np.array_equal(uv.reshape(-1, 3, 2), ref.corner_attributes["UVMap"])
+    assert np.all(np.isfinite(pos))
+
+
+def test_sharp_and_creased_edges_are_creases(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2)
+    ob = bpy.context.active_object
+    me = ob.data
+    sharp = me.attributes.new("sharp_edge", "BOOLEAN", "EDGE")
+    flags = np.zeros(len(me.edges), bool)
+    flags[::7] = True
+    sharp.data.foreach_set("value", flags)
+    crease = me.attributes.new("crease_edge", "FLOAT", "EDGE")
+    values = np.zeros(len(me.edges), np.float32)
+    values[3::11] = 0.5
+    crease.data.foreach_set("value", values)
+    assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
+    out = bpy.context.active_object
+    ref, marks = kernel_of(addon_module, bpy, ob, 2)
+    assert len(marks.pairs) == np.count_nonzero(flags | (values > 0))
+    pos, _, use = arrays_of(out.data)
+    assert np.array_equal(pos, ref.positions) and np.all(use == 2)  # closed stays closed
+    select(bpy, ob)
+    assert bpy.ops.tessera.loop_subdivide(levels=2, use_creases=False) == {"FINISHED"}
+    smooth, _, _ = arrays_of(bpy.context.active_object.data)
+    assert not np.allclose(smooth, pos)
+
+
+def test_open_grid_with_a_hole_and_replace(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=6)
+    ob = bpy.context.active_object
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    ob.data.polygons[14].select = True
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.delete(type="FACE")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    ref, _ = kernel_of(addon_module, bpy, ob, 3, boundary="EDGE_AND_CORNER")
+    coarse_arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    coarse, coarse_tris = coarse_arrays.positions, coarse_arrays.triangles
+    name = ob.data.name
+    assert bpy.ops.tessera.loop_subdivide(levels=3, boundary="EDGE_AND_CORNER", output="REPLACE") == {"FINISHED"}
+    assert bpy.context.active_object is ob and ob.data.name == name
+    pos, _, use = arrays_of(ob.data)
+    assert np.array_equal(pos, ref.positions) and np.all(np.isfinite(pos))
+    single = np.flatnonzero(np.bincount(coarse_tris.ravel()) == 1)  # border vertices of a single triangle
+    assert len(single) >= 2 and np.array_equal(pos[single], coarse[single])  # keep their place
