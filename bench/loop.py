@@ -1,12 +1,13 @@
 """Loop subdivision (seed 002 §A.9, B3 and B6) against OpenSubdiv, VTK, trimesh and Blender, in one run.
 
 Cases (Suzanne, 968 triangles, smooth, except where said):
-- ``kernel_level_<L>`` for L = 1..6 (B3, time against output triangles): `kernels.subdivision.loop.loop_subdivide`
-  (positions, welded triangles, edges and corner edges) against OpenSubdiv's CPU Loop refinement of the same
-  mesh (Far::TopologyRefiner uniform refinement + PrimvarRefiner in double, the seconds its C++ measures, through
-  tools/osd_oracle); ``speedup`` > 1: Tessera is faster.
-- ``vtk_level_<L>``: the kernel against VTK's vtkLoopSubdivisionFilter (the Update call only) at L = 3..5.
-- ``trimesh_level_<L>``: the kernel against trimesh.remesh.subdivide_loop at L = 3..5.
+- ``kernel_<backend>_level_<L>`` for L = 1..6 (B3, time against output triangles): `kernels.subdivision.loop.
+  loop_subdivide` (positions, welded triangles, edges and corner edges; OpenCL on PoCL, or the numpy reference)
+  against OpenSubdiv's CPU Loop refinement of the same mesh (Far::TopologyRefiner uniform refinement +
+  PrimvarRefiner in double, the seconds its C++ measures, through tools/osd_oracle); ``speedup`` > 1: Tessera is
+  faster.
+- ``vtk_level_<L>``: the kernel (OpenCL) against VTK's vtkLoopSubdivisionFilter (the Update call only), L = 3..5.
+- ``trimesh_level_<L>``: the kernel (OpenCL) against trimesh.remesh.subdivide_loop at L = 3..5.
 - ``operator_level_5`` (B6): ``tessera.loop_subdivide`` end to end (read, subdivide, write a new object) on the
   flat-shaded Suzanne *Add > Monkey* gives, against adding Subdivision Surface level 5 and applying it, per output
   triangle (Loop 991,232 triangles, Catmull-Clark 1,007,616).
@@ -114,15 +115,15 @@ def main():
     ob = suzanne(bpy, smooth=True)
     arrays, _ = bridge.read_mesh(ob.data)
     v, f = arrays.positions.astype(np.float64), arrays.triangles
-    rows = []
     for level in range(1, 7):
-        best = {"ours": np.inf, "osd": np.inf, "vtk": np.inf, "trimesh": np.inf}
+        best = {"opencl": np.inf, "numpy": np.inf, "osd": np.inf, "vtk": np.inf, "trimesh": np.inf}
         vtk_run = vtk_filter(v, f, level) if 3 <= level <= 5 else None
         n = 0
         for _ in range(REPEAT if level < 6 else 3):  # interleaved rounds
-            seconds, res = timed(lambda lv=level: loop_subdivide(v, f, lv))
-            best["ours"], n = min(best["ours"], seconds), len(res.triangles)
-            del res
+            for backend in ("opencl", "numpy"):
+                seconds, res = timed(lambda lv=level, b=backend: loop_subdivide(v, f, lv, backend=b))
+                best[backend], n = min(best[backend], seconds), len(res.triangles)
+                del res
             ref = osd_oracle.loop_refine(v, f, level)
             best["osd"] = min(best["osd"], ref.seconds_topology + ref.seconds_primvar)
             assert len(ref.triangles) == n
@@ -133,16 +134,14 @@ def main():
                 assert count == n
                 seconds, (_, tf) = timed(lambda lv=level: subdivide_loop(v, f, iterations=lv))
                 best["trimesh"] = min(best["trimesh"], seconds)
-        rows.append(row(f"kernel_level_{level}", best["ours"], n, "OpenSubdiv Far Loop (topology + primvar, C++)",
-                        best["osd"], n))
+        level_rows = [row(f"kernel_{b}_level_{level}", best[b], n, "OpenSubdiv Far Loop (topology + primvar, C++)",
+                          best["osd"], n) for b in ("opencl", "numpy")]
         if vtk_run is not None:
-            rows.append(row(f"vtk_level_{level}", best["ours"], n, "vtkLoopSubdivisionFilter", best["vtk"], n))
-            rows.append(row(f"trimesh_level_{level}", best["ours"], n, "trimesh.remesh.subdivide_loop",
-                            best["trimesh"], n))
-        print(json.dumps(rows[-1 if vtk_run is None else -3]), flush=True)
-        if vtk_run is not None:
-            print(json.dumps(rows[-2]), flush=True)
-            print(json.dumps(rows[-1]), flush=True)
+            level_rows += [row(f"vtk_level_{level}", best["opencl"], n, "vtkLoopSubdivisionFilter", best["vtk"], n),
+                           row(f"trimesh_level_{level}", best["opencl"], n, "trimesh.remesh.subdivide_loop",
+                               best["trimesh"], n)]
+        for r in level_rows:
+            print(json.dumps(r), flush=True)
 
     ob = suzanne(bpy, smooth=False)
     enable_extension()  # after the factory settings are read

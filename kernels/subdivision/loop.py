@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..common.errors import BudgetError, InvalidInputError
+from ..common.opencl_runtime import backend_runtime
 from ..common.topology import validate_triangles
+from . import loop_opencl
 from .loop_rules import (
     RULE_CORNER,
     RULE_CREASE,
@@ -33,6 +35,7 @@ BOUNDARY_RULES = ("EDGE_ONLY", "EDGE_AND_CORNER")
 #: Bytes per output vertex, triangle and channel the estimate counts (float64 work arrays, int64 topology).
 BYTES_PER_VERTEX, BYTES_PER_TRIANGLE, BYTES_PER_CHANNEL = 8 * 3 * 3, 8 * 3 * 4, 8 * 3
 BLOCK = 1 << 14  # rows per block of the edge rule
+OPENCL_MIN_TRIANGLES = 4096  # output triangles from which "auto" takes OpenCL (faster from there: bench/loop.py)
 
 
 @dataclass
@@ -200,8 +203,50 @@ def _fvar_coarse(geo, fvar_tris, n_fvar):
     return lv
 
 
+@dataclass
+class _Final:
+    """The last level's topology (what `LoopResult` keeps)."""
+
+    triangles: np.ndarray
+    edges: np.ndarray
+    face_edges: np.ndarray
+    edge_sharpness: np.ndarray
+
+
+def _runtime(backend, lv, est):
+    """The OpenCL runtime to subdivide ``lv`` with, or None for numpy ("auto": OpenCL from
+    OPENCL_MIN_TRIANGLES output triangles on, where it is faster)."""
+    runtime = backend_runtime(backend, "Loop subdivision")
+    if runtime is None:
+        return None
+    if not loop_opencl.supports(runtime, lv):
+        if backend == "opencl":
+            raise InvalidInputError("The OpenCL path subdivides infinitely sharp creases only (and needs a device "
+                                    "with double precision); use the numpy backend for semi-sharp creases")
+        return None
+    if backend == "auto" and est.triangles < OPENCL_MIN_TRIANGLES:
+        return None
+    return runtime
+
+
+def _levels(lv, values, levels, runtime, progress):
+    """``levels`` Loop steps of vertex data (V, D) float64 on `LoopLevel` ``lv``: (values, last level)."""
+    if levels == 0:
+        return values, lv
+    if runtime is not None and loop_opencl.supports(runtime, lv):
+        values, tris, edges, face_edges, sharp = loop_opencl.subdivide(runtime, lv, values, levels, progress)
+        return values, _Final(tris, edges, face_edges, sharp)
+    for step in range(levels):
+        values = loop_step(lv, values, correction_table(lv.valence.max(initial=6)))
+        lv = refine_level(lv, final=step == levels - 1)
+        if progress is not None:
+            progress(step + 1, levels)
+    return values, lv
+
+
 def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=None, boundary="EDGE_ONLY",
-                   point_data=None, corner_data=None, budget_bytes=0, progress=None, dtype=np.float32):
+                   point_data=None, corner_data=None, budget_bytes=0, progress=None, dtype=np.float32,
+                   backend="auto"):
     """Subdivide a triangle mesh ``levels`` times with Loop's scheme.
 
     positions: (V, 3) float; triangles: (F, 3) int; levels: 0..MAX_LEVELS. creases: ``(pairs (K, 2) int,
@@ -211,6 +256,7 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
     point_data: name -> (V, ...) float, interpolated like positions; corner_data: name -> (F, 3, ...) float,
     each on its own face-varying mesh with linear boundaries. progress: callable(done, total) or None.
     dtype: of the output values (float32; float64 for comparisons with other float64 implementations).
+    backend: "auto" (OpenCL where it is faster and the creases allow it), "numpy" or "opencl" (`loop_opencl`).
     Returns a `LoopResult`. Raises `InvalidInputError` (bad indices, non-manifold edges, unknown rule, non-finite
     values) and `BudgetError`.
     """
@@ -239,24 +285,18 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
                    sum(v.shape[2] for v in corner_data.values()))
     check_budget(est, budget_bytes)
 
+    runtime = _runtime(backend, lv, est)
     fvars = {}
     for name, values in corner_data.items():
         fv_values, fv_tris = _face_varying(tris, values)
         fvars[name] = (_fvar_coarse(lv, fv_tris, len(fv_values)), fv_values)
 
-    data = np.concatenate([pos, *point_data.values()], axis=1)
-    total = levels * (1 + len(fvars))
-    for step in range(levels):
-        data = loop_step(lv, data, correction_table(lv.valence.max(initial=6)))
-        lv = refine_level(lv, final=step == levels - 1)
-        if progress is not None:
-            progress(step * (1 + len(fvars)) + 1, total)
+    meshes = 1 + len(fvars)
+    report = None if progress is None else lambda i: lambda done, _: progress(i * levels + done, meshes * levels)
+    data, lv = _levels(lv, np.concatenate([pos, *point_data.values()], axis=1), levels, runtime,
+                       None if report is None else report(0))
     for i, (name, (flv, fv)) in enumerate(fvars.items()):
-        for step in range(levels):
-            fv = loop_step(flv, fv, correction_table(flv.valence.max(initial=6)))
-            flv = refine_level(flv, final=step == levels - 1)
-            if progress is not None:
-                progress(step * (1 + len(fvars)) + 2 + i, total)
+        fv, flv = _levels(flv, fv, levels, runtime, None if report is None else report(i + 1))
         fvars[name] = fv[flv.triangles].astype(dtype).reshape((len(flv.triangles), 3, *corner_shapes[name]))
 
     out_points = {}

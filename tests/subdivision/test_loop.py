@@ -15,10 +15,20 @@ from meshes import (
     random_irregular_closed,
     torus,
 )
+from tessera.kernels.common import opencl_runtime
 from tessera.kernels.common.errors import BudgetError, InvalidInputError
 from tessera.kernels.subdivision.loop import estimate, loop_subdivide
 from tessera.kernels.subdivision.loop_rules import correction_factor, correction_table, crease_to_sharpness, loop_beta
 from tessera.kernels.subdivision.loop_topology import coarse_level
+
+
+@pytest.fixture(autouse=True)
+def numpy_reference():
+    """These tests check the numpy reference; test_opencl_loop.py compares the OpenCL path with it."""
+    opencl_runtime.configure(mode="0")
+    yield
+    opencl_runtime.configure()
+
 
 # Digest §A.3.2: cf(n) and beta(n) for n = 3..12, to the printed 6 decimals.
 CF_TABLE = [1.5, 1.291667, 1.121243, 1.0, 0.915132, 0.854780, 0.810840, 0.778073, 0.753089, 0.733654]
