@@ -107,12 +107,13 @@ class EdgeMarks:
     """What a subdivision keeps sharp, as Blender marks it.
 
     pairs: (K, 2) int32 vertex ids of the marked edges; crease: (K,) float32 in 0..1 (an edge marked sharp
-    counts as crease 1); vertex_crease: (V,) float32 or None; n_gons: faces with more than three corners (they
-    are triangulated when read); loose_edges: edges in no face.
+    counts as crease 1); sharp: (K,) bool marked sharp; vertex_crease: (V,) float32 or None; n_gons: faces with
+    more than three corners (they are triangulated when read); loose_edges: edges in no face.
     """
 
     pairs: np.ndarray
     crease: np.ndarray
+    sharp: np.ndarray
     vertex_crease: np.ndarray | None
     n_gons: int
     loose_edges: int
@@ -123,13 +124,14 @@ def read_edge_marks(mesh):
     ``crease_vert`` point attribute, the count of n-gons and of loose edges."""
     n_e, n_p = len(mesh.edges), len(mesh.polygons)
     crease = np.zeros(n_e, np.float32)
+    sharp = np.zeros(n_e, bool)
     attr = mesh.attributes.get("crease_edge")
     if attr is not None and attr.domain == "EDGE" and attr.data_type == "FLOAT":
         crease = _get(attr.data, "value", n_e, np.float32)
     attr = mesh.attributes.get("sharp_edge")
     if attr is not None and attr.domain == "EDGE" and attr.data_type == "BOOLEAN":
-        crease = np.where(_get(attr.data, "value", n_e, bool), np.float32(1.0), crease)
-    marked = np.flatnonzero(crease > 0)
+        sharp = _get(attr.data, "value", n_e, bool)
+    marked = np.flatnonzero(sharp | (crease > 0))
     pairs = _get(mesh.attributes[".edge_verts"].data, "value", n_e, np.int32, 2)[marked] if n_e else np.zeros((0, 2))
     vertex_crease = None
     attr = mesh.attributes.get("crease_vert")
@@ -138,7 +140,18 @@ def read_edge_marks(mesh):
     sizes = _get(mesh.polygons, "loop_total", n_p, np.int32)
     corner_edge = _get(mesh.attributes[".corner_edge"].data, "value", len(mesh.loops), np.int32)
     loose = n_e - int(np.count_nonzero(np.bincount(corner_edge, minlength=n_e)))
-    return EdgeMarks(pairs.astype(np.int32), crease[marked], vertex_crease, int(np.count_nonzero(sizes > 3)), loose)
+    crease = np.where(sharp, np.float32(1.0), crease)
+    return EdgeMarks(pairs.astype(np.int32), crease[marked], sharp[marked], vertex_crease,
+                     int(np.count_nonzero(sizes > 3)), loose)
+
+
+def write_edge_attribute(mesh, name, values):
+    """An edge attribute of ``mesh``: values (E,) bool (BOOLEAN) or float (FLOAT), replacing one of that name."""
+    values = np.ascontiguousarray(values)
+    if values.dtype == bool:
+        _new_attribute(mesh, name, "BOOLEAN", "EDGE").data.foreach_set("value", values)
+    else:
+        _new_attribute(mesh, name, "FLOAT", "EDGE").data.foreach_set("value", values.astype(np.float32))
 
 
 def corner_tangents(mesh, uv_map):

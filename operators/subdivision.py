@@ -1,13 +1,14 @@
 """``tessera.loop_subdivide``: Loop subdivision of the active mesh (seed 002 §A.3), creases kept."""
 
 import bpy
+import numpy as np
 
 from ..addon import bridge
 from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.subdivision.loop import MAX_LEVELS, loop_subdivide
-from ..kernels.subdivision.loop_rules import crease_to_sharpness
+from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
 from .selection import place_mesh, read_source
 
 BOUNDARY_ITEMS = (
@@ -74,6 +75,7 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
             )
             mesh = tx.track(bridge.write_mesh(f"{ob.data.name}.loop", out, info,
                                               edges=(result.edges, result.corner_edges)))
+            self._carry_marks(mesh, result, marks)
         finally:
             wm.progress_end()
         place_mesh(context, tx, ob, mesh, self.output, "loop")
@@ -83,6 +85,19 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
         if marks.loose_edges:
             self.report({"WARNING"}, f"{marks.loose_edges:,} loose edge(s) (in no face) were left out")
         return {"FINISHED"}
+
+    def _carry_marks(self, mesh, result, marks):
+        """Edges on marked input edges keep Mark Sharp, and what is left of their crease (sharpness drops by
+        one per level), so the result shades and subdivides on as the source would."""
+        if not len(marks.pairs):
+            return
+        if marks.sharp.any():
+            bridge.write_edge_attribute(mesh, "sharp_edge", result.edge_values(marks.pairs, marks.sharp, False))
+        soft = marks.crease * ~marks.sharp
+        if soft.any() and self.use_creases:
+            left = np.maximum(crease_to_sharpness(soft) - self.levels, 0.0) / SHARPNESS_INFINITE
+            remaining = np.where(soft >= 1.0, 1.0, np.sqrt(left)).astype(np.float32)
+            bridge.write_edge_attribute(mesh, "crease_edge", result.edge_values(marks.pairs, remaining, 0.0))
 
 
 classes = (TESSERA_OT_loop_subdivide,)

@@ -13,6 +13,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   ``tessera.displacement_stroke``; the map is also written as ``out/demo_map.exr`` (32-bit float);
 - ``out/demo_terrain.png``: a synthetic ridged terrain (1025², written as a 16-bit PNG height map) added with
   ``tessera.terrain_add`` and meshed adaptively for the scene camera, wireframe on top;
+- ``out/demo_loop.png``: Suzanne as Add > Monkey gives it, Loop subdivision level 2 of it, and a cube with its top
+  edges marked sharp at Loop level 3 (``tessera.loop_subdivide``);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -342,6 +344,40 @@ def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
     return total
 
 
+def build_loop_scene():
+    """Suzanne as Add > Monkey gives it, Loop level 2 of it, and a cube whose top edges are marked sharp at Loop
+    level 3 (the crease stays a crisp curve); returns [(name, triangles, seconds)]."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.55, 0.65, 0.8, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    bpy.ops.mesh.primitive_monkey_add(location=(-2.6, 0.0, 0.0))
+    coarse = bpy.context.active_object
+    coarse.data.materials.append(clay)
+    rows = []
+    bpy.ops.mesh.primitive_cube_add(size=1.5, location=(2.7, 0.0, 0.0), rotation=(0.0, 0.0, 0.6))
+    cube = bpy.context.active_object
+    cube.data.materials.append(clay)
+    top = [e for e in cube.data.edges if all(cube.data.vertices[i].co.z > 0 for i in e.vertices)]
+    sharp = cube.data.attributes.new("sharp_edge", "BOOLEAN", "EDGE")
+    for e in top:
+        sharp.data[e.index].value = True
+    for source, levels in ((coarse, 2), (cube, 3)):
+        bpy.context.view_layer.objects.active = source
+        t0 = time.perf_counter()
+        if bpy.ops.tessera.loop_subdivide(levels=levels) != {"FINISHED"}:
+            sys.exit("demo: loop_subdivide failed")
+        out = bpy.context.active_object
+        rows.append((source.name, len(out.data.polygons), time.perf_counter() - t0))
+        bpy.ops.object.shade_smooth()
+        if source is coarse:
+            out.location.x = 0.0
+        else:
+            bpy.data.objects.remove(source)
+        wire_overlay(out, wire_mat, thickness=0.004)
+    wire_overlay(coarse, wire_mat)
+    add_camera((0.0, -10.0, 3.4), (1.26, 0.0, 0.0), lens=42)
+    return rows
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -387,10 +423,13 @@ def main():
     tris, full = build_terrain_scene()
     render("demo_terrain.png")
     print(f"demo: terrain for the camera: {tris:,} triangles ({100 * tris / full:.2f}% of the {full:,}-triangle grid)")
+    for name, tris, elapsed in build_loop_scene():
+        print(f"demo: Loop subdivision of {name}: {tris:,} triangles in {elapsed:.2f} s")
+    render("demo_loop.png")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png"):
+                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")

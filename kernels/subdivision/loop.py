@@ -45,7 +45,8 @@ class LoopResult:
     positions: (V, 3) float32; triangles: (F, 3) int32; edges: (E, 2) int32 and corner_edges: (F, 3) int32
     (edge of each local edge ``k`` -> ``k + 1``), known without a search; edge_sharpness: (E,) float32 what is
     left of each crease (boundaries infinite); point_attributes: name -> (V, ...) float32;
-    corner_attributes: name -> (F, 3, ...) float32; levels: int.
+    corner_attributes: name -> (F, 3, ...) float32; levels: int; coarse_edges: (E0, 2) int32 the input's edges
+    (level 0; edge ``j`` of the result lies on coarse edge ``j >> levels`` when ``j < E0 << levels``).
     """
 
     positions: np.ndarray
@@ -56,10 +57,37 @@ class LoopResult:
     point_attributes: dict = field(default_factory=dict)
     corner_attributes: dict = field(default_factory=dict)
     levels: int = 0
+    coarse_edges: np.ndarray | None = None
 
     def coarse_face(self):
         """(F,) int64: the coarse triangle each output face comes from."""
         return np.arange(len(self.triangles), dtype=np.int64) >> (2 * self.levels)
+
+    def coarse_edge(self):
+        """(E,) int64: the coarse edge each output edge lies on, -1 for edges inside coarse triangles."""
+        j = np.arange(len(self.edges), dtype=np.int64)
+        return np.where(j < (len(self.coarse_edges) << self.levels), j >> self.levels, -1)
+
+    def edge_values(self, pairs, values, fill=0):
+        """Per output edge (E,), the value given for the coarse edge it lies on: pairs (K, 2) int vertex ids of
+        input edges (either order) with values (K,); ``fill`` elsewhere (pairs that are no edge are ignored)."""
+        values = np.asarray(values)
+        out = np.full(len(self.edges), fill, dtype=values.dtype)
+        if len(pairs) == 0:
+            return out
+        n = int(self.coarse_edges.max(initial=0)) + 1
+        keys = self.coarse_edges[:, 0].astype(np.int64) * n + self.coarse_edges[:, 1]
+        pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+        ok = pairs.max(axis=1) < n
+        want = pairs[ok].min(axis=1) * n + pairs[ok].max(axis=1)
+        at = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
+        per_coarse = np.full(len(keys), fill, dtype=values.dtype)
+        hit = keys[at] == want
+        per_coarse[at[hit]] = values[ok][hit]
+        coarse = self.coarse_edge()
+        inside = coarse >= 0
+        out[inside] = per_coarse[coarse[inside]]
+        return out
 
 
 @dataclass
@@ -293,6 +321,7 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
 
     meshes = 1 + len(fvars)
     report = None if progress is None else lambda i: lambda done, _: progress(i * levels + done, meshes * levels)
+    coarse_edges = lv.edges
     data, lv = _levels(lv, np.concatenate([pos, *point_data.values()], axis=1), levels, runtime,
                        None if report is None else report(0))
     for i, (name, (flv, fv)) in enumerate(fvars.items()):
@@ -313,4 +342,5 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
         point_attributes=out_points,
         corner_attributes=fvars,
         levels=levels,
+        coarse_edges=coarse_edges,
     )

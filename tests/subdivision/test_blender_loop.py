@@ -78,6 +78,15 @@ def test_sharp_and_creased_edges_are_creases(clean_scene, bpy_module, addon_modu
     assert len(marks.pairs) == np.count_nonzero(flags | (values > 0))
     pos, _, use = arrays_of(out.data)
     assert np.array_equal(pos, ref.positions) and np.all(use == 2)  # closed stays closed
+    # the marks go on: 4 sharp halves per sharp edge, crease 0.5 (sharpness 2.5) is 0.5 / sqrt(10) after 2 levels
+    out_sharp = np.empty(len(out.data.edges), bool)
+    out.data.attributes["sharp_edge"].data.foreach_get("value", out_sharp)
+    assert out_sharp.sum() == 4 * flags.sum()
+    out_crease = np.empty(len(out.data.edges), np.float32)
+    out.data.attributes["crease_edge"].data.foreach_get("value", out_crease)
+    soft = (values > 0) & ~flags
+    assert np.count_nonzero(out_crease) == 4 * soft.sum()
+    assert np.allclose(out_crease[out_crease > 0], np.sqrt(0.5 / 10), rtol=1e-6)
     select(bpy, ob)
     assert bpy.ops.tessera.loop_subdivide(levels=2, use_creases=False) == {"FINISHED"}
     smooth, _, _ = arrays_of(bpy.context.active_object.data)

@@ -261,6 +261,24 @@ def test_order_of_faces_and_vertices_does_not_change_the_surface():
     assert np.array_equal(perm_f[b.coarse_face()[faces]], a.coarse_face())
 
 
+def test_output_edges_know_their_coarse_edge():
+    v, f = random_irregular_closed(6)
+    lv = coarse_level(f, len(v))
+    r = loop_subdivide(v, f, 3, dtype=np.float64)
+    coarse = r.coarse_edge()
+    on = coarse >= 0
+    assert on.sum() == 8 * len(lv.edges)
+    # the 8 output edges on each coarse edge are a path from one of its ends to the other
+    for e in range(0, len(lv.edges), 7):
+        ids, counts = np.unique(r.edges[coarse == e], return_counts=True)
+        ends = set(ids[counts == 1])
+        assert ends == set(lv.edges[e]) and np.all(counts[counts != 1] == 2) and len(ids) == 9
+    values = r.edge_values(lv.edges[[3, 7]][:, ::-1], np.array([2.0, 5.0]))
+    assert np.array_equal(np.flatnonzero(values == 2.0), np.flatnonzero(coarse == 3))
+    assert np.array_equal(np.flatnonzero(values == 5.0), np.flatnonzero(coarse == 7))
+    assert np.count_nonzero(values) == 16
+
+
 def test_faces_follow_the_t_l_c_r_convention():
     v, f = octahedron()
     r = loop_subdivide(v, f, 1, dtype=np.float64)
