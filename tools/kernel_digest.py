@@ -85,10 +85,25 @@ def terrain():
     return _digest(*out)
 
 
+def subdivision():
+    from meshes import cup, random_irregular_closed
+    from tessera.kernels.subdivision.loop import loop_subdivide
+    from tessera.kernels.subdivision.loop_topology import coarse_level
+
+    out = []
+    for v, f in (random_irregular_closed(3), cup()):
+        edges = coarse_level(f, len(v)).edges
+        creases = edges[::4], np.array([10.0, 0.5, 1.7, 2.5] * len(edges))[: len(edges[::4])].astype(np.float32)
+        uv = np.random.default_rng(2).random((len(f), 3, 2))
+        r = loop_subdivide(v, f, 3, creases=creases, corner_data={"UV": uv}, backend="numpy")
+        out += [r.positions, r.triangles, r.edges, r.corner_attributes["UV"]]
+    return _digest(*out)
+
+
 def main():
     _import_tessera()
     print(json.dumps({"numpy": np.__version__, "tessellation": tessellation(), "tubes": tubes(),
-                      "terrain": terrain()}))
+                      "terrain": terrain(), "subdivision": subdivision()}))
 
 
 if __name__ == "__main__":
