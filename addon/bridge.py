@@ -145,6 +145,14 @@ def read_edge_marks(mesh):
                      int(np.count_nonzero(sizes > 3)), loose)
 
 
+def write_point_colours(mesh, name, colours):
+    """A point colour attribute (FLOAT_COLOR) of ``mesh`` from colours (V, 4), made the active and default one."""
+    attr = _new_attribute(mesh, name, "FLOAT_COLOR", "POINT")
+    attr.data.foreach_set("color", np.ascontiguousarray(colours, np.float32).ravel())
+    mesh.color_attributes.active_color = mesh.color_attributes[name]
+    mesh.color_attributes.default_color_name = name
+
+
 def write_edge_attribute(mesh, name, values):
     """An edge attribute of ``mesh``: values (E,) bool (BOOLEAN) or float (FLOAT), replacing one of that name."""
     values = np.ascontiguousarray(values)

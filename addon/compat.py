@@ -9,7 +9,9 @@ ask for it, and the version is compared only where the difference cannot be seen
 - stroke elements: 4.2's `OperatorStrokeElement` requires ``pen_flip`` when built from Python (`stroke_element`);
 - geometry-nodes modifier inputs: ``mod[identifier] = value`` until 5.1, ``mod.properties.inputs`` from 5.2
   (`set_modifier_input`);
-- the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`).
+- the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`);
+- materials: 5.0+ materials always have a node tree (``use_nodes`` is deprecated); 4.x needs the flag set
+  (`use_material_nodes`).
 """
 
 import math
@@ -66,3 +68,10 @@ def set_modifier_input(mod, identifier, value):
 def has_uv_tangent_node():
     """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
     return hasattr(bpy.types, "GeometryNodeUVTangent")
+
+
+def use_material_nodes(material):
+    """Make ``material`` a node material (4.x: ``use_nodes``, which adds the default Principled BSDF; 5.0+ always
+    has its node tree and deprecates the flag)."""
+    if material.node_tree is None:
+        material.use_nodes = True

@@ -1,4 +1,8 @@
-"""``tessera.loop_subdivide``: Loop subdivision of the active mesh (seed 002 §A.3), creases kept."""
+"""``tessera.loop_subdivide``: Loop subdivision of the active mesh (seed 002 §A.3), creases kept, baked lighting
+carried as a colour attribute; ``tessera.bake_lighting_hce``: the light on the mesh, baked by Cycles and stored
+per coarse triangle as an HCE (seed 002 §A.2)."""
+
+import time
 
 import bpy
 import numpy as np
@@ -6,10 +10,16 @@ import numpy as np
 from ..addon import bridge
 from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
+from ..addon.subdivision.bake import bake_colours
+from ..kernels.common.errors import TesseraError
 from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import MAX_LEVELS, loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
 from .selection import place_mesh, read_source
+
+HCE_PROPERTY = "tessera_hce"  # the mesh's custom property holding the packed HCE (bytes, saved with the .blend)
+BAKED_COLOUR = "BakedLight"  # the point colour attribute Loop Subdivide writes from it
 
 BOUNDARY_ITEMS = (
     ("EDGE_ONLY", "Smooth", "Open borders follow Loop's boundary rules: a uniform cubic B-spline along the border"),
@@ -33,6 +43,10 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
         name="Creases", default=True,
         description="Edges marked sharp and edges with crease 1 stay sharp; smaller creases soften over the "
                     "levels, as in OpenSubdiv and Blender's Subdivision Surface; vertex creases make corners")
+    use_baked_lighting: bpy.props.BoolProperty(
+        name="Baked Lighting", default=True,
+        description=f"Where the mesh has lighting baked by Bake Lighting to HCE, write it at the new level as the "
+                    f"colour attribute {BAKED_COLOUR!r}")
     output: bpy.props.EnumProperty(
         name="Output", default="NEW_OBJECT",
         items=(("NEW_OBJECT", "New Object", "Add a new object beside the source (its modifiers applied first)"),
@@ -66,6 +80,7 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
                 budget_bytes=get_preferences(context).memory_budget_bytes,
                 progress=lambda done, total: wm.progress_update(int(90 * done / max(total, 1))),
             )
+            baked = self._baked_lighting(ob, arrays, result)
             coarse = result.coarse_face()
             out = MeshArrays(
                 positions=result.positions, triangles=result.triangles,
@@ -76,6 +91,8 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
             mesh = tx.track(bridge.write_mesh(f"{ob.data.name}.loop", out, info,
                                               edges=(result.edges, result.corner_edges)))
             self._carry_marks(mesh, result, marks)
+            if baked is not None:
+                bridge.write_point_colours(mesh, BAKED_COLOUR, baked)
         finally:
             wm.progress_end()
         place_mesh(context, tx, ob, mesh, self.output, "loop")
@@ -85,6 +102,22 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
         if marks.loose_edges:
             self.report({"WARNING"}, f"{marks.loose_edges:,} loose edge(s) (in no face) were left out")
         return {"FINISHED"}
+
+    def _baked_lighting(self, ob, arrays, result):
+        """Vertex colours (V, 4) decoded from the mesh's HCE at the result's level, or None (none stored, or
+        switched off, or stale: then a warning says why)."""
+        blob = ob.data.get(HCE_PROPERTY)
+        if blob is None or not self.use_baked_lighting:
+            return None
+        try:
+            packed = hce.unpack_container(blob, arrays.triangles)
+        except TesseraError as err:
+            self.report({"WARNING"}, f"Baked lighting not used: {err}")
+            return None
+        normals = hce.face_normals(result.positions, result.triangles)
+        roots = hce.face_normals(arrays.positions, arrays.triangles)
+        faces = hce.select_colours(packed, result.levels, roots, normals)
+        return hce.vertex_colours(result.triangles, faces, len(result.positions))
 
     def _carry_marks(self, mesh, result, marks):
         """Edges on marked input edges keep Mark Sharp, and what is left of their crease (sharpness drops by
@@ -100,5 +133,75 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
             bridge.write_edge_attribute(mesh, "crease_edge", result.edge_values(marks.pairs, remaining, 0.0))
 
 
-classes = (TESSERA_OT_loop_subdivide,)
+class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
+    """Bake the light on the active mesh with Cycles (diffuse, direct and indirect) at its Loop sub-triangles and
+    store it on the mesh as a hierarchical colour encoding, for Loop Subdivide to carry to any level"""
+
+    bl_idname = "tessera.bake_lighting_hce"
+    bl_label = "Bake Lighting to HCE"
+    bl_options = {"REGISTER", "UNDO"}
+
+    depth: bpy.props.IntProperty(
+        name="Depth", description="Loop level of the sub-triangles the light is baked at (colours hold to any "
+        "level: finer levels share their ancestors' colours)", default=2, min=0, max=4)
+    samples: bpy.props.IntProperty(name="Samples", description="Cycles samples per texel", default=32, min=1,
+                                   max=4096, soft_max=512)
+    normals: bpy.props.IntProperty(
+        name="Normals", description="Extra normals per coarse triangle, each with its own colours (light that "
+        "differs with the surface's direction, e.g. across a bend)", default=4, min=0, max=8)
+    tolerance: bpy.props.FloatProperty(
+        name="Tolerance", description="A node is split while some sub-triangle under it differs from its colour "
+        "by more than this (0: full depth everywhere)", default=1.0 / 255, min=0.0, max=1.0, precision=4)
+    albedo: bpy.props.BoolProperty(name="Surface Colour", default=True,
+                                   description="Multiply by the surface colour (off: the light alone)")
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if ob is None or ob.type != "MESH":
+            cls.poll_message_set("Select a mesh object to bake (make it active)")
+            return False
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode to bake")
+            return False
+        return True
+
+    @guarded
+    def execute(self, context, tx):
+        ob = context.active_object
+        t0 = time.perf_counter()
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            arrays, _ = bridge.read_mesh(ob.data)
+            marks = bridge.read_edge_marks(ob.data)
+            sub = loop_subdivide(arrays.positions, arrays.triangles, self.depth,
+                                 creases=(marks.pairs, crease_to_sharpness(marks.crease)),
+                                 budget_bytes=get_preferences(context).memory_budget_bytes)
+            wm.progress_update(10)
+            material = arrays.face_attributes.get("material_index")
+            material = np.zeros(len(arrays.triangles), np.int32) if material is None else material.reshape(-1)
+            colours = bake_colours(context, ob, sub.positions, sub.triangles, material[sub.coarse_face()],
+                                   self.samples, self.albedo)
+            wm.progress_update(80)
+            n_f, leaves = len(arrays.triangles), 4**self.depth
+            normals = hce.face_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
+            trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), normals,
+                                       hce.face_normals(arrays.positions, arrays.triangles), m=self.normals,
+                                       tolerance=self.tolerance)
+            blob = hce.pack_container(trees, arrays.triangles, 4)
+        finally:
+            wm.progress_end()
+        old = ob.data.get(HCE_PROPERTY)
+        ob.data[HCE_PROPERTY] = blob
+        tx.on_rollback(lambda: ob.data.__setitem__(HCE_PROPERTY, old) if old is not None
+                       else ob.data.pop(HCE_PROPERTY, None))
+        nodes = sum(len(t.subdivided) for t in trees)
+        self.report({"INFO"}, f"Baked lighting: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
+                              f"{np.mean([len(t.normals) for t in trees]):.1f} extra normals each, "
+                              f"{len(blob) / 1024:,.0f} KiB, {time.perf_counter() - t0:.1f} s")
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_loop_subdivide, TESSERA_OT_bake_lighting_hce)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -283,7 +283,7 @@ def test_every_numeric_setting_has_a_finite_range(clean_scene, bpy_module):
 
 def _setup_for(bpy, name, tmp_path):
     """Make the context ``tessera.<name>`` runs in; returns the keyword arguments it needs besides the NaN."""
-    if name in ("tessellate", "displacement_add"):
+    if name in ("tessellate", "displacement_add", "bake_lighting_hce"):
         bpy.ops.mesh.primitive_monkey_add()
         return {}
     if name == "tubes":
@@ -380,6 +380,10 @@ def test_loop_subdivide_refuses_non_manifold_edges_and_oversized_results(clean_s
     prefs.memory_budget_mb = 64
     try:
         refused(bpy, bpy.ops.tessera.loop_subdivide, ["3,964,928 triangles", "budget"], levels=6)
+        engine = bpy.context.scene.render.engine
+        prefs.memory_budget_mb = 4
+        refused(bpy, bpy.ops.tessera.bake_lighting_hce, ["budget"], depth=4)
+        assert bpy.context.scene.render.engine == engine and "tessera_hce" not in bpy.context.active_object.data
     finally:
         prefs.memory_budget_mb = old
 

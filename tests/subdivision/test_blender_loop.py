@@ -114,3 +114,60 @@ def test_open_grid_with_a_hole_and_replace(clean_scene, bpy_module, addon_module
     assert np.array_equal(pos, ref.positions) and np.all(np.isfinite(pos))
     single = np.flatnonzero(np.bincount(coarse_tris.ravel()) == 1)  # border vertices of a single triangle
     assert len(single) >= 2 and np.array_equal(pos[single], coarse[single])  # keep their place
+
+
+def lit_scene(bpy, compat):
+    """An icosphere between a red wall and a white floor under an area light."""
+    red = bpy.data.materials.new("Red")
+    red.diffuse_color = (0.9, 0.05, 0.05, 1.0)
+    bpy.ops.mesh.primitive_plane_add(size=6, location=(-1.6, 0, 0), rotation=(0, 1.5708, 0))
+    wall = bpy.context.active_object
+    wall.data.materials.append(red)
+    compat.use_material_nodes(red)
+    red.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.9, 0.05, 0.05, 1.0)
+    bpy.ops.mesh.primitive_plane_add(size=6, location=(0, 0, -1.2))
+    bpy.ops.object.light_add(type="AREA", location=(0, 0, 3))
+    bpy.context.active_object.data.energy = 200
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1)
+    return bpy.context.active_object
+
+
+def test_baked_lighting_goes_to_every_level_without_seams(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    engine = bpy.context.scene.render.engine
+    n_objects, n_images = len(bpy.data.objects), len(bpy.data.images)
+    assert bpy.ops.tessera.bake_lighting_hce(depth=2, samples=4, normals=2) == {"FINISHED"}
+    assert bpy.context.scene.render.engine == engine and bpy.context.active_object is ob
+    assert (len(bpy.data.objects), len(bpy.data.images)) == (n_objects, n_images)  # no temporary left
+    hce = addon_module("kernels.subdivision.hce")
+    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    packed = hce.unpack_container(ob.data["tessera_hce"], arrays.triangles)
+    assert len(packed.node_start) == len(arrays.triangles) + 1
+    for levels in (1, 3):
+        select(bpy, ob)
+        assert bpy.ops.tessera.loop_subdivide(levels=levels) == {"FINISHED"}
+        out = bpy.context.active_object.data
+        assert out.color_attributes.active_color.name == "BakedLight"
+        col = np.empty(len(out.vertices) * 4, np.float32)
+        out.color_attributes["BakedLight"].data.foreach_get("color", col)
+        col = col.reshape(-1, 4)
+        pos, _, _ = arrays_of(out)
+        assert np.all(np.isfinite(col)) and np.all(col[:, :3] >= 0) and col[:, :3].max() > 0.05
+        left = pos[:, 0] < -0.5  # facing the red wall: more red than green
+        assert col[left, 0].mean() > col[left, 1].mean()
+
+
+def test_stale_baked_lighting_is_reported_and_not_used(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=1) == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    ob.data.polygons[0].select = True
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.delete(type="FACE")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    assert bpy.ops.tessera.loop_subdivide(levels=1) == {"FINISHED"}
+    assert "BakedLight" not in bpy.context.active_object.data.color_attributes
