@@ -10,6 +10,7 @@ class TESSERA_MT_object(bpy.types.Menu):
     def draw(self, context):
         self.layout.operator("tessera.tessellate", icon="MOD_SUBSURF")
         self.layout.operator("tessera.loop_subdivide", icon="MOD_SUBSURF")
+        self.layout.operator("tessera.bake_lighting_hce", icon="LIGHT_SUN")
         self.layout.operator("tessera.tubes", icon="MESH_CYLINDER")
         self.layout.operator("tessera.displacement_add", icon="IMAGE_DATA")
         self.layout.operator("tessera.terrain_add", icon="RNDCURVE")

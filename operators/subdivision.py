@@ -36,8 +36,8 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     levels: bpy.props.IntProperty(
-        name="Levels", description="Times every triangle is split in four (faces grow by 4^levels)",
-        default=2, min=1, max=MAX_LEVELS, soft_max=4)
+        name="Levels", description="Times every triangle is split in four (faces grow by 4^levels; 0: the "
+        "triangulated mesh as it is, with its baked lighting)", default=2, min=0, max=MAX_LEVELS, soft_max=4)
     boundary: bpy.props.EnumProperty(name="Boundary", items=BOUNDARY_ITEMS, default="EDGE_ONLY")
     use_creases: bpy.props.BoolProperty(
         name="Creases", default=True,

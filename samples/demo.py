@@ -15,6 +15,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   ``tessera.terrain_add`` and meshed adaptively for the scene camera, wireframe on top;
 - ``out/demo_loop.png``: Suzanne as Add > Monkey gives it, Loop subdivision level 2 of it, and a cube with its top
   edges marked sharp at Loop level 3 (``tessera.loop_subdivide``);
+- ``out/demo_loop_hce.png``: a Cornell-like box; Suzanne's light baked by Cycles into its HCE, shown on the coarse
+  mesh (left) and carried to Loop level 3 (right) as vertex colours (``tessera.bake_lighting_hce``);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -378,6 +380,48 @@ def build_loop_scene():
     return rows
 
 
+def build_hce_scene():
+    """A Cornell-like box (red and green walls, an area light): Suzanne's lighting baked by Cycles at Loop depth 2
+    into its HCE, then the coarse Suzanne (left, 968 triangles) and Loop level 3 carrying the baked colours
+    (right). Returns (seconds to bake, triangles at level 3)."""
+    clear_scene()
+
+    def node_material(name, rgba):
+        mat = material(name, rgba)
+        if mat.node_tree is None:  # 4.x (5.0+ materials always have nodes)
+            mat.use_nodes = True
+        mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = rgba
+        return mat
+
+    white, red = node_material("White", (0.8, 0.8, 0.8, 1)), node_material("Red", (0.8, 0.08, 0.06, 1))
+    green = node_material("Green", (0.1, 0.65, 0.12, 1))
+    walls = (((0, 0, 0), (0, 0, 0), white), ((0, 0, 4), (3.1416, 0, 0), white), ((0, 2, 2), (1.5708, 0, 0), white),
+             ((-2, 0, 2), (0, 1.5708, 0), red), ((2, 0, 2), (0, -1.5708, 0), green))
+    for loc, rot, mat in walls:
+        bpy.ops.mesh.primitive_plane_add(size=4, location=loc, rotation=rot)
+        bpy.context.active_object.data.materials.append(mat)
+    bpy.ops.object.light_add(type="AREA", location=(0, 0, 3.95))
+    bpy.context.active_object.data.energy, bpy.context.active_object.data.size = 120, 1.2
+    bpy.ops.mesh.primitive_monkey_add(location=(-0.85, 0.2, 1.3), rotation=(0.35, 0, 0.25), size=1.3)
+    source = bpy.context.active_object
+    source.data.materials.append(white)
+    t0 = time.perf_counter()
+    if bpy.ops.tessera.bake_lighting_hce(depth=2, samples=64) != {"FINISHED"}:
+        sys.exit("demo: bake_lighting_hce failed")
+    seconds = time.perf_counter() - t0
+    if bpy.ops.tessera.loop_subdivide(levels=3) != {"FINISHED"}:
+        sys.exit("demo: loop_subdivide failed")
+    out = bpy.context.active_object
+    out.location.x += 1.7
+    bpy.ops.object.shade_smooth()
+    bpy.context.view_layer.objects.active = source
+    if bpy.ops.tessera.loop_subdivide(levels=0) != {"FINISHED"}:  # the coarse mesh with its root colours
+        sys.exit("demo: loop_subdivide failed")
+    bpy.data.objects.remove(source)
+    add_camera((0.0, -7.6, 2.0), (1.5708, 0.0, 0.0), lens=30)
+    return seconds, len(out.data.polygons)
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -386,11 +430,11 @@ def export(tess):
     bpy.ops.wm.obj_export(filepath=str(OUT / "demo.obj"), export_selected_objects=True)
 
 
-def render(name):
+def render(name, color_type="MATERIAL", light="STUDIO"):
     scene = bpy.context.scene
     scene.render.engine = "BLENDER_WORKBENCH"
-    scene.display.shading.light = "STUDIO"
-    scene.display.shading.color_type = "MATERIAL"
+    scene.display.shading.light = light
+    scene.display.shading.color_type = color_type
     scene.display.shading.show_specular_highlight = False
     scene.render.resolution_x, scene.render.resolution_y = 1280, 620
     scene.render.film_transparent = False
@@ -426,10 +470,13 @@ def main():
     for name, tris, elapsed in build_loop_scene():
         print(f"demo: Loop subdivision of {name}: {tris:,} triangles in {elapsed:.2f} s")
     render("demo_loop.png")
+    seconds, tris = build_hce_scene()
+    render("demo_loop_hce.png", color_type="VERTEX", light="FLAT")
+    print(f"demo: lighting baked to HCE in {seconds:.1f} s, carried to Loop level 3 ({tris:,} triangles)")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png"):
+                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")

@@ -19,6 +19,11 @@ class TESSERA_PT_loop_subdivision(Sidebar, bpy.types.Panel):
             col.label(text=f"{n_tris:,} triangles -> {n_tris * 16:,} at level 2", icon="MESH_DATA")
         creases = [a.name for a in me.attributes if a.name in ("crease_edge", "sharp_edge", "crease_vert")]
         col.label(text="Creases: " + (", ".join(creases) if creases else "none"), icon="MOD_EDGESPLIT")
+        baked = "tessera_hce" in me
+        col.label(text="Baked lighting: " + ("stored (Loop Subdivide writes BakedLight)" if baked else "none"),
+                  icon="LIGHT_SUN")
+        layout.operator("tessera.bake_lighting_hce", icon="LIGHT_SUN", text="Bake Lighting" if not baked
+                        else "Bake Lighting Again")
         row = layout.row(align=True)
         row.scale_y = 1.4
         for level in (1, 2, 3):
