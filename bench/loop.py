@@ -8,6 +8,9 @@ Cases (Suzanne, 968 triangles, smooth, except where said):
   faster.
 - ``vtk_level_<L>``: the kernel (OpenCL) against VTK's vtkLoopSubdivisionFilter (the Update call only), L = 3..5.
 - ``trimesh_level_<L>``: the kernel (OpenCL) against trimesh.remesh.subdivide_loop at L = 3..5.
+- ``recompute_level_<L>`` (B4): the seed's recomputation model, every coarse triangle subdivided from its own
+  1-ring (`kernels.subdivision.loop_recompute`, numpy, one patch at a time), against the shared-vertex numpy
+  reference at the same level (the same bits out), L = 2, 3.
 - ``operator_level_5`` (B6): ``tessera.loop_subdivide`` end to end (read, subdivide, write a new object) on the
   flat-shaded Suzanne *Add > Monkey* gives, against adding Subdivision Surface level 5 and applying it, per output
   triangle (Loop 991,232 triangles, Catmull-Clark 1,007,616).
@@ -142,6 +145,20 @@ def main():
                                best["trimesh"], n)]
         for r in level_rows:
             print(json.dumps(r), flush=True)
+
+    from tessera.kernels.subdivision.loop_recompute import Recomputation
+
+    for level in (2, 3):
+        best_rec, best_ref = np.inf, np.inf
+        for _ in range(3):
+            seconds, out = timed(lambda lv=level: Recomputation(v, f, lv).run(check=False))
+            best_rec = min(best_rec, seconds)
+            seconds, ref = timed(lambda lv=level: loop_subdivide(v, f, lv, backend="numpy", dtype=np.float64))
+            best_ref = min(best_ref, seconds)
+            assert np.array_equal(out, ref.positions)
+        n = len(f) * 4**level
+        print(json.dumps(row(f"recompute_level_{level}", best_rec, n, "shared-vertex numpy reference", best_ref, n,
+                             patches=len(f))), flush=True)
 
     ob = suzanne(bpy, smooth=False)
     enable_extension()  # after the factory settings are read
