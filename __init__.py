@@ -27,6 +27,7 @@ _modules = (
     "addon.tubes.preview",
     "addon.terrain.preview",
     "addon.tessellation.preview",
+    "addon.subdivision.preview",
     "addon.displacement.brush_cursor",
     "addon.displacement.brush_tool",
 )

@@ -1,6 +1,7 @@
 """The one ``tessera`` pointer on each ID type that Tessera stores settings on.
 
-- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain`` (each capability's settings);
+- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain``, ``loop`` (each capability's
+  settings);
 - ``Scene.tessera``: ``brush`` (the displacement brush shared by the tool and stroke replays);
 - ``Image.tessera``: ``serial`` (strokes applied to a map image, for undo).
 
@@ -11,11 +12,12 @@ roots, then the pointers, so the order is written here and nowhere else.
 import bpy
 
 from .displacement import settings as displacement_settings
+from .subdivision import settings as loop_settings
 from .terrain import settings as terrain_settings
 from .tessellation import settings as tessellation_settings
 from .tubes import settings as tube_settings
 
-_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings)
+_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings, loop_settings)
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
@@ -23,6 +25,7 @@ class TESSERA_PG_object(bpy.types.PropertyGroup):
     tubes: bpy.props.PointerProperty(type=tube_settings.TESSERA_PG_tubes)
     displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement)
     terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
+    loop: bpy.props.PointerProperty(type=loop_settings.TESSERA_PG_loop)
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):

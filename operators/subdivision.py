@@ -11,42 +11,23 @@ from ..addon import bridge
 from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..addon.subdivision.bake import bake_colours
-from ..kernels.common.errors import TesseraError
+from ..addon.subdivision.build import HCE_PROPERTY, subdivide
+from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.subdivision import hce
-from ..kernels.subdivision.loop import MAX_LEVELS, loop_subdivide
+from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
 from .selection import place_mesh, read_source
 
-HCE_PROPERTY = "tessera_hce"  # the mesh's custom property holding the packed HCE (bytes, saved with the .blend)
-BAKED_COLOUR = "BakedLight"  # the point colour attribute Loop Subdivide writes from it
 
-BOUNDARY_ITEMS = (
-    ("EDGE_ONLY", "Smooth", "Open borders follow Loop's boundary rules: a uniform cubic B-spline along the border"),
-    ("EDGE_AND_CORNER", "Keep Corners",
-     "As Smooth, and border vertices with a single face (the corners of a plane) stay where they are"),
-)
-
-
-class TESSERA_OT_loop_subdivide(bpy.types.Operator):
+class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
     """Subdivide the active mesh with Loop's scheme for triangles; sharp and creased edges stay creased"""
 
     bl_idname = "tessera.loop_subdivide"
     bl_label = "Loop Subdivide"
     bl_options = {"REGISTER", "UNDO"}
 
-    levels: bpy.props.IntProperty(
-        name="Levels", description="Times every triangle is split in four (faces grow by 4^levels; 0: the "
-        "triangulated mesh as it is, with its baked lighting)", default=2, min=0, max=MAX_LEVELS, soft_max=4)
-    boundary: bpy.props.EnumProperty(name="Boundary", items=BOUNDARY_ITEMS, default="EDGE_ONLY")
-    use_creases: bpy.props.BoolProperty(
-        name="Creases", default=True,
-        description="Edges marked sharp and edges with crease 1 stay sharp; smaller creases soften over the "
-                    "levels, as in OpenSubdiv and Blender's Subdivision Surface; vertex creases make corners")
-    use_baked_lighting: bpy.props.BoolProperty(
-        name="Baked Lighting", default=True,
-        description=f"Where the mesh has lighting baked by Bake Lighting to HCE, write it at the new level as the "
-                    f"colour attribute {BAKED_COLOUR!r}")
+    # levels, boundary, use_creases, use_baked_lighting: LoopOptions (addon/subdivision/settings.py)
     output: bpy.props.EnumProperty(
         name="Output", default="NEW_OBJECT",
         items=(("NEW_OBJECT", "New Object", "Add a new object beside the source (its modifiers applied first)"),
@@ -70,17 +51,10 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
         wm.progress_begin(0, 100)
         try:
             arrays, info, marks = read_source(context, ob, self.output)
-            arrays.point_attributes.pop("crease_vert", None)  # a crease, not data to smooth
-            result = loop_subdivide(
-                arrays.positions, arrays.triangles, self.levels,
-                creases=(marks.pairs, crease_to_sharpness(marks.crease)) if self.use_creases else None,
-                vertex_sharpness=None if marks.vertex_crease is None or not self.use_creases
-                else crease_to_sharpness(marks.vertex_crease),
-                boundary=self.boundary, point_data=arrays.point_attributes, corner_data=arrays.corner_attributes,
-                budget_bytes=get_preferences(context).memory_budget_bytes,
-                progress=lambda done, total: wm.progress_update(int(90 * done / max(total, 1))),
-            )
-            baked = self._baked_lighting(ob, arrays, result)
+            build = subdivide(arrays, marks, self, ob.data.get(HCE_PROPERTY),
+                              get_preferences(context).memory_budget_bytes,
+                              lambda done, total: wm.progress_update(int(90 * done / max(total, 1))))
+            result, baked = build.result, build.baked
             coarse = result.coarse_face()
             out = MeshArrays(
                 positions=result.positions, triangles=result.triangles,
@@ -96,28 +70,14 @@ class TESSERA_OT_loop_subdivide(bpy.types.Operator):
         finally:
             wm.progress_end()
         place_mesh(context, tx, ob, mesh, self.output, "loop")
+        for note in build.notes:
+            self.report({"WARNING"}, note)
         if marks.n_gons:
             self.report({"INFO"}, f"{marks.n_gons:,} face(s) with more than three corners were triangulated first "
                                   f"(Loop subdivides triangles)")
         if marks.loose_edges:
             self.report({"WARNING"}, f"{marks.loose_edges:,} loose edge(s) (in no face) were left out")
         return {"FINISHED"}
-
-    def _baked_lighting(self, ob, arrays, result):
-        """Vertex colours (V, 4) decoded from the mesh's HCE at the result's level, or None (none stored, or
-        switched off, or stale: then a warning says why)."""
-        blob = ob.data.get(HCE_PROPERTY)
-        if blob is None or not self.use_baked_lighting:
-            return None
-        try:
-            packed = hce.unpack_container(blob, arrays.triangles)
-        except TesseraError as err:
-            self.report({"WARNING"}, f"Baked lighting not used: {err}")
-            return None
-        normals = hce.face_normals(result.positions, result.triangles)
-        roots = hce.face_normals(arrays.positions, arrays.triangles)
-        faces = hce.select_colours(packed, result.levels, roots, normals)
-        return hce.vertex_colours(result.triangles, faces, len(result.positions))
 
     def _carry_marks(self, mesh, result, marks):
         """Edges on marked input edges keep Mark Sharp, and what is left of their crease (sharpness drops by

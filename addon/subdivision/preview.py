@@ -1,0 +1,41 @@
+"""Live Loop preview in the 3D viewport: meshes with ``tessera.loop.preview`` are drawn Loop-subdivided, with
+their baked lighting, from the kernel's result (uploaded once; rebuilt when the mesh or the settings change).
+Nothing is drawn or compiled in background mode."""
+
+import bpy
+import numpy as np
+
+from ..bridge import read_edge_marks, read_mesh
+from ..preferences import get_preferences
+from ..viewport import Preview, PreviewEntry
+from .build import HCE_PROPERTY, subdivide, vertex_normals
+from .settings import TOPIC
+
+
+def build_draw_data(ob, budget_bytes=0):
+    """The `gpu_shaders.subdivision.draw.LoopDrawData` of ``ob``'s mesh with its ``tessera.loop`` settings."""
+    from ...gpu_shaders.subdivision.draw import LoopDrawData
+
+    arrays, _ = read_mesh(ob.data)
+    build = subdivide(arrays, read_edge_marks(ob.data), ob.tessera.loop, ob.data.get(HCE_PROPERTY), budget_bytes)
+    r = build.result
+    return LoopDrawData(r.positions, vertex_normals(r.positions, r.triangles), build.baked, r.triangles)
+
+
+def entry_for(ob):
+    """Cached draw data for ``ob`` (built on first use), or None when it cannot be built (error remembered)."""
+    return PREVIEW.entry(ob, lambda: PreviewEntry(build_draw_data(ob, get_preferences().memory_budget_bytes),
+                                                  data_uid=ob.data.session_uid))
+
+
+def _draw(context, region, view, proj):
+    for ob in context.visible_objects:
+        if ob.type != "MESH" or not ob.tessera.loop.preview:
+            continue
+        entry = entry_for(ob)
+        if entry is not None:
+            entry.draw.draw(view @ np.array(ob.matrix_world), proj)
+
+
+PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC)
+register, unregister = PREVIEW.register, PREVIEW.unregister

@@ -1,0 +1,1 @@
+"""Drawing Loop-subdivided meshes (the viewport preview): `draw.LoopDrawData`."""
