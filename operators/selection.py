@@ -16,6 +16,18 @@ def select_only(context, objects):
         context.view_layer.objects.active = objects[-1]
 
 
+def mesh_poll(cls, context, verb):
+    """Poll of an operator on the active mesh in Object Mode; says why not (``verb``: what the operator does)."""
+    ob = context.active_object
+    if ob is None or ob.type != "MESH":
+        cls.poll_message_set(f"Select a mesh object to {verb} (make it active)")
+        return False
+    if context.mode != "OBJECT":
+        cls.poll_message_set(f"Switch to Object Mode to {verb}")
+        return False
+    return True
+
+
 def read_source(context, ob, output):
     """`bridge.read_mesh` of what the operator works on: the object with its modifiers evaluated for a new
     object, its own mesh data for ``output == "REPLACE"``. Returns ``(arrays, info, marks)`` (marks:

@@ -17,7 +17,7 @@ from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
-from .selection import place_mesh, read_source
+from .selection import mesh_poll, place_mesh, read_source
 
 
 class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
@@ -35,14 +35,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if ob is None or ob.type != "MESH":
-            cls.poll_message_set("Select a mesh object to subdivide (make it active)")
-            return False
-        if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode to subdivide")
-            return False
-        return True
+        return mesh_poll(cls, context, "subdivide")
 
     @guarded
     def execute(self, context, tx):
@@ -117,14 +110,7 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if ob is None or ob.type != "MESH":
-            cls.poll_message_set("Select a mesh object to bake (make it active)")
-            return False
-        if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode to bake")
-            return False
-        return True
+        return mesh_poll(cls, context, "bake")
 
     @guarded
     def execute(self, context, tx):

@@ -16,10 +16,11 @@ from ..addon.tessellation.settings import (
     needs_camera,
     surface_options,
 )
+from ..kernels.common.budget import check_budget
 from ..kernels.common.errors import GPUContextError
 from ..kernels.tessellation.adaptive import adaptive_levels
-from ..kernels.tessellation.tessellate import check_budget, estimate, tessellate, uniform_levels
-from .selection import place_mesh, read_source
+from ..kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
+from .selection import mesh_poll, place_mesh, read_source
 
 
 def _world_positions(positions, matrix):
@@ -41,14 +42,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if ob is None or ob.type != "MESH":
-            cls.poll_message_set("Select a mesh object to tessellate (make it active)")
-            return False
-        if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode to tessellate")
-            return False
-        return True
+        return mesh_poll(cls, context, "tessellate")
 
     def invoke(self, context, event):
         stored = context.active_object.tessera.tessellate

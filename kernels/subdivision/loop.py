@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..common.errors import BudgetError, InvalidInputError
+from ..common.budget import Estimate, check_budget
+from ..common.errors import InvalidInputError
 from ..common.opencl_runtime import backend_runtime
 from ..common.topology import validate_triangles
 from . import loop_opencl
@@ -90,29 +91,12 @@ class LoopResult:
         return out
 
 
-@dataclass
-class Estimate:
-    vertices: int
-    triangles: int
-    bytes: int
-
-
 def estimate(n_vertices, n_edges, n_faces, levels, channels=0, corner_channels=0):
     """Output size and a working-memory estimate of ``levels`` Loop steps; channels: point-data floats beyond
     the position, corner_channels: floats per corner of all corner attributes together."""
     v, e, f = level_counts(n_vertices, n_edges, n_faces, levels)
     size = v * (BYTES_PER_VERTEX + 8 * channels) + e * 8 * 8 + f * (BYTES_PER_TRIANGLE + 8 * 3 * corner_channels)
     return Estimate(vertices=int(v), triangles=int(f), bytes=int(size))
-
-
-def check_budget(est, budget_bytes):
-    """Raise `BudgetError` when an `Estimate` exceeds ``budget_bytes`` (0 or None: no limit)."""
-    if budget_bytes and est.bytes > budget_bytes:
-        raise BudgetError(
-            f"The result would have {est.triangles:,} triangles and need about {est.bytes / 2**20:,.0f} MiB, "
-            f"over the memory budget of {budget_bytes / 2**20:,.0f} MiB. Lower the levels, or raise the "
-            f"budget in the Tessera preferences."
-        )
 
 
 def _vertex_sums(lv, values, mask=None):
@@ -311,7 +295,7 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
     widths = [v.shape[1] for v in point_data.values()]
     est = estimate(len(pos), len(lv.edges), len(tris), levels, sum(widths),
                    sum(v.shape[2] for v in corner_data.values()))
-    check_budget(est, budget_bytes)
+    check_budget(est, budget_bytes, "the levels")
 
     runtime = _runtime(backend, lv, est)
     fvars = {}

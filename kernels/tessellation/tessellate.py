@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..common import workers
-from ..common.errors import BudgetError, InvalidInputError
+from ..common.budget import Estimate
+from ..common.errors import InvalidInputError
 from ..common.mesh_arrays import MeshArrays
 from ..common.topology import triangle_edges, validate_triangles
 from . import patches
@@ -65,15 +66,6 @@ BYTES_PER_VERTEX = 64
 BYTES_PER_CHANNEL = 4
 
 
-@dataclass(frozen=True)
-class Estimate:
-    """Output size of a tessellation, computed without running it."""
-
-    vertices: int
-    triangles: int
-    bytes: int
-
-
 def uniform_levels(mesh, level):
     """One level for every edge of ``mesh``: (E,) float64."""
     tris = validate_triangles(mesh.triangles, len(mesh.positions))
@@ -91,16 +83,6 @@ def estimate(mesh, edge_levels, inner_levels=None, spacing="EQUAL"):
     size = n_triangles * (BYTES_PER_TRIANGLE + 3 * BYTES_PER_CHANNEL * corner_channels)
     size += n_vertices * (BYTES_PER_VERTEX + BYTES_PER_CHANNEL * point_channels)
     return Estimate(vertices=n_vertices, triangles=n_triangles, bytes=int(size))
-
-
-def check_budget(est, budget_bytes):
-    """Raise `BudgetError` when an `Estimate` exceeds ``budget_bytes`` (0 or None: no limit)."""
-    if budget_bytes and est.bytes > budget_bytes:
-        raise BudgetError(
-            f"The result would have {est.triangles:,} triangles and need about {est.bytes / 2**20:,.0f} MiB, "
-            f"over the memory budget of {budget_bytes / 2**20:,.0f} MiB. Lower the level, or raise the "
-            f"budget in the Tessera preferences."
-        )
 
 
 def _check_options(method, options):
