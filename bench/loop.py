@@ -11,6 +11,10 @@ Cases (Suzanne, 968 triangles, smooth, except where said):
 - ``recompute_level_<L>`` (B4): the seed's recomputation model, every coarse triangle subdivided from its own
   1-ring (`kernels.subdivision.loop_recompute`, numpy, one patch at a time), against the shared-vertex numpy
   reference at the same level (the same bits out), L = 2, 3.
+- ``stencils_opencl_level_<L>`` (B4 on a device): one OpenCL work item per coarse triangle evaluating its stencil
+  on its packed 1-ring (`kernels.subdivision.loop_stencils`; shared vertices recomputed by every triangle that
+  touches them), against the level-by-level OpenCL kernel (shared vertices computed once), L = 2, 3; the stencils
+  are built once per mesh topology (their build time is reported beside).
 - ``operator_level_5`` (B6): ``tessera.loop_subdivide`` end to end (read, subdivide, write a new object) on the
   flat-shaded Suzanne *Add > Monkey* gives, against adding Subdivision Surface level 5 and applying it, per output
   triangle (Loop 991,232 triangles, Catmull-Clark 1,007,616).
@@ -159,6 +163,23 @@ def main():
         n = len(f) * 4**level
         print(json.dumps(row(f"recompute_level_{level}", best_rec, n, "shared-vertex numpy reference", best_ref, n,
                              patches=len(f))), flush=True)
+
+    from tessera.kernels.common.opencl_runtime import get_runtime
+    from tessera.kernels.subdivision import loop_stencils
+
+    runtime = get_runtime()
+    for level in (2, 3):
+        build_seconds, table = timed(lambda lv=level: loop_stencils.build(v, f, lv))
+        best_st, best_lv = np.inf, np.inf
+        for _ in range(REPEAT):
+            seconds, out = timed(lambda t=table: loop_stencils.apply_opencl(runtime, t, v))
+            best_st = min(best_st, seconds)
+            seconds, _ = timed(lambda lv=level: loop_subdivide(v, f, lv, backend="opencl"))
+            best_lv = min(best_lv, seconds)
+        n = len(f) * 4**level
+        print(json.dumps(row(f"stencils_opencl_level_{level}", best_st, n, "level-by-level OpenCL kernel", best_lv,
+                             n, stencils=len(table.weights), stencil_build_seconds=round(build_seconds, 3))),
+              flush=True)
 
     ob = suzanne(bpy, smooth=False)
     enable_extension()  # after the factory settings are read
