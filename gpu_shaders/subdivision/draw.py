@@ -58,3 +58,57 @@ class LoopDrawData:
         shader.uniform_float("model_view", np.asarray(model_view, np.float32).T.ravel().tolist())
         shader.uniform_float("lit_range", (0.3, 0.7) if lit else (1.0, 0.0))
         self._batch.draw(shader)
+
+
+def _describe_stencils():
+    import gpu
+
+    info = gpu.types.GPUShaderCreateInfo()
+    for name in ("tex_width", "face_count", "rows", "width_p"):
+        info.push_constant("INT", name)
+    for slot, name in enumerate(("points", "patch_ids", "outputs", "stencil", "weights")):
+        info.sampler(slot, "FLOAT_2D", name)
+    info.image(0, "RGBA32F", "FLOAT_2D", "out_positions", qualifiers={"WRITE"})
+    info.local_group_size(64, 1, 1)
+    info.compute_source(loader.source("subdivision/loop_stencil_comp.glsl"))
+    return info
+
+
+def _scalars(values):
+    """Scalars (N,) as an RGBA32F texture, four to a texel."""
+    from ..textures import rgba_texture
+
+    flat = np.asarray(values, np.float32).ravel()
+    padded = np.zeros(-(-max(len(flat), 1) // 4) * 4, np.float32)
+    padded[: len(flat)] = flat
+    return rgba_texture(padded.reshape(-1, 4))
+
+
+def evaluate_stencils_on_gpu(table, positions):
+    """Loop-subdivided positions (V_L, 3) float32 from a `kernels.subdivision.loop_stencils.StencilTable` and the
+    coarse positions (V, 3), by the compute shader: one invocation per coarse triangle. Needs a GPU context."""
+    import gpu
+
+    from ..textures import TEX_WIDTH, rgba_texture
+
+    if table.n_vertices >= 2**24 or len(positions) >= 2**24:
+        raise ValueError("the GPU stencil path keeps ids as exact float32: at most 16.7M vertices")
+    pts = np.zeros((len(positions), 4), np.float32)
+    pts[:, :3] = positions
+    n_f, width_p = table.patch.shape
+    rows = table.outputs.shape[1]
+    height = max(1, -(-table.n_vertices // TEX_WIDTH))
+    out = gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F")
+    shader = loader.shader("loop_stencils", _describe_stencils)
+    shader.bind()
+    for name, value in (("tex_width", TEX_WIDTH), ("face_count", n_f), ("rows", rows), ("width_p", width_p)):
+        shader.uniform_int(name, value)
+    textures = {"points": rgba_texture(pts), "patch_ids": _scalars(table.patch), "outputs": _scalars(table.outputs),
+                "stencil": _scalars(table.stencil), "weights": _scalars(table.weights)}
+    for name, tex in textures.items():
+        shader.uniform_sampler(name, tex)
+    shader.image("out_positions", out)
+    gpu.compute.dispatch(shader, -(-n_f // 64), 1, 1)
+    buf = out.read()
+    buf.dimensions = out.width * out.height * 4
+    return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[: table.n_vertices, :3].copy()

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from meshes import cup, random_irregular_closed
 
 pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 
@@ -48,3 +49,16 @@ def test_preview_shows_the_baked_colours(clean_scene, bpy_module, addon_module, 
     red_pixels = (image[..., 0] > 240) & (image[..., 1] < 10) & (image[..., 2] < 10)
     assert red_pixels[48, 48]  # the baked colour, drawn as it is (not shaded)
     assert red_pixels.sum() > 1000
+
+
+def test_compute_shader_one_invocation_per_coarse_triangle(gpu_renderer, addon_module):
+    """The stencils in a Blender compute shader equal the numpy reference (float32 on the GPU)."""
+    stencils = addon_module("kernels.subdivision.loop_stencils")
+    loop = addon_module("kernels.subdivision.loop")
+    draw = addon_module("gpu_shaders.subdivision.draw")
+    for v, f in (random_irregular_closed(3), cup()):
+        for level in (1, 2, 3):
+            table = stencils.build(v, f, level)
+            gpu = draw.evaluate_stencils_on_gpu(table, v.astype(np.float32))
+            ref = loop.loop_subdivide(v, f, level, backend="numpy", dtype=np.float64).positions
+            assert np.abs(gpu - ref).max() <= 1e-6 * max(1.0, np.abs(ref).max())
