@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .loop import loop_subdivide
 from .loop_recompute import Recomputation
 
 
@@ -40,39 +41,61 @@ class StencilTable:
 
 def build(positions, triangles, levels, creases=None, vertex_sharpness=None, boundary="EDGE_ONLY"):
     """The `StencilTable` of a mesh at ``levels`` (arguments as `loop.loop_subdivide`; positions only give the
-    vertex count: stencils do not depend on them)."""
+    vertex count: stencils do not depend on them).
+
+    All patches are subdivided at once, as one mesh of disjoint copies (each patch's points numbered in global
+    order, so every sum runs as in `loop_recompute`), carrying for each point the unit vector of its place in its
+    patch: the subdivided values are the stencil rows.
+    """
     n_v = len(positions)
     rec = Recomputation(np.zeros((n_v, 1)), triangles, levels, creases, vertex_sharpness, boundary)
-    n_sub = 4**levels
+    tris = rec.triangles
+    n_f, n_sub = len(tris), 4**levels
     rows = (2**levels + 1) * (2**levels + 2) // 2
-    n_f = len(rec.triangles)
-    patches = [np.unique(rec.triangles[ring]) for ring in rec.rings]
-    width = max(len(p) for p in patches)
+    patches = [np.unique(tris[ring]) for ring in rec.rings]
+    sizes = np.array([len(p) for p in patches])
+    width = int(sizes.max())
+    first = np.concatenate([[0], np.cumsum(sizes)])  # each patch's first point in the union
+    union_points = np.concatenate(patches)
+    ring_sizes = np.array([len(r) for r in rec.rings])
+    face_first = np.concatenate([[0], np.cumsum(ring_sizes)])
+    union_faces = np.concatenate([first[t] + np.searchsorted(patches[t], tris[ring]) for t, ring in
+                                  enumerate(rec.rings)])
+    own = face_first[:-1] + np.array([np.searchsorted(ring, t) for t, ring in enumerate(rec.rings)])
+    local = np.arange(len(union_points)) - np.repeat(first[:-1], sizes)
+    identity = np.zeros((len(union_points), width))
+    identity[np.arange(len(union_points)), local] = 1.0
+    union_creases = None
+    if creases is not None and len(creases[0]):
+        pairs = np.asarray(creases[0], np.int64).reshape(-1, 2)
+        values = np.asarray(creases[1], np.float32)
+        found_pairs, found_values = [], []
+        for t in range(n_f):  # a crease goes into every patch that holds both its points
+            in_patch = np.isin(pairs, patches[t]).all(axis=1)
+            if in_patch.any():
+                found_pairs.append(first[t] + np.searchsorted(patches[t], pairs[in_patch]))
+                found_values.append(values[in_patch])
+        if found_pairs:
+            union_creases = (np.concatenate(found_pairs), np.concatenate(found_values))
+    vs = None if vertex_sharpness is None else np.asarray(vertex_sharpness, np.float32)[union_points]
+    result = loop_subdivide(np.zeros((len(union_points), 3)), union_faces, levels, creases=union_creases,
+                            vertex_sharpness=vs, boundary=boundary, point_data={"w": identity}, dtype=np.float64,
+                            backend="numpy")
+    sub = (own[:, None] * n_sub + np.arange(n_sub)).ravel()
+    union_ids = result.triangles[sub].reshape(n_f, -1)  # each triangle's sub-triangle corners in the union
+    global_ids = rec.output_triangles.reshape(n_f, -1)
+    order = np.argsort(global_ids, axis=1, kind="stable")
+    sorted_global = np.take_along_axis(global_ids, order, axis=1)
+    keep = np.concatenate([np.ones((n_f, 1), bool), np.diff(sorted_global, axis=1) > 0], axis=1)
+    outputs = sorted_global[keep].reshape(n_f, rows).astype(np.int64)
+    union_rows = np.take_along_axis(union_ids, order, axis=1)[keep].reshape(n_f, rows)
+    w = result.point_attributes["w"].reshape(len(result.positions), width)[union_rows]  # (F, rows, width)
     patch = np.full((n_f, width), -1, np.int64)
-    outputs = np.empty((n_f, rows), np.int64)
-    stencil = np.empty(n_f, np.int64)
-    cache, weights = {}, []
-    for t in range(n_f):
-        verts = patches[t]
-        patch[t, : len(verts)] = verts
-        rec.values = np.zeros((n_v, len(verts)))
-        rec.values[verts, np.arange(len(verts))] = 1.0  # identity on the patch: the rows are the weights
-        ids, w = rec.patch(t)
-        ids, w = ids.reshape(-1), w.reshape(-1, len(verts))
-        order = np.unique(ids, return_index=True)[1]  # each output vertex once, by global id
-        ids, w = ids[order], w[order]
-        if len(ids) != rows:
-            raise AssertionError(f"triangle {t}: {len(ids)} sub-vertices, expected {rows}")
-        outputs[t] = ids
-        key = w.tobytes()
-        if key not in cache:
-            cache[key] = len(weights)
-            padded = np.zeros((rows, width))
-            padded[:, : len(verts)] = w
-            weights.append(padded)
-        stencil[t] = cache[key]
-    return StencilTable(patch, outputs, stencil, np.array(weights), rec.n_out,
-                        rec.output_triangles[: n_f * n_sub])
+    patch[np.arange(width)[None, :] < sizes[:, None]] = union_points
+    flat = np.ascontiguousarray(w).reshape(n_f, -1)
+    uniq, stencil = np.unique(flat, axis=0, return_inverse=True)
+    return StencilTable(patch, outputs, stencil.reshape(-1).astype(np.int64), uniq.reshape(-1, rows, width),
+                        rec.n_out, rec.output_triangles)
 
 
 def apply(table, values):
@@ -94,16 +117,17 @@ def apply_opencl(runtime, table, values):
     if values.ndim == 1:
         values = values[:, None]
 
-    def upload(a):
-        return cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a))
+    def upload(a, dtype):
+        return cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a, dtype))
 
     out = np.empty((table.n_vertices, values.shape[1]))
     dst = cl.Buffer(runtime.context, mf.WRITE_ONLY, out.nbytes)
     n_f, width_p = table.patch.shape
     kernel = runtime.kernel("subdivision/loop_stencil", "apply_stencils")
-    kernel(runtime.queue, (n_f,), None, upload(table.patch), upload(table.outputs), upload(table.stencil),
-           upload(table.weights), upload(values), dst, np.int32(n_f), np.int32(width_p),
-           np.int32(table.outputs.shape[1]), np.int32(values.shape[1]))
+    i64, f64 = np.int64, np.float64
+    kernel(runtime.queue, (n_f,), None, upload(table.patch, i64), upload(table.outputs, i64),
+           upload(table.stencil, i64), upload(table.weights, f64), upload(values, f64), dst, np.int32(n_f),
+           np.int32(width_p), np.int32(table.outputs.shape[1]), np.int32(values.shape[1]))
     cl.enqueue_copy(runtime.queue, out, dst)
     runtime.queue.finish()
     return out
