@@ -300,8 +300,8 @@ def unpack_container(blob, triangles):
         raise InvalidInputError("The stored baked lighting is not an HCE (or was written by a newer Tessera)")
     channels, n_faces = (int(x) for x in np.frombuffer(blob[len(MAGIC) : len(MAGIC) + 8], "<u4"))
     if n_faces != len(triangles) or blob[len(MAGIC) + 8 : head] != topology_key(triangles):
-        raise InvalidInputError("The baked lighting belongs to another version of this mesh (its faces changed "
-                                "after the bake): bake the lighting again")
+        raise InvalidInputError("The baked lighting belongs to other faces than these (the mesh was edited after "
+                                "the bake, or modifiers change its faces): bake the lighting again")
     end = head + 8 * (n_faces + 1)
     offsets = np.frombuffer(blob[head:end], "<u8").astype(np.int64)
     if len(blob) != end + offsets[-1]:

@@ -171,3 +171,18 @@ def test_stale_baked_lighting_is_reported_and_not_used(clean_scene, bpy_module, 
     bpy.ops.object.mode_set(mode="OBJECT")
     assert bpy.ops.tessera.loop_subdivide(levels=1) == {"FINISHED"}
     assert "BakedLight" not in bpy.context.active_object.data.color_attributes
+
+
+def test_baked_lighting_is_saved_with_the_file(clean_scene, bpy_module, addon_module, tmp_path):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=2) == {"FINISHED"}
+    blob, name = bytes(ob.data["tessera_hce"]), ob.name
+    path = tmp_path / "baked.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    ob = bpy.data.objects[name]
+    assert bytes(ob.data["tessera_hce"]) == blob
+    select(bpy, ob)
+    assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
+    assert "BakedLight" in bpy.context.active_object.data.color_attributes
