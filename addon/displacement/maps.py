@@ -20,6 +20,7 @@ from ...kernels.displacement.map_buffer import MapBuffer
 from ...kernels.displacement.map_strokes import TileUndo, run_stroke, stroke_dabs, union_region
 from .. import bridge
 from ..compat import has_uv_tangent_node
+from ..node_groups import set_inputs
 from . import nodes as displace_nodes
 
 MODIFIER_NAME = "Tessera Displacement"
@@ -173,7 +174,7 @@ def sync_modifier(ob):
     if kind == "NODES":
         mod.node_group = displace_nodes.node_group()
         uv_map = settings.uv_map or getattr(ob.data.uv_layers.active, "name", "")
-        displace_nodes.set_inputs(mod, {"Image": settings.image, "UV Map": uv_map,
+        set_inputs(mod, {"Image": settings.image, "UV Map": uv_map,
                                         "Mid-Level": settings.mid_level, "Strength": settings.strength})
         ob.update_tag()
         return mod

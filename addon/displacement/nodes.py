@@ -6,10 +6,9 @@ MikkTSpace tangent of the UV Tangent node (Blender 5.0 and newer) made orthogona
 bitangent sign from the orientation of the corner's face in UV space (the sign of its UV polygon's area).
 """
 
-import bpy
-
 from ...kernels.common.errors import TesseraError
-from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node, set_modifier_input
+from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
+from ..node_groups import Graph, GroupSpec, ensure_group, register_group
 
 GROUP_NAME = "Tessera Tangent Displacement"
 INPUTS = (("Image", "NodeSocketImage"), ("UV Map", "NodeSocketString"), ("Mid-Level", "NodeSocketFloat"),
@@ -17,51 +16,8 @@ INPUTS = (("Image", "NodeSocketImage"), ("UV Map", "NodeSocketString"), ("Mid-Le
 _VERSION = 1  # bump when the graph changes: older groups in a file are rebuilt
 
 
-class _Graph:
-    """Small helper to add nodes and links to a node tree."""
-
-    def __init__(self, tree):
-        self.tree = tree
-
-    def node(self, kind, inputs=(), **props):
-        n = self.tree.nodes.new(kind)
-        for key, value in props.items():
-            setattr(n, key, value)
-        for i, value in inputs:
-            self.feed(n.inputs[i], value)
-        return n
-
-    def feed(self, socket, value):
-        if isinstance(value, bpy.types.NodeSocket):
-            self.tree.links.new(value, socket)
-        else:
-            socket.default_value = value
-
-    def math(self, op, *args):
-        n = self.node("ShaderNodeMath", operation=op)
-        for i, a in enumerate(args):
-            self.feed(n.inputs[i], a)
-        return n.outputs[0]
-
-    def vec(self, op, *args, out=0):
-        n = self.node("ShaderNodeVectorMath", operation=op)
-        sockets = ("Vector", "Scale") if op == "SCALE" else range(len(args))
-        for i, a in zip(sockets, args, strict=True):
-            self.feed(n.inputs[i], a)
-        return n.outputs[out]
-
-    def at(self, domain, data_type, value, index):
-        """``value`` evaluated on ``domain`` at ``index`` (Evaluate at Index)."""
-        return self.node("GeometryNodeFieldAtIndex", [(0, value), (1, index)], domain=domain,
-                         data_type=data_type).outputs[0]
-
-    def on(self, domain, data_type, value):
-        """``value`` evaluated on ``domain`` and read back in the caller's domain (Evaluate on Domain)."""
-        return self.node("GeometryNodeFieldOnDomain", [(0, value)], domain=domain, data_type=data_type).outputs[0]
-
-
 def _build(tree):
-    g = _Graph(tree)
+    g = Graph(tree)
     tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
     for name, kind in INPUTS:
         tree.interface.new_socket(name, in_out="INPUT", socket_type=kind)
@@ -101,25 +57,12 @@ def _build(tree):
     tree.links.new(setpos.outputs[0], go.inputs[0])
 
 
+SPEC = register_group(GroupSpec(GROUP_NAME, _VERSION, _build, catalog="Tessera/Displacement",
+                                 available=lambda: None if has_uv_tangent_node() else UV_TANGENT_MESSAGE))
+
+
 def node_group():
     """The group, built on first use (and rebuilt when an older version is in the file)."""
     if not has_uv_tangent_node():
         raise TesseraError(UV_TANGENT_MESSAGE)
-    tree = bpy.data.node_groups.get(GROUP_NAME)
-    if tree is not None and tree.get("tessera_version") == _VERSION:
-        return tree
-    if tree is not None:
-        tree.nodes.clear()
-        tree.interface.clear()
-    else:
-        tree = bpy.data.node_groups.new(GROUP_NAME, "GeometryNodeTree")
-    _build(tree)
-    tree["tessera_version"] = _VERSION
-    return tree
-
-
-def set_inputs(mod, values):
-    """Set a Nodes modifier's group inputs from ``{socket name: value}``."""
-    for item in mod.node_group.interface.items_tree:
-        if item.item_type == "SOCKET" and item.in_out == "INPUT" and item.name in values:
-            set_modifier_input(mod, item.identifier, values[item.name])
+    return ensure_group(SPEC)

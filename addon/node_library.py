@@ -1,0 +1,120 @@
+"""Tessera's node groups as an asset library: a .blend of every group (marked as assets, in catalogs under
+*Tessera*) written into the extension's user folder, and a preferences asset library entry "Tessera" pointing at
+it, added on enable and removed on disable (one entry, never a stale one). The groups then show in Add Modifier
+and in the node editor's Add menu; a file that uses one holds its own copy (appended), so it evaluates on a
+machine without the add-on.
+
+The .blend is named by a hash of the groups' names and versions: a new version writes a new file and removes the
+old one. Nothing is written while Blender is starting (data is read-only then): a one-shot timer does it.
+"""
+
+import hashlib
+import uuid
+from pathlib import Path
+
+import bpy
+
+from . import node_groups
+from .displacement import nodes as _displace_nodes  # noqa: F401 (registers its group)
+from .preferences import BASE_PACKAGE
+from .tessellation import phong_nodes as _phong_nodes  # noqa: F401 (registers its group)
+
+LIBRARY_NAME = "Tessera"
+CATALOG_FILE = "blender_assets.cats.txt"
+_NAMESPACE = uuid.UUID("6f1c8f0e-3b1e-4c43-9a55-7e2a1d0c5b21")
+
+
+def library_dir():
+    """The folder of the library (created), or None where Tessera runs as a legacy add-on."""
+    try:
+        return Path(bpy.utils.extension_path_user(BASE_PACKAGE, path="node_library", create=True))
+    except (ValueError, AttributeError):
+        return None
+
+
+def _available():
+    return [s for s in node_groups.GROUPS.values() if s.available is None or s.available() is None]
+
+
+def library_file(directory):
+    key = ";".join(f"{s.name}:{s.version}" for s in sorted(_available(), key=lambda s: s.name))
+    return Path(directory) / f"tessera_nodes_{hashlib.sha256(key.encode()).hexdigest()[:12]}.blend"
+
+
+def catalog_id(path):
+    return str(uuid.uuid5(_NAMESPACE, path))
+
+
+def write_library(directory):
+    """Write the groups' .blend and the catalogs into ``directory`` (older Tessera .blends removed). Returns the
+    file. Groups this file already had are left as they were; the ones built for writing are removed again."""
+    directory = Path(directory)
+    path = library_file(directory)
+    specs = _available()
+    before = set(bpy.data.node_groups)
+    trees = [node_groups.ensure_group(spec) for spec in specs]
+    try:
+        for spec, tree in zip(specs, trees, strict=True):
+            tree.asset_mark()
+            tree.asset_data.catalog_id = catalog_id(spec.catalog)
+            tree.asset_data.description = (tree.bl_description if hasattr(tree, "bl_description") else "") or \
+                f"Tessera: {spec.name}"
+        tmp = path.with_suffix(".tmp.blend")
+        bpy.data.libraries.write(str(tmp), set(trees), fake_user=True)
+        tmp.replace(path)  # never a half-written library
+    finally:
+        for tree in trees:
+            if tree in before:
+                tree.asset_clear()
+            else:
+                bpy.data.node_groups.remove(tree)
+    catalogs = sorted({s.catalog for s in specs} | {"Tessera"})
+    lines = ["# Tessera's node-group catalogs (written by the add-on)", "VERSION 1", ""]
+    lines += [f"{catalog_id(c)}:{c}:{c.replace('/', '-')}" for c in catalogs]
+    (directory / CATALOG_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    for old in directory.glob("tessera_nodes_*.blend"):
+        if old != path:
+            old.unlink()
+    return path
+
+
+def _entries():
+    return [lib for lib in bpy.context.preferences.filepaths.asset_libraries if lib.name == LIBRARY_NAME]
+
+
+def register_library():
+    """Write the library if it is missing or outdated and add (or repoint) the one "Tessera" asset library."""
+    directory = library_dir()
+    if directory is None:
+        return None
+    if not library_file(directory).exists() or not (directory / CATALOG_FILE).exists():
+        write_library(directory)
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    entries = _entries()
+    for extra in entries[1:]:
+        libraries.remove(extra)
+    if entries:
+        entries[0].path = str(directory)
+    else:
+        libraries.new(name=LIBRARY_NAME, directory=str(directory))
+    return directory
+
+
+def _deferred():
+    register_library()
+    return None  # do not repeat
+
+
+def register():
+    try:
+        register_library()
+    except AttributeError:  # bpy.data is read-only while Blender starts: write it once it has started
+        bpy.app.timers.register(_deferred, first_interval=0.1)
+
+
+def unregister():
+    if bpy.app.timers.is_registered(_deferred):
+        bpy.app.timers.unregister(_deferred)
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    for entry in _entries():
+        libraries.remove(entry)

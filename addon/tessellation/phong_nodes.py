@@ -1,0 +1,62 @@
+"""The geometry-nodes group "Tessera Phong": Phong tessellation (Boubekeur & Alexa 2008, seed 001) in the modifier
+stack, with no add-on needed to evaluate it. Numpy reference: `kernels.tessellation.patches.phong_control`.
+
+Subdivide Mesh splits every triangle (linearly: UVs and attributes are interpolated as the kernel does). Each
+new point p lies on a coarse triangle with barycentric coordinates b, and Phong's point is
+``p* = sum_i b_i (p - ((p - P_i).n_i) n_i) = p - (sum_i b_i n_i n_i^T) p + sum_i b_i (P_i.n_i) n_i``. Both sums
+are linear in b: the coarse corners carry n n^T (6 numbers) and (P.n) n as corner attributes, Subdivide Mesh
+interpolates them with the positions, so every new corner holds the sums for its own coarse triangle (no search,
+so self-intersecting meshes are fine; on a coarse edge both triangles give the same sums). The result is
+``p + a (p* - p)`` with the shape factor a (a field: per-vertex a works). Watertight: the coarse mesh's point
+normals, so shared edges stay shared.
+"""
+
+from ..node_groups import Graph, GroupSpec, register_group, socket
+
+GROUP_NAME = "Tessera Phong"
+VERSION = 1
+
+
+def _build(tree):
+    g = Graph(tree)
+    socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
+    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
+           description="Each level splits every triangle in four (Subdivide Mesh)")
+    socket(tree, "Shape Factor", "NodeSocketFloat", default=0.75, min_value=0.0, max_value=1.0,
+           description="0: flat triangles; 1: full Phong tessellation (0.75 as in the paper); a field, so it "
+                       "can vary per vertex")
+    socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The curved, finer mesh")
+    gi, go = g.node("NodeGroupInput"), g.node("NodeGroupOutput")
+    coarse = g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
+    position = g.node("GeometryNodeInputPosition").outputs[0]
+    normal = g.on("POINT", "FLOAT_VECTOR", g.node("GeometryNodeInputNormal").outputs[0])
+    n = g.split(normal)
+    diag = g.vec("MULTIPLY", normal, normal)  # (nx nx, ny ny, nz nz)
+    off = g.xyz(g.math("MULTIPLY", n[0], n[1]), g.math("MULTIPLY", n[1], n[2]), g.math("MULTIPLY", n[2], n[0]))
+    plane = g.vec("SCALE", normal, g.vec("DOT_PRODUCT", position, normal, out=1))  # (P.n) n
+
+    names = ("tessera_phong_diag", "tessera_phong_off", "tessera_phong_plane")
+    geometry = coarse
+    for name, field in zip(names, (diag, off, plane), strict=True):  # point values on every corner
+        geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", name), ("Value", field)],
+                          data_type="FLOAT_VECTOR", domain="CORNER").outputs[0]
+    fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Level"])]).outputs[0]
+
+    def carried(name):  # the interpolated corner values, read on the points (all corners of a point agree)
+        value = g.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type="FLOAT_VECTOR").outputs[0]
+        return g.on("POINT", "FLOAT_VECTOR", g.on("CORNER", "FLOAT_VECTOR", value))
+
+    d, o, c = (carried(name) for name in names)
+    p = g.split(position)
+    oo = g.split(o)
+    a = g.vec("MULTIPLY", o, g.xyz(p[1], p[2], p[0]))  # (ox py, oy pz, oz px)
+    b = g.vec("MULTIPLY", g.xyz(oo[2], oo[0], oo[1]), g.xyz(p[2], p[0], p[1]))  # (oz pz, ox px, oy py)
+    np_ = g.vec("ADD", g.vec("MULTIPLY", d, position), g.vec("ADD", a, b))  # (sum b_i n_i n_i^T) p
+    offset = g.vec("SCALE", g.vec("SUBTRACT", c, np_), gi.outputs["Shape Factor"])
+    moved = g.node("GeometryNodeSetPosition", [(0, fine), ("Offset", offset)]).outputs[0]
+    for name in names:
+        moved = g.node("GeometryNodeRemoveAttribute", [(0, moved), ("Name", name)]).outputs[0]
+    tree.links.new(moved, go.inputs[0])
+
+
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation"))
