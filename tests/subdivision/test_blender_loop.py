@@ -25,6 +25,17 @@ def arrays_of(me):
     return pos.reshape(-1, 3), corners.reshape(-1, 3), np.bincount(corner_edge, minlength=n_e)
 
 
+def delete_face(bpy, ob, index):
+    """Delete face ``index`` of ``ob`` (active, Object Mode) the way a user would, in Edit Mode."""
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    ob.data.polygons[index].select = True
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.delete(type="FACE")
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
 def kernel_of(addon_module, bpy, ob, levels, **kw):
     """The kernel's result on what the operator reads (the object's mesh, triangulated by Blender)."""
     bridge = addon_module("addon.bridge")
@@ -97,13 +108,7 @@ def test_open_grid_with_a_hole_and_replace(clean_scene, bpy_module, addon_module
     bpy = bpy_module
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=6)
     ob = bpy.context.active_object
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.select_all(action="DESELECT")
-    bpy.ops.object.mode_set(mode="OBJECT")
-    ob.data.polygons[14].select = True
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.delete(type="FACE")
-    bpy.ops.object.mode_set(mode="OBJECT")
+    delete_face(bpy, ob, 14)
     ref, _ = kernel_of(addon_module, bpy, ob, 3, boundary="EDGE_AND_CORNER")
     coarse_arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
     coarse, coarse_tris = coarse_arrays.positions, coarse_arrays.triangles
@@ -162,13 +167,7 @@ def test_stale_baked_lighting_is_reported_and_not_used(clean_scene, bpy_module, 
     bpy = bpy_module
     ob = lit_scene(bpy, addon_module("addon.compat"))
     assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=1) == {"FINISHED"}
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.select_all(action="DESELECT")
-    bpy.ops.object.mode_set(mode="OBJECT")
-    ob.data.polygons[0].select = True
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.delete(type="FACE")
-    bpy.ops.object.mode_set(mode="OBJECT")
+    delete_face(bpy, ob, 0)
     assert bpy.ops.tessera.loop_subdivide(levels=1) == {"FINISHED"}
     assert "BakedLight" not in bpy.context.active_object.data.color_attributes
 
