@@ -4,9 +4,9 @@ stack, with no add-on needed to evaluate it. Numpy reference: `kernels.tessellat
 Subdivide Mesh splits every triangle (linearly: UVs and attributes are interpolated as the kernel does). Each
 new point p lies on a coarse triangle with barycentric coordinates b, and Phong's point is
 ``p* = sum_i b_i (p - ((p - P_i).n_i) n_i) = p - (sum_i b_i n_i n_i^T) p + sum_i b_i (P_i.n_i) n_i``. Both sums
-are linear in b: the coarse corners carry n n^T (6 numbers) and (P.n) n as corner attributes, Subdivide Mesh
-interpolates them with the positions, so every new corner holds the sums for its own coarse triangle (no search,
-so self-intersecting meshes are fine; on a coarse edge both triangles give the same sums). The result is
+are linear in b: the coarse points carry n n^T (6 numbers) and (P.n) n as attributes, which Subdivide Mesh
+(bilinear) interpolates with the same weights as the positions, so every new point holds the sums of the coarse
+triangle it lies on (no search, so self-intersecting meshes are fine). The result is
 ``p + a (p* - p)`` with the shape factor a (a field: per-vertex a works). Watertight: the coarse mesh's point
 normals, so shared edges stay shared.
 """
@@ -14,7 +14,7 @@ normals, so shared edges stay shared.
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Phong"
-VERSION = 1
+VERSION = 2
 
 
 def _build(tree):
@@ -37,14 +37,13 @@ def _build(tree):
 
     names = ("tessera_phong_diag", "tessera_phong_off", "tessera_phong_plane")
     geometry = coarse
-    for name, field in zip(names, (diag, off, plane), strict=True):  # point values on every corner
+    for name, field in zip(names, (diag, off, plane), strict=True):
         geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", name), ("Value", field)],
-                          data_type="FLOAT_VECTOR", domain="CORNER").outputs[0]
+                          data_type="FLOAT_VECTOR", domain="POINT").outputs[0]
     fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Level"])]).outputs[0]
 
-    def carried(name):  # the interpolated corner values, read on the points (all corners of a point agree)
-        value = g.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type="FLOAT_VECTOR").outputs[0]
-        return g.on("POINT", "FLOAT_VECTOR", g.on("CORNER", "FLOAT_VECTOR", value))
+    def carried(name):  # the point values, interpolated by the subdivision with the same weights as positions
+        return g.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type="FLOAT_VECTOR").outputs[0]
 
     d, o, c = (carried(name) for name in names)
     p = g.split(position)
