@@ -18,6 +18,7 @@ from . import node_groups
 from .displacement import nodes as _displace_nodes  # noqa: F401 (registers its group)
 from .preferences import BASE_PACKAGE
 from .tessellation import phong_nodes as _phong_nodes  # noqa: F401 (registers its group)
+from .tessellation import pn_nodes as _pn_nodes  # noqa: F401 (registers its group)
 
 LIBRARY_NAME = "Tessera"
 CATALOG_FILE = "blender_assets.cats.txt"

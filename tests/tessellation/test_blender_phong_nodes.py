@@ -1,5 +1,5 @@
-"""The "Tessera Phong" geometry-nodes group against the numpy Phong patch (tier: blender), closed meshes staying
-closed, and a file using it evaluating the same in a Blender without the add-on."""
+"""The "Tessera Phong" and "Tessera PN Triangles" geometry-nodes groups against the numpy patches (tier: blender),
+closed meshes staying closed, and a file using them evaluating the same in a Blender without the add-on."""
 
 import subprocess
 import sys
@@ -39,17 +39,18 @@ def evaluated_positions(bpy, ob):
     return pos.reshape(-1, 3).astype(np.float64), me
 
 
-def phong_modifier(bpy, addon_module, ob, **inputs):
+def group_modifier(bpy, addon_module, ob, module, **inputs):
     ng = addon_module("addon.node_groups")
-    spec = addon_module("addon.tessellation.phong_nodes").SPEC
-    mod = ob.modifiers.new("Phong", "NODES")
+    spec = addon_module(f"addon.tessellation.{module}").SPEC
+    mod = ob.modifiers.new(spec.name, "NODES")
     mod.node_group = ng.ensure_group(spec)
     ng.set_inputs(mod, inputs)
     return mod
 
 
+@pytest.mark.parametrize("method", ["PHONG", "PN"])
 @pytest.mark.parametrize("shape", ["ico", "suzanne"])
-def test_every_vertex_lies_on_the_kernels_phong_surface(clean_scene, bpy_module, addon_module, shape):
+def test_every_vertex_lies_on_the_kernels_surface(clean_scene, bpy_module, addon_module, shape, method):
     bpy = bpy_module
     patches = addon_module("kernels.tessellation.patches")
     if shape == "ico":
@@ -64,14 +65,19 @@ def test_every_vertex_lies_on_the_kernels_phong_surface(clean_scene, bpy_module,
     pos = np.array([v.co for v in me.vertices], np.float64)
     nor = np.array([v.normal for v in me.vertices], np.float64)
     tris = np.array([p.vertices[:] for p in me.polygons])
+    module = "phong_nodes" if method == "PHONG" else "pn_nodes"
     for level, alpha in ((1, 0.75), (2, 1.0)):
-        mod = phong_modifier(bpy, addon_module, ob, Level=level, **{"Shape Factor": 0.0})
+        mod = group_modifier(bpy, addon_module, ob, module, Level=level, **{"Shape Factor": 0.0})
         flat, _ = evaluated_positions(bpy, ob)
         addon_module("addon.node_groups").set_inputs(mod, {"Shape Factor": alpha})
         curved, out = evaluated_positions(bpy, ob)
         t, bary = locate(flat, pos, tris)
-        control = patches.phong_control(pos[tris], nor[tris], alpha)
-        ref = np.einsum("pk,pkc->pc", patches.quadratic_basis(bary), control[t])
+        if method == "PHONG":
+            ref = np.einsum("pk,pkc->pc", patches.quadratic_basis(bary), patches.phong_control(pos[tris], nor[tris],
+                                                                                               alpha)[t])
+        else:  # PN with a shape factor: the linear point moved a of the way to the PN point
+            pn = np.einsum("pk,pkc->pc", patches.cubic_basis(bary), patches.pn_control(pos[tris], nor[tris])[t])
+            ref = flat + alpha * (pn - flat)
         assert np.abs(curved - ref).max() <= 1e-5 * np.abs(pos).max()
         if shape == "ico":  # closed stays closed
             edges = np.empty(len(out.loops), np.int32)
