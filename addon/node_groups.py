@@ -54,12 +54,13 @@ class Graph:
 
     def at(self, domain, data_type, value, index):
         """``value`` evaluated on ``domain`` at ``index`` (Evaluate at Index)."""
-        return self.node("GeometryNodeFieldAtIndex", [(0, value), (1, index)], domain=domain,
-                         data_type=data_type).outputs[0]
+        return self.node("GeometryNodeFieldAtIndex", [("Value", value), ("Index", index)], domain=domain,
+                         data_type=data_type).outputs[0]  # by name: 4.2 has Index first, 5.x Value first
 
     def on(self, domain, data_type, value):
         """``value`` evaluated on ``domain`` and read back in the caller's domain (Evaluate on Domain)."""
-        return self.node("GeometryNodeFieldOnDomain", [(0, value)], domain=domain, data_type=data_type).outputs[0]
+        return self.node("GeometryNodeFieldOnDomain", [("Value", value)], domain=domain,
+                         data_type=data_type).outputs[0]
 
 
 def socket(tree, name, kind, in_out="INPUT", description="", default=None, min_value=None, max_value=None):

@@ -31,13 +31,13 @@ def _build(tree):
     coarse = g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
 
     position = g.node("GeometryNodeInputPosition").outputs[0]
-    normal = g.node("GeometryNodeInputNormal").outputs[0]
+    normal = g.on("POINT", "FLOAT_VECTOR", g.node("GeometryNodeInputNormal").outputs[0])  # point normals
+    index = g.node("GeometryNodeInputIndex").outputs[0]
     p, n = [], []
-    for k in range(3):  # the face's corners in order, read in the face domain
-        corner = g.node("GeometryNodeCornersOfFace", [("Sort Index", k)]).outputs["Corner Index"]
-        vertex = g.node("GeometryNodeVertexOfCorner", [(0, corner)]).outputs[0]
-        p.append(g.at("POINT", "FLOAT_VECTOR", position, vertex))
-        n.append(g.at("POINT", "FLOAT_VECTOR", normal, vertex))
+    for k in range(3):  # the face's corners in order: values on the corner domain, read from the face domain
+        corner = g.node("GeometryNodeCornersOfFace", [("Face Index", index), ("Sort Index", k)]).outputs[0]
+        p.append(g.at("CORNER", "FLOAT_VECTOR", position, corner))
+        n.append(g.at("CORNER", "FLOAT_VECTOR", normal, corner))
 
     def tangent(i, j):  # (2 Pi + Pj - ((Pj - Pi).Ni) Ni) / 3
         w = g.vec("DOT_PRODUCT", g.vec("SUBTRACT", p[j], p[i]), n[i], out=1)
@@ -57,7 +57,7 @@ def _build(tree):
     for name, field in zip(_CONTROL, controls, strict=True):
         geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", name), ("Value", field)],
                           data_type="FLOAT_VECTOR", domain="FACE").outputs[0]
-    k = g.node("GeometryNodeFaceOfCorner").outputs["Index in Face"]
+    k = g.node("GeometryNodeFaceOfCorner", [(0, index)]).outputs["Index in Face"]
     one_hot = g.xyz(*(g.node("ShaderNodeMath", [(0, k), (1, float(i)), (2, 0.5)], operation="COMPARE").outputs[0]
                       for i in range(3)))
     geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", _BARY), ("Value", one_hot)],
