@@ -17,6 +17,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   edges marked sharp at Loop level 3 (``tessera.loop_subdivide``);
 - ``out/demo_loop_hce.png``: a Cornell-like box; Suzanne's light baked by Cycles into its HCE, shown on the coarse
   mesh (left) and carried to Loop level 3 (right) as vertex colours (``tessera.bake_lighting_hce``);
+- ``out/demo_node_groups.png``: Suzanne as it is, and with the Tessera Phong and PN Triangles node groups as
+  modifiers (``tessera.node_group_add``; geometry nodes do the work);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -422,6 +424,32 @@ def build_hce_scene():
     return seconds, len(out.data.polygons)
 
 
+def build_node_groups_scene():
+    """Suzanne as it is (left), with the Tessera Phong group (middle) and the Tessera PN Triangles group (right) as
+    modifiers, Level 2: non-destructive, and evaluated by geometry nodes alone. Returns the triangle counts."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    counts = []
+    for x, group in ((-2.6, None), (0.0, "Tessera Phong"), (2.6, "Tessera PN Triangles")):
+        ob = add_suzanne((x, 0.0, 0.0), clay)
+        if group is not None:
+            for other in bpy.context.selected_objects:
+                other.select_set(False)
+            ob.select_set(True)
+            bpy.context.view_layer.objects.active = ob
+            if bpy.ops.tessera.node_group_add(group=group) != {"FINISHED"}:
+                sys.exit(f"demo: node_group_add {group} failed")
+        wire = wire_overlay(ob, wire_mat)
+        for mod in ob.modifiers:  # the wire copy shows the group's triangles too
+            copy = wire.modifiers.new(mod.name, "NODES")
+            copy.node_group = mod.node_group
+            wire.modifiers.move(len(wire.modifiers) - 1, 0)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        counts.append(len(ob.evaluated_get(depsgraph).data.polygons))
+    add_camera((0.0, -10.5, 0.55), (1.5, 0.0, 0.0), lens=42)
+    return counts
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -473,10 +501,14 @@ def main():
     seconds, tris = build_hce_scene()
     render("demo_loop_hce.png", color_type="VERTEX", light="FLAT")
     print(f"demo: lighting baked to HCE in {seconds:.1f} s, carried to Loop level 3 ({tris:,} triangles)")
+    counts = build_node_groups_scene()
+    render("demo_node_groups.png")
+    print(f"demo: Suzanne with the Tessera Phong / PN Triangles groups as modifiers: {counts} faces")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png"):
+                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
+                 "demo_node_groups.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
