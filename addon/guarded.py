@@ -64,7 +64,7 @@ class Transaction:
                 traceback.print_exc()
         for block in reversed(self._blocks):
             try:
-                _remove(block)
+                remove_block(block)
             except ReferenceError:  # removed already (a writer replaced it): nothing left to do
                 pass
             except RuntimeError as err:
@@ -73,7 +73,7 @@ class Transaction:
         self._undo.clear()
 
 
-def _remove(block):
+def remove_block(block):
     """Remove a new ID from its bpy.data collection (a ReferenceError when something removed it already)."""
     for id_type, name in _COLLECTIONS:
         if isinstance(block, id_type):

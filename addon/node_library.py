@@ -58,8 +58,7 @@ def write_library(directory):
         for spec, tree in zip(specs, trees, strict=True):
             tree.asset_mark()
             tree.asset_data.catalog_id = catalog_id(spec.catalog)
-            tree.asset_data.description = (tree.bl_description if hasattr(tree, "bl_description") else "") or \
-                f"Tessera: {spec.name}"
+            tree.asset_data.description = f"Tessera: {spec.name}"
         tmp = path.with_suffix(".tmp.blend")
         bpy.data.libraries.write(str(tmp), set(trees), fake_user=True)
         tmp.replace(path)  # never a half-written library

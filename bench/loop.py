@@ -29,10 +29,11 @@ from pathlib import Path
 
 import numpy as np
 from _setup import enable_extension, import_path
+from tessellation import SUBSURF_LEVEL, subsurf_apply  # the same baseline as bench/tessellation.py
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools" / "osd_oracle"))
 REPEAT = 5
-SUBSURF_LEVEL, LOOP_LEVEL = 5, 5
+LOOP_LEVEL = 5
 
 
 def suzanne(bpy, smooth):
@@ -71,23 +72,6 @@ def vtk_filter(v, f, level):
         return filt.GetOutput().GetNumberOfPolys()
 
     return run
-
-
-def subsurf_apply(bpy, ob):
-    copy = ob.copy()
-    copy.data = ob.data.copy()
-    bpy.context.scene.collection.objects.link(copy)
-    bpy.context.view_layer.objects.active = copy
-    t = time.perf_counter()
-    mod = copy.modifiers.new("Subdivision", "SUBSURF")
-    mod.levels = SUBSURF_LEVEL
-    bpy.ops.object.modifier_apply(modifier=mod.name)
-    seconds = time.perf_counter() - t
-    n = 2 * len(copy.data.polygons)  # quads from level 1 on
-    me = copy.data
-    bpy.data.objects.remove(copy)
-    bpy.data.meshes.remove(me)
-    return seconds, n
 
 
 def loop_operator(bpy, ob):
@@ -187,7 +171,7 @@ def main():
     for _ in range(REPEAT):
         seconds, n_op = loop_operator(bpy, ob)
         best_op = min(best_op, seconds)
-        seconds, n_sub = subsurf_apply(bpy, ob)
+        seconds, n_sub = subsurf_apply(bpy, ob, repeat=1)  # one per round: the rounds interleave
         best_sub = min(best_sub, seconds)
     print(json.dumps(row(f"operator_level_{LOOP_LEVEL}", best_op, n_op,
                          f"Subdivision Surface level {SUBSURF_LEVEL} add + apply", best_sub, n_sub,

@@ -54,10 +54,11 @@ def subsurf_evaluate(bpy, ob):
     return min(r[0] for r in runs), runs[0][1]
 
 
-def subsurf_apply(bpy, ob):
-    """Seconds to add the modifier and apply it to a copy of the mesh, and the triangle count."""
+def subsurf_apply(bpy, ob, repeat=REPEAT):
+    """Seconds to add the modifier and apply it to a copy of the mesh (best of ``repeat``), and the triangle
+    count."""
     best, n = float("inf"), 0
-    for _ in range(REPEAT):
+    for _ in range(repeat):
         copy = ob.copy()
         copy.data = ob.data.copy()
         bpy.context.scene.collection.objects.link(copy)

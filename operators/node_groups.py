@@ -6,9 +6,12 @@ from ..addon import node_groups, node_library  # noqa: F401 (node_library: every
 from ..addon.guarded import guarded
 from ..kernels.common.errors import InvalidInputError
 
+_ITEMS = []  # Blender keeps only pointers to the strings of dynamic enum items: they must outlive the call
+
 
 def _group_items(self, context):
-    return [(name, name, f"Add {name} as a modifier") for name in sorted(node_groups.GROUPS)]
+    _ITEMS[:] = [(name, name, f"Add {name} as a modifier") for name in sorted(node_groups.GROUPS)]
+    return _ITEMS
 
 
 class TESSERA_OT_node_group_add(bpy.types.Operator):

@@ -14,6 +14,7 @@ from ..addon.subdivision.bake import bake_colours
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
 from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.common.normals import face_unit_normals
 from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
@@ -131,9 +132,9 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
                                    self.samples, self.albedo)
             wm.progress_update(80)
             n_f, leaves = len(arrays.triangles), 4**self.depth
-            normals = hce.face_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
+            normals = face_unit_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
             trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), normals,
-                                       hce.face_normals(arrays.positions, arrays.triangles), m=self.normals,
+                                       face_unit_normals(arrays.positions, arrays.triangles), m=self.normals,
                                        tolerance=self.tolerance)
             blob = hce.pack_container(trees, arrays.triangles, 4)
         finally:

@@ -48,6 +48,17 @@ def pytest_sessionfinish(session, exitstatus):
         session.exitstatus = 1
 
 
+@pytest.fixture
+def numpy_reference():
+    """Run a test on the numpy reference (OpenCL off), whatever the environment says; the OpenCL tests compare
+    the OpenCL paths with it."""
+    from tessera.kernels.common import opencl_runtime
+
+    opencl_runtime.configure(mode="0")
+    yield
+    opencl_runtime.configure()
+
+
 @pytest.fixture(scope="session")
 def tmp_root():
     return _TMP

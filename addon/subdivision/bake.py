@@ -15,6 +15,7 @@ from ...kernels.common.errors import TesseraError
 from ...kernels.common.mesh_arrays import MeshArrays
 from ...kernels.subdivision.bake_atlas import atlas_size, atlas_uvs, triangle_means
 from .. import bridge, compat
+from ..guarded import remove_block
 
 UV_NAME = "TesseraBake"
 
@@ -102,7 +103,4 @@ def bake_colours(context, ob, positions, triangles, material_index, samples, alb
         return colours
     finally:
         for block in made:
-            collection = {bpy.types.Object: bpy.data.objects, bpy.types.Mesh: bpy.data.meshes,
-                          bpy.types.Image: bpy.data.images}.get(type(block), bpy.data.materials)
-            if block.name in collection and collection[block.name] == block:
-                collection.remove(block)
+            remove_block(block)

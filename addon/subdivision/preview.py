@@ -5,10 +5,11 @@ Nothing is drawn or compiled in background mode."""
 import bpy
 import numpy as np
 
+from ...kernels.common.normals import shared_vertex_normals
 from ..bridge import read_edge_marks, read_mesh
 from ..preferences import get_preferences
 from ..viewport import Preview, PreviewEntry
-from .build import HCE_PROPERTY, subdivide, vertex_normals
+from .build import HCE_PROPERTY, subdivide
 from .settings import TOPIC
 
 
@@ -19,7 +20,7 @@ def build_draw_data(ob, budget_bytes=0):
     arrays, _ = read_mesh(ob.data)
     build = subdivide(arrays, read_edge_marks(ob.data), ob.tessera.loop, ob.data.get(HCE_PROPERTY), budget_bytes)
     r = build.result
-    return LoopDrawData(r.positions, vertex_normals(r.positions, r.triangles), build.baked, r.triangles)
+    return LoopDrawData(r.positions, shared_vertex_normals(r.positions, r.triangles), build.baked, r.triangles)
 
 
 def entry_for(ob):

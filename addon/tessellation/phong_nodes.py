@@ -14,20 +14,27 @@ normals, so shared edges stay shared.
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Phong"
-VERSION = 2
+VERSION = 3
+
+
+def surface_interface(g, shape_default, shape_description):
+    """The sockets the curved-surface groups share (Geometry, Level, Shape Factor -> Geometry); returns the group
+    input and output nodes and the triangulated input mesh."""
+    tree = g.tree
+    socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
+    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
+           description="Subdivision levels of every face (Subdivide Mesh)")
+    socket(tree, "Shape Factor", "NodeSocketFloat", default=shape_default, min_value=0.0, max_value=1.0,
+           description=shape_description)
+    socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The curved, finer mesh")
+    gi, go = g.node("NodeGroupInput"), g.node("NodeGroupOutput")
+    return gi, go, g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
 
 
 def _build(tree):
     g = Graph(tree)
-    socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
-    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
-           description="Each level splits every triangle in four (Subdivide Mesh)")
-    socket(tree, "Shape Factor", "NodeSocketFloat", default=0.75, min_value=0.0, max_value=1.0,
-           description="0: flat triangles; 1: full Phong tessellation (0.75 as in the paper); a field, so it "
-                       "can vary per vertex")
-    socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The curved, finer mesh")
-    gi, go = g.node("NodeGroupInput"), g.node("NodeGroupOutput")
-    coarse = g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
+    gi, go, coarse = surface_interface(g, 0.75, "0: flat triangles; 1: full Phong tessellation (0.75 as in the "
+                                                "paper); a field, so it can vary per vertex")
     position = g.node("GeometryNodeInputPosition").outputs[0]
     normal = g.on("POINT", "FLOAT_VECTOR", g.node("GeometryNodeInputNormal").outputs[0])
     n = g.split(normal)

@@ -11,24 +11,19 @@ mean of their corners. The result is ``p + a (pn - p)`` with the shape factor a 
 normals.
 """
 
-from ..node_groups import Graph, GroupSpec, register_group, socket
+from ..node_groups import Graph, GroupSpec, register_group
+from .phong_nodes import surface_interface
 
 GROUP_NAME = "Tessera PN Triangles"
-VERSION = 1
+VERSION = 2
 _CONTROL = [f"tessera_pn_{i}" for i in range(10)]  # order of cubic_basis: P1 P2 P3 b210 b120 b021 b012 b102 b201 b111
 _BARY = "tessera_pn_bary"
 
 
 def _build(tree):
     g = Graph(tree)
-    socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
-    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
-           description="Subdivision levels (Subdivide Mesh) of every triangle")
-    socket(tree, "Shape Factor", "NodeSocketFloat", default=1.0, min_value=0.0, max_value=1.0,
-           description="0: flat triangles; 1: PN triangles; a field, so it can vary per vertex")
-    socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The curved, finer mesh")
-    gi, go = g.node("NodeGroupInput"), g.node("NodeGroupOutput")
-    coarse = g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
+    gi, go, coarse = surface_interface(g, 1.0, "0: flat triangles; 1: PN triangles; a field, so it can vary per "
+                                               "vertex")
 
     position = g.node("GeometryNodeInputPosition").outputs[0]
     normal = g.on("POINT", "FLOAT_VECTOR", g.node("GeometryNodeInputNormal").outputs[0])  # point normals

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.normals import accumulate
 
 SLOTS = "TLCR"
 
@@ -180,22 +181,11 @@ def select_colours(hce, levels, root_normals, face_normals):
     return hce.colours[nodes, k]
 
 
-def face_normals(positions, triangles):
-    """Unit normals (F, 3) float64 of triangles (F, 3) over positions (V, 3) (zero for degenerate ones)."""
-    p = np.asarray(positions, np.float64)
-    t = np.asarray(triangles)
-    n = np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
-
-
 def vertex_colours(triangles, face_colours, n_vertices):
     """Mean of the colours (F, C) of the faces around each vertex: (V, C) float32 (uniform weights, in face order)."""
-    t = np.asarray(triangles).ravel()
-    counts = np.bincount(t, minlength=n_vertices).astype(np.float64)
-    corner = np.repeat(np.asarray(face_colours, np.float64), 3, axis=0)
-    out = np.stack([np.bincount(t, corner[:, c], n_vertices) for c in range(corner.shape[1])], axis=1)
-    return (out / np.maximum(counts, 1)[:, None]).astype(np.float32)
+    corner = np.repeat(np.asarray(face_colours, np.float64)[:, None, :], 3, axis=1)
+    counts = np.bincount(np.asarray(triangles).ravel(), minlength=n_vertices)
+    return (accumulate(triangles, corner, n_vertices) / np.maximum(counts, 1)[:, None]).astype(np.float32)
 
 
 def pick_normals(leaf_normals, root_normals, m, cos_spread=0.9):

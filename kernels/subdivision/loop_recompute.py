@@ -60,17 +60,25 @@ class Recomputation:
         self.output_triangles = lv.triangles
         self.n_out = int(lv.triangles.max()) + 1
 
-    def patch(self, t):
-        """Coarse triangle ``t`` subdivided from its 1-ring alone: (global vertex ids (4^L, 3) of its sub-triangles,
-        their values (4^L, 3, D) float64)."""
+    def local_patch(self, t):
+        """Coarse triangle ``t``'s 1-ring as a mesh of its own: (global ids (P,) of its points, sorted, so the
+        renumbering keeps the global order; its triangles (k, 3) in local ids, in global face order; the creases
+        among its points ``(pairs, sharpness)`` in local ids, or None)."""
         ring = self.rings[t]
-        verts = np.unique(self.triangles[ring])  # sorted: the renumbering keeps the global order
+        verts = np.unique(self.triangles[ring])
         local = np.searchsorted(verts, self.triangles[ring])
         creases = None
         if self.creases is not None and len(self.creases[0]):
             pairs = np.asarray(self.creases[0], np.int64).reshape(-1, 2)
             keep = np.isin(pairs, verts).all(axis=1)
             creases = (np.searchsorted(verts, pairs[keep]), np.asarray(self.creases[1])[keep])
+        return verts, local, creases
+
+    def patch(self, t):
+        """Coarse triangle ``t`` subdivided from its 1-ring alone: (global vertex ids (4^L, 3) of its sub-triangles,
+        their values (4^L, 3, D) float64)."""
+        ring = self.rings[t]
+        verts, local, creases = self.local_patch(t)
         lv = coarse_level(local, len(verts), creases, self.vertex_sharpness[verts],
                           self.boundary == "EDGE_AND_CORNER")
         values = self.values[verts]

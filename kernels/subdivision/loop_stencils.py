@@ -52,31 +52,19 @@ def build(positions, triangles, levels, creases=None, vertex_sharpness=None, bou
     tris = rec.triangles
     n_f, n_sub = len(tris), 4**levels
     rows = (2**levels + 1) * (2**levels + 2) // 2
-    patches = [np.unique(tris[ring]) for ring in rec.rings]
+    local = [rec.local_patch(t) for t in range(n_f)]
+    patches = [verts for verts, _, _ in local]
     sizes = np.array([len(p) for p in patches])
     width = int(sizes.max())
     first = np.concatenate([[0], np.cumsum(sizes)])  # each patch's first point in the union
     union_points = np.concatenate(patches)
-    ring_sizes = np.array([len(r) for r in rec.rings])
-    face_first = np.concatenate([[0], np.cumsum(ring_sizes)])
-    union_faces = np.concatenate([first[t] + np.searchsorted(patches[t], tris[ring]) for t, ring in
-                                  enumerate(rec.rings)])
+    union_faces = np.concatenate([first[t] + faces for t, (_, faces, _) in enumerate(local)])
+    face_first = np.concatenate([[0], np.cumsum([len(faces) for _, faces, _ in local])])
     own = face_first[:-1] + np.array([np.searchsorted(ring, t) for t, ring in enumerate(rec.rings)])
-    local = np.arange(len(union_points)) - np.repeat(first[:-1], sizes)
     identity = np.zeros((len(union_points), width))
-    identity[np.arange(len(union_points)), local] = 1.0
-    union_creases = None
-    if creases is not None and len(creases[0]):
-        pairs = np.asarray(creases[0], np.int64).reshape(-1, 2)
-        values = np.asarray(creases[1], np.float32)
-        found_pairs, found_values = [], []
-        for t in range(n_f):  # a crease goes into every patch that holds both its points
-            in_patch = np.isin(pairs, patches[t]).all(axis=1)
-            if in_patch.any():
-                found_pairs.append(first[t] + np.searchsorted(patches[t], pairs[in_patch]))
-                found_values.append(values[in_patch])
-        if found_pairs:
-            union_creases = (np.concatenate(found_pairs), np.concatenate(found_values))
+    identity[np.arange(len(union_points)), np.arange(len(union_points)) - np.repeat(first[:-1], sizes)] = 1.0
+    found = [(first[t] + c[0], c[1]) for t, (_, _, c) in enumerate(local) if c is not None and len(c[0])]
+    union_creases = (np.concatenate([p for p, _ in found]), np.concatenate([v for _, v in found])) if found else None
     vs = None if vertex_sharpness is None else np.asarray(vertex_sharpness, np.float32)[union_points]
     result = loop_subdivide(np.zeros((len(union_points), 3)), union_faces, levels, creases=union_creases,
                             vertex_sharpness=vs, boundary=boundary, point_data={"w": identity}, dtype=np.float64,

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.normals import face_unit_normals, shared_vertex_normals
 from ..common.partition import MAX_LEVEL
 from ..common.topology import triangle_edges, validate_triangles
 from . import metrics
-from .normals import face_unit_normals, shared_vertex_normals
 from .patches import pn_control, pn_edge_control
 
 METRICS = ("DISTANCE", "PROJECTED", "SILHOUETTE", "CURVATURE")

@@ -21,10 +21,11 @@ from ..common import workers
 from ..common.budget import Estimate
 from ..common.errors import InvalidInputError
 from ..common.mesh_arrays import MeshArrays
+from ..common.normals import shared_vertex_normals
 from ..common.topology import triangle_edges, validate_triangles
 from . import patches
 from .interpolate import corner_values, face_values, normalized, point_values
-from .normals import NORMAL_MODES, shared_vertex_normals, split_by_normals, split_corners
+from .normals import NORMAL_MODES, split_by_normals, split_corners
 from .refine import refine, refinement_counts
 from .surface_eval import evaluate_corners, evaluate_corners_by_class, evaluate_surface
 

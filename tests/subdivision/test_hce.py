@@ -6,26 +6,20 @@ import struct
 import numpy as np
 import pytest
 from meshes import random_irregular_closed
-from tessera.kernels.common import opencl_runtime
 from tessera.kernels.common.errors import InvalidInputError
+from tessera.kernels.common.normals import face_unit_normals
 from tessera.kernels.subdivision.hce import (
     HceMesh,
     HceTree,
     decode,
     encode,
-    face_normals,
     path_nodes,
     select_colours,
     vertex_colours,
 )
 from tessera.kernels.subdivision.loop import loop_subdivide
 
-
-@pytest.fixture(autouse=True)
-def numpy_reference():
-    opencl_runtime.configure(mode="0")
-    yield
-    opencl_runtime.configure()
+pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
 
 def random_tree(rng, depth, m, channels=3, p=0.6):
@@ -139,8 +133,8 @@ def test_vertex_colours_average_every_incident_sub_triangle():
     trees = [random_tree(rng, 2, int(rng.integers(0, 3)))[0] for _ in range(len(f))]
     hce = HceMesh.pack(trees)
     r = loop_subdivide(v, f, 2, dtype=np.float64)
-    faces = face_normals(r.positions, r.triangles)
-    colours = select_colours(hce, 2, face_normals(v, f), faces)
+    faces = face_unit_normals(r.positions, r.triangles)
+    colours = select_colours(hce, 2, face_unit_normals(v, f), faces)
     per_vertex = vertex_colours(r.triangles, colours, len(r.positions))
     # an explicit average over the faces around a few vertices, coarse-edge vertices (from two coarse faces) included
     on_edges = np.flatnonzero(r.coarse_edge() >= 0)
@@ -153,7 +147,7 @@ def test_vertex_colours_average_every_incident_sub_triangle():
 def leaf_samples(v, f, depth, colour_fn):
     """Loop-subdivide to ``depth`` and sample a colour per sub-triangle: (colours (F, 4^D, C), normals, result)."""
     r = loop_subdivide(v, f, depth, dtype=np.float64)
-    normals = face_normals(r.positions, r.triangles)
+    normals = face_unit_normals(r.positions, r.triangles)
     centres = r.positions[r.triangles].mean(axis=1)
     colours = colour_fn(centres, normals)
     return colours.reshape(len(f), 4**depth, -1), normals.reshape(len(f), 4**depth, 3), r
@@ -170,7 +164,7 @@ def test_encoded_samples_decode_within_the_tolerance():
         return np.concatenate([lambert * (0.5 + 0.5 * np.sin(3 * centres)), np.ones((len(centres), 1))], axis=1)
 
     cols, normals, r = leaf_samples(v, f, 3, shade)
-    roots = face_normals(v, f)
+    roots = face_unit_normals(v, f)
     for tol in (0.0, 0.02, 0.2):
         trees = encode_samples(cols, normals, roots, m=4, tolerance=tol)
         hce = HceMesh.pack(trees)

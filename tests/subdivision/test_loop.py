@@ -15,19 +15,12 @@ from meshes import (
     random_irregular_closed,
     torus,
 )
-from tessera.kernels.common import opencl_runtime
 from tessera.kernels.common.errors import BudgetError, InvalidInputError
 from tessera.kernels.subdivision.loop import estimate, loop_subdivide
 from tessera.kernels.subdivision.loop_rules import correction_factor, correction_table, crease_to_sharpness, loop_beta
 from tessera.kernels.subdivision.loop_topology import coarse_level
 
-
-@pytest.fixture(autouse=True)
-def numpy_reference():
-    """These tests check the numpy reference; test_opencl_loop.py compares the OpenCL path with it."""
-    opencl_runtime.configure(mode="0")
-    yield
-    opencl_runtime.configure()
+pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
 
 # Digest §A.3.2: cf(n) and beta(n) for n = 3..12, to the printed 6 decimals.

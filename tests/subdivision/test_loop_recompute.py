@@ -5,17 +5,11 @@ whatever the order the triangles are taken in."""
 import numpy as np
 import pytest
 from meshes import bipyramid, cup, plane_with_hole, random_irregular_closed
-from tessera.kernels.common import opencl_runtime
 from tessera.kernels.subdivision.loop import loop_subdivide
 from tessera.kernels.subdivision.loop_recompute import Recomputation, one_ring
 from tessera.kernels.subdivision.loop_topology import coarse_level
 
-
-@pytest.fixture(autouse=True)
-def numpy_reference():
-    opencl_runtime.configure(mode="0")
-    yield
-    opencl_runtime.configure()
+pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
 
 MESHES = {"irregular": lambda: random_irregular_closed(5), "bipyramid16": lambda: bipyramid(16), "cup": cup,

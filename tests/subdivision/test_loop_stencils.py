@@ -5,7 +5,6 @@ positions."""
 import numpy as np
 import pytest
 from meshes import bipyramid, cup, random_irregular_closed
-from tessera.kernels.common import opencl_runtime
 from tessera.kernels.subdivision import loop_stencils
 from tessera.kernels.subdivision.loop import loop_subdivide
 from tessera.kernels.subdivision.loop_topology import coarse_level
@@ -13,40 +12,34 @@ from tessera.kernels.subdivision.loop_topology import coarse_level
 MESHES = {"irregular": lambda: random_irregular_closed(2), "bipyramid16": lambda: bipyramid(16), "cup": cup}
 
 
+@pytest.mark.usefixtures("numpy_reference")
 @pytest.mark.parametrize("name", list(MESHES))
 def test_stencils_equal_the_reference_and_agree_on_shared_vertices(name):
-    opencl_runtime.configure(mode="0")
-    try:
-        v, f = MESHES[name]()
-        for level in (1, 2, 3):
-            table = loop_stencils.build(v, f, level)
-            ref = loop_subdivide(v, f, level, dtype=np.float64)
-            assert np.array_equal(table.triangles, ref.triangles)
-            out = loop_stencils.apply(table, v)
-            assert np.abs(out - ref.positions).max() <= 1e-14 * np.abs(v).max()
-            # every triangle's own rows: shared vertices get the same bits from each writer
-            rows = np.einsum("fkp,fpd->fkd", table.weights[table.stencil],
-                             np.where((table.patch >= 0)[..., None], v[np.maximum(table.patch, 0)], 0.0))
-            assert np.array_equal(rows, out[table.outputs])
-            # the stencils are the same for any positions
-            moved = v + np.random.default_rng(level).normal(size=v.shape)
-            assert np.abs(loop_stencils.apply(table, moved) -
-                          loop_subdivide(moved, f, level, dtype=np.float64).positions).max() <= 1e-13
-    finally:
-        opencl_runtime.configure()
+    v, f = MESHES[name]()
+    for level in (1, 2, 3):
+        table = loop_stencils.build(v, f, level)
+        ref = loop_subdivide(v, f, level, dtype=np.float64)
+        assert np.array_equal(table.triangles, ref.triangles)
+        out = loop_stencils.apply(table, v)
+        assert np.abs(out - ref.positions).max() <= 1e-14 * np.abs(v).max()
+        # every triangle's own rows: shared vertices get the same bits from each writer
+        rows = np.einsum("fkp,fpd->fkd", table.weights[table.stencil],
+                         np.where((table.patch >= 0)[..., None], v[np.maximum(table.patch, 0)], 0.0))
+        assert np.array_equal(rows, out[table.outputs])
+        # the stencils are the same for any positions
+        moved = v + np.random.default_rng(level).normal(size=v.shape)
+        assert np.abs(loop_stencils.apply(table, moved) -
+                      loop_subdivide(moved, f, level, dtype=np.float64).positions).max() <= 1e-13
 
 
+@pytest.mark.usefixtures("numpy_reference")
 def test_creases_in_the_stencils():
-    opencl_runtime.configure(mode="0")
-    try:
-        v, f = random_irregular_closed(4)
-        edges = coarse_level(f, len(v)).edges
-        creases = edges[::6], np.full(len(edges[::6]), 1.5, np.float32)
-        table = loop_stencils.build(v, f, 2, creases=creases)
-        ref = loop_subdivide(v, f, 2, creases=creases, dtype=np.float64)
-        assert np.abs(loop_stencils.apply(table, v) - ref.positions).max() <= 1e-14
-    finally:
-        opencl_runtime.configure()
+    v, f = random_irregular_closed(4)
+    edges = coarse_level(f, len(v)).edges
+    creases = edges[::6], np.full(len(edges[::6]), 1.5, np.float32)
+    table = loop_stencils.build(v, f, 2, creases=creases)
+    ref = loop_subdivide(v, f, 2, creases=creases, dtype=np.float64)
+    assert np.abs(loop_stencils.apply(table, v) - ref.positions).max() <= 1e-14
 
 
 @pytest.mark.opencl

@@ -6,10 +6,10 @@ from meshes import edge_use_counts, is_closed_oriented_manifold, octahedron, ran
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.common.mesh_arrays import MeshArrays
+from tessera.kernels.common.normals import face_unit_normals
 from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation import surface_eval
 from tessera.kernels.tessellation.adaptive import METRICS, AdaptiveSettings, adaptive_levels, face_side_edge_levels
-from tessera.kernels.tessellation.normals import face_unit_normals
 from tessera.kernels.tessellation.tessellate import SurfaceOptions, tessellate, uniform_levels
 
 

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from tessera.kernels.common import opencl_runtime
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.tubes.builder import TubeSettings, build_tubes, pixel_world_size, prepare_lines
@@ -10,13 +9,7 @@ from tessera.kernels.tubes.curve_refine import catmull_rom, select_points
 from tessera.kernels.tubes.frames import rotation_minimizing_frames, tangents
 from tessera.kernels.tubes.polylines import Polylines, drop_duplicates
 
-
-@pytest.fixture(autouse=True)
-def numpy_reference():
-    """These tests check the numpy reference; tests/tubes/test_opencl_tubes.py compares the OpenCL path with it."""
-    opencl_runtime.configure(mode="0")
-    yield
-    opencl_runtime.configure()
+pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
 
 def helix(a=1.0, b=0.3, turns=2.0, n=400):
