@@ -8,10 +8,13 @@ ask for it, and the version is compared only where the difference cannot be seen
   `set_split_custom_normals`, `CUSTOM_NORMAL_STORAGE_ERROR`);
 - stroke elements: 4.2's `OperatorStrokeElement` requires ``pen_flip`` when built from Python (`stroke_element`);
 - geometry-nodes modifier inputs: ``mod[identifier] = value`` until 5.1, ``mod.properties.inputs`` from 5.2
-  (`set_modifier_input`);
+  (`set_modifier_input`); menu inputs by item name from 5.2, by an internal integer before (`menu_input_value`);
 - the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`);
 - materials: 5.0+ materials always have a node tree (``use_nodes`` is deprecated); 4.x needs the flag set
-  (`use_material_nodes`).
+  (`use_material_nodes`);
+- geometry-node modes (Set Curve Normal, Resample Curve, Merge by Distance, ...): a node property until 4.5, a
+  menu input socket from 5.0 (`set_node_mode`); Curve to Mesh scales the profile by the curve radius by itself in
+  4.2 and through its Scale input from 4.5 (builders link the radius where the node has that input).
 """
 
 import math
@@ -63,6 +66,38 @@ def set_modifier_input(mod, identifier, value):
         mod[identifier] = value
     else:
         getattr(inputs, identifier).value = value
+
+
+def set_node_mode(node, name, identifier, label):
+    """Choose a geometry node's mode: the input socket ``name`` (5.0+, the item's ``label``) where the node has
+    one, else the property ``name.lower()`` (the item's ``identifier``)."""
+    socket = node.inputs.get(name)
+    if socket is not None and socket.type == "MENU":
+        socket.default_value = label
+    else:
+        setattr(node, name.lower().replace(" ", "_"), identifier)
+
+
+
+def menu_input_value(tree, item, label):
+    """What `set_modifier_input` takes for the menu socket ``item`` of ``tree`` set to its item ``label``: the label
+    from 5.2 (``mod.properties.inputs`` speaks names); before, the item's internal integer identifier, which Python
+    cannot read: a throw-away modifier on a throw-away mesh is made with the label as the socket's default and
+    its stored value is read back."""
+    if hasattr(bpy.types, "NodesModifier") and "properties" in bpy.types.NodesModifier.bl_rna.properties:
+        return label
+    old = item.default_value
+    mesh = bpy.data.meshes.new("__tessera_menu_probe")
+    probe = bpy.data.objects.new("__tessera_menu_probe", mesh)
+    try:
+        item.default_value = label
+        mod = probe.modifiers.new("probe", "NODES")
+        mod.node_group = tree
+        return int(mod[item.identifier])
+    finally:
+        bpy.data.objects.remove(probe)
+        bpy.data.meshes.remove(mesh)
+        item.default_value = old
 
 
 def has_uv_tangent_node():

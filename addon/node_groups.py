@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import bpy
 
-from .compat import set_modifier_input
+from .compat import menu_input_value, set_modifier_input
 
 
 class Graph:
@@ -56,6 +56,27 @@ class Graph:
         """``value`` evaluated on ``domain`` at ``index`` (Evaluate at Index)."""
         return self.node("GeometryNodeFieldAtIndex", [("Value", value), ("Index", index)], domain=domain,
                          data_type=data_type).outputs[0]  # by name: 4.2 has Index first, 5.x Value first
+
+    def store(self, geometry, name, value, data_type="FLOAT", domain="POINT"):
+        """``geometry`` with the named attribute ``name`` set to the field ``value``."""
+        return self.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", name), ("Value", value)],
+                         data_type=data_type, domain=domain).outputs[0]
+
+    def named(self, name, data_type="FLOAT"):
+        return self.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type=data_type).outputs[0]
+
+    def remove(self, geometry, names):
+        for name in names:
+            geometry = self.node("GeometryNodeRemoveAttribute", [(0, geometry), ("Name", name)]).outputs[0]
+        return geometry
+
+    def switch(self, data_type, condition, false, true):
+        return self.node("GeometryNodeSwitch", [("Switch", condition), ("False", false), ("True", true)],
+                         input_type=data_type).outputs[0]
+
+    def input(self, kind, output=0):
+        """The output ``output`` of a new input node (Position, Index, ...)."""
+        return self.node(kind).outputs[output]
 
     def on(self, domain, data_type, value):
         """``value`` evaluated on ``domain`` and read back in the caller's domain (Evaluate on Domain)."""
@@ -119,5 +140,8 @@ def set_inputs(mod, values):
     (input values are ID properties: changing them does not tag the depsgraph by itself)."""
     for item in mod.node_group.interface.items_tree:
         if item.item_type == "SOCKET" and item.in_out == "INPUT" and item.name in values:
-            set_modifier_input(mod, item.identifier, values[item.name])
+            value = values[item.name]
+            if item.socket_type == "NodeSocketMenu":  # by the item's name
+                value = menu_input_value(mod.node_group, item, value)
+            set_modifier_input(mod, item.identifier, value)
     mod.id_data.update_tag()

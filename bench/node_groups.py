@@ -4,6 +4,10 @@
   Suzanne (968 triangles, Level 4 and 5) against Subdivision Surface evaluated at level 5 on the same object,
   output triangles per second (a quad counts as two triangles); and against ``tessera.tessellate`` (the same
   method, end to end, a new object) at about the same output.
+- ``tubes_group``: the "Tessera Tubes" group on a Curve object of CURVES poly splines of POINTS points (random
+  walks, radius per point), 8 sides, no caps, against Curve to Mesh with an 8-point Curve Circle profile scaled by
+  the radius (Blender's own sweep, its minimum-twist frames, no UVs), with and without the group's UVs, and
+  against ``tessera.tubes`` end to end; output quads per second.
 Timings: best of REPEAT, cases interleaved. Prints one JSON object per case. Run: make bench, or
 .venv/bin/python bench/node_groups.py
 """
@@ -25,9 +29,12 @@ def evaluate(bpy, ob, mod, set_level):
     t = time.perf_counter()
     mod.show_viewport = True
     depsgraph.update()
-    me = ob.evaluated_get(depsgraph).data
+    seconds = time.perf_counter() - t
+    evaluated = ob.evaluated_get(depsgraph)
+    me = evaluated.to_mesh()
     n = sum(len(p.vertices) - 2 for p in me.polygons) if len(me.polygons) < 1000 else 2 * len(me.polygons)
-    return time.perf_counter() - t, n
+    evaluated.to_mesh_clear()
+    return seconds, n
 
 
 def main():
@@ -45,6 +52,91 @@ def main():
         spec = importlib.import_module(f"{name}.addon.tessellation.{module}").SPEC
         for level in (4, 5):
             run(bpy, ob, groups, spec, method, level)
+    bpy.data.objects.remove(ob)
+    spec = importlib.import_module(f"{name}.addon.tubes.nodes").SPEC
+    run_tubes(bpy, groups, spec, random_walks(bpy, CURVES, POINTS))
+
+
+CURVES, POINTS, SIDES = 3000, 40, 8
+
+
+def random_walks(bpy, count, points):
+    """A Curve object of ``count`` POLY splines of ``points`` points each."""
+    import numpy as np
+
+    rng = np.random.default_rng(7)
+    data = bpy.data.curves.new("Walks", "CURVE")
+    data.dimensions = "3D"
+    for k in range(count):
+        s = data.splines.new("POLY")
+        s.points.add(points - 1)
+        walk = np.cumsum(rng.normal(size=(points, 3)) * 0.05, axis=0) + rng.uniform(-5, 5, 3)
+        s.points.foreach_set("co", np.c_[walk, np.ones(points)].ravel())
+        s.points.foreach_set("radius", rng.uniform(0.5, 1.5, points))
+    ob = bpy.data.objects.new("Walks", data)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def curve_to_mesh_group(bpy):
+    """Blender's own sweep: Curve to Mesh with a Curve Circle of SIDES points, scaled by the curve radius."""
+    tree = bpy.data.node_groups.new("Curve to Mesh baseline", "GeometryNodeTree")
+    tree.interface.new_socket("Curve", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Mesh", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    gi, go = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    circle = tree.nodes.new("GeometryNodeCurvePrimitiveCircle")
+    circle.mode = "RADIUS"
+    circle.inputs["Resolution"].default_value = SIDES
+    circle.inputs["Radius"].default_value = 0.02
+    sweep = tree.nodes.new("GeometryNodeCurveToMesh")
+    tree.links.new(gi.outputs[0], sweep.inputs["Curve"])
+    tree.links.new(circle.outputs[0], sweep.inputs["Profile Curve"])
+    if "Scale" in sweep.inputs:
+        tree.links.new(tree.nodes.new("GeometryNodeInputRadius").outputs[0], sweep.inputs["Scale"])
+    tree.links.new(sweep.outputs[0], go.inputs[0])
+    return tree
+
+
+def run_tubes(bpy, groups, spec, ob):
+    """The tubes group against Curve to Mesh and tessera.tubes: prints two JSON rows."""
+    best = {"group": float("inf"), "group_no_uv": float("inf"), "curve_to_mesh": float("inf"),
+            "operator": float("inf")}
+    counts = {}
+    baseline = curve_to_mesh_group(bpy)
+    tree = groups.ensure_group(spec)
+    trees = {"group": tree, "group_no_uv": tree, "curve_to_mesh": baseline}
+    inputs = {"group": {"Radius": 0.02, "Sides": SIDES}, "group_no_uv": {"Radius": 0.02, "Sides": SIDES, "UV Map": ""},
+              "curve_to_mesh": {}}
+    for _ in range(REPEAT):
+        for key, tree in trees.items():
+            mod = ob.modifiers.new(key, "NODES")
+            mod.node_group = tree
+            seconds, triangles = evaluate(bpy, ob, mod, lambda m, key=key: groups.set_inputs(m, inputs[key]))
+            counts[key] = triangles // 2
+            best[key] = min(best[key], seconds)
+            ob.modifiers.remove(mod)
+        for other in bpy.context.selected_objects:
+            other.select_set(False)
+        ob.select_set(True)
+        bpy.context.view_layer.objects.active = ob
+        t = time.perf_counter()
+        bpy.ops.tessera.tubes(radius=0.02, sides=SIDES, caps="NONE")
+        best["operator"] = min(best["operator"], time.perf_counter() - t)
+        out = bpy.context.active_object
+        counts["operator"] = len(out.data.polygons)
+        me = out.data
+        bpy.data.objects.remove(out)
+        bpy.data.meshes.remove(me)
+    rate = {k: counts[k] / best[k] for k in best}
+    for ours, base, label in (("group", "curve_to_mesh", f"Curve to Mesh, {SIDES}-point circle scaled by the radius"),
+                              ("group_no_uv", "curve_to_mesh", "the same, the group writing no UVs"),
+                              ("group", "operator", "tessera.tubes end to end (with UVs)")):
+        print(json.dumps({"bench": "node_groups", "case": f"tubes_{ours}_{CURVES}x{POINTS}_vs_{base}",
+                          "output_quads": counts[ours], "seconds": round(best[ours], 4),
+                          "quads_per_second": round(rate[ours]), "baseline": label,
+                          "baseline_quads": counts[base], "baseline_seconds": round(best[base], 4),
+                          "baseline_quads_per_second": round(rate[base]),
+                          "speedup": round(rate[ours] / rate[base], 2)}), flush=True)
 
 
 def run(bpy, ob, groups, spec, method, level):
@@ -79,7 +171,7 @@ def run(bpy, ob, groups, spec, method, level):
                           "triangles_per_second": round(rate["group"]), "baseline": label,
                           "baseline_triangles": counts[base], "baseline_seconds": round(best[base], 4),
                           "baseline_triangles_per_second": round(rate[base]),
-                          "speedup": round(rate["group"] / rate[base], 2)}), flush=True)
+                          "speedup": round(rate[ours] / rate[base], 2)}), flush=True)
 
 
 if __name__ == "__main__":
