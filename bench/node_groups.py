@@ -67,7 +67,7 @@ def random_walks(bpy, count, points):
     rng = np.random.default_rng(7)
     data = bpy.data.curves.new("Walks", "CURVE")
     data.dimensions = "3D"
-    for k in range(count):
+    for _ in range(count):
         s = data.splines.new("POLY")
         s.points.add(points - 1)
         walk = np.cumsum(rng.normal(size=(points, 3)) * 0.05, axis=0) + rng.uniform(-5, 5, 3)
@@ -171,7 +171,7 @@ def run(bpy, ob, groups, spec, method, level):
                           "triangles_per_second": round(rate["group"]), "baseline": label,
                           "baseline_triangles": counts[base], "baseline_seconds": round(best[base], 4),
                           "baseline_triangles_per_second": round(rate[base]),
-                          "speedup": round(rate[ours] / rate[base], 2)}), flush=True)
+                          "speedup": round(rate["group"] / rate[base], 2)}), flush=True)
 
 
 if __name__ == "__main__":

@@ -79,7 +79,8 @@ class _Tubes:
         ax, ay, az = (g.math("ABSOLUTE", c) for c in g.split(t))
         is_x = g.math("MINIMUM", g.math("SUBTRACT", 1.0, g.math("GREATER_THAN", ax, ay)),
                       g.math("SUBTRACT", 1.0, g.math("GREATER_THAN", ax, az)))
-        is_y = g.math("MULTIPLY", g.math("SUBTRACT", 1.0, is_x), g.math("SUBTRACT", 1.0, g.math("GREATER_THAN", ay, az)))
+        is_y = g.math("MULTIPLY", g.math("SUBTRACT", 1.0, is_x),
+                      g.math("SUBTRACT", 1.0, g.math("GREATER_THAN", ay, az)))
         is_z = g.math("SUBTRACT", g.math("SUBTRACT", 1.0, is_x), is_y)
         e = g.xyz(is_x, is_y, is_z)
         return g.vec("NORMALIZE", g.vec("SUBTRACT", e, g.vec("SCALE", t, self.dot(e, t))))
