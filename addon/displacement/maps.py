@@ -174,7 +174,7 @@ def sync_modifier(ob):
     if kind == "NODES":
         mod.node_group = displace_nodes.node_group()
         uv_map = settings.uv_map or getattr(ob.data.uv_layers.active, "name", "")
-        set_inputs(mod, {"Image": settings.image, "UV Map": uv_map,
+        set_inputs(mod, {"Map": "Tangent", "Image": settings.image, "UV Map": uv_map,
                                         "Mid-Level": settings.mid_level, "Strength": settings.strength})
         ob.update_tag()
         return mod

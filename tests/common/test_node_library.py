@@ -54,3 +54,91 @@ def test_node_group_add_puts_the_group_on_the_selection(clean_scene, bpy_module,
     descriptions = {i.name: i.description for i in tree.interface.items_tree if i.item_type == "SOCKET"}
     assert all(descriptions.values()) and {"Level", "Shape Factor"} <= set(descriptions)
     bpy.data.node_groups.remove(tree)
+
+
+FARM = """
+import sys, bpy, numpy as np
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+assert not any('tessera' in name for name in bpy.context.preferences.addons.keys()), 'the add-on is enabled'
+dg = bpy.context.evaluated_depsgraph_get()
+out = {}
+for ob in bpy.data.objects:
+    me = ob.evaluated_get(dg).to_mesh()
+    pos = np.empty(len(me.vertices) * 3, np.float32)
+    me.attributes['position'].data.foreach_get('vector', pos)
+    out[ob.name] = pos.reshape(-1, 3)
+np.savez(sys.argv[2], **out)
+"""
+
+
+def farm_scene(bpy, addon_module):
+    """One object per Tessera group, each with its group as a modifier; returns their evaluated positions."""
+    import numpy as np
+
+    ng = addon_module("addon.node_groups")
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2)
+    bpy.context.active_object.name = "Phong"
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, location=(3, 0, 0))
+    bpy.context.active_object.name = "PN"
+    bpy.ops.curve.primitive_bezier_curve_add(location=(0, 3, 0))
+    bpy.context.active_object.name = "Tubes"
+    bpy.ops.mesh.primitive_uv_sphere_add(location=(3, 3, 0))
+    bpy.context.active_object.name = "Displace"
+    image = bpy.data.images.new("Farm Map", 8, 8)  # 8-bit, packed as PNG: what is saved is what was shown
+    rgba = np.random.default_rng(2).uniform(0, 1, (8 * 8, 4)).astype(np.float32)
+    rgba[:, 3] = 1.0  # opaque: this test is about the groups, not how a PNG keeps transparent texels
+    image.pixels.foreach_set(rgba.ravel())
+    image.update()
+    image.pack()
+    inputs = {"Phong": {"Level": 2}, "PN": {"Level": 2}, "Tubes": {"Caps": "Round", "Sides": 6},
+              "Displace": {"Map": "Height", "Image": image, "Strength": 0.2}}
+    for name, spec in (("Phong", "tessera.phong_nodes"), ("PN", "tessera.pn_nodes"), ("Tubes", "tubes.nodes"),
+                       ("Displace", "displacement.nodes")):
+        ob = bpy.data.objects[name]
+        mod = ob.modifiers.new(name, "NODES")
+        mod.node_group = ng.ensure_group(addon_module(f"addon.{spec.replace('tessera.', 'tessellation.')}").SPEC)
+        ng.set_inputs(mod, inputs[name])
+    assert {ob.modifiers[-1].node_group.name for ob in bpy.data.objects} == set(ng.GROUPS)
+    dg = bpy.context.evaluated_depsgraph_get()
+    out = {}
+    for ob in bpy.data.objects:
+        me = ob.evaluated_get(dg).to_mesh()
+        out[ob.name] = np.array([v.co for v in me.vertices], np.float32)
+        ob.evaluated_get(dg).to_mesh_clear()
+    return out
+
+
+def test_a_file_using_every_group_evaluates_the_same_without_the_add_on(clean_scene, bpy_module, addon_module,
+                                                                       tmp_path):
+    """Saved with every group, the file evaluates to the same geometry in a Blender with no Tessera (the render
+    farm); reopened with the add-on, its groups are kept as they are (no rebuild, no second copy)."""
+    import os
+    import subprocess
+    import sys
+
+    import numpy as np
+
+    bpy = bpy_module
+    here = farm_scene(bpy, addon_module)
+    for tree in bpy.data.node_groups:
+        tree.nodes[0].label = "kept"  # a rebuilt group would lose it
+    path = tmp_path / "farm.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    out = tmp_path / "farm.npz"
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "farm_user"))  # a user folder with no Tessera
+    proc = subprocess.run([sys.executable, "-c", FARM, str(path), str(out)], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    farm = dict(np.load(out))
+    assert set(farm) == set(here)
+    for name, pos in here.items():
+        assert farm[name].shape == pos.shape and np.array_equal(farm[name], pos), name
+        assert len(pos) > 0
+    ng = addon_module("addon.node_groups")
+    names = {tree.name for tree in bpy.data.node_groups}
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    assert entries(bpy) and len(entries(bpy)) == 1
+    for spec in ng.GROUPS.values():
+        tree = ng.ensure_group(spec)
+        assert tree.nodes[0].label == "kept", spec.name
+    assert {tree.name for tree in bpy.data.node_groups} == names

@@ -1,8 +1,5 @@
-"""The "Tessera Phong" and "Tessera PN Triangles" geometry-nodes groups against the numpy patches (tier: blender),
-closed meshes staying closed, and a file using them evaluating the same in a Blender without the add-on."""
-
-import subprocess
-import sys
+"""The "Tessera Phong" and "Tessera PN Triangles" geometry-nodes groups against the numpy patches (tier: blender)
+and closed meshes staying closed. The farm-safe test of every group is in tests/common/test_node_library.py."""
 
 import numpy as np
 import pytest
@@ -84,39 +81,3 @@ def test_every_vertex_lies_on_the_kernels_surface(clean_scene, bpy_module, addon
             out.attributes[".corner_edge"].data.foreach_get("value", edges)
             assert np.all(np.bincount(edges, minlength=len(out.edges)) == 2)
         ob.modifiers.remove(mod)
-
-
-FARM = """
-import sys, bpy, numpy as np
-bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
-assert not any('tessera' in name for name in bpy.context.preferences.addons.keys()), 'the add-on is enabled'
-ob = bpy.data.objects['Icosphere']
-me = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-pos = np.empty(len(me.vertices) * 3, np.float32)
-me.attributes['position'].data.foreach_get('vector', pos)
-np.save(sys.argv[2], pos.reshape(-1, 3))
-"""
-
-
-def test_a_file_using_the_group_evaluates_the_same_without_the_add_on(clean_scene, bpy_module, addon_module,
-                                                                     tmp_path):
-    bpy = bpy_module
-    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2)
-    ob = bpy.context.active_object
-    bpy.ops.object.shade_smooth()
-    assert bpy.ops.tessera.node_group_add(group="Tessera Phong") == {"FINISHED"}
-    assert ob.modifiers[-1].node_group.name == "Tessera Phong"
-    here, _ = evaluated_positions(bpy, ob)
-    path = tmp_path / "farm.blend"
-    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
-    out = tmp_path / "farm.npy"
-    env_user = tmp_path / "farm_user"  # a Blender user folder with no Tessera in it
-    import os
-
-    env = dict(os.environ, BLENDER_USER_RESOURCES=str(env_user))
-    proc = subprocess.run([sys.executable, "-c", FARM, str(path), str(out)], capture_output=True, text=True,
-                          env=env, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    farm = np.load(out)
-    assert farm.shape == here.shape and np.array_equal(farm, here.astype(np.float32))
-    assert len(here) > 12 * 16  # really subdivided
