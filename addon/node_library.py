@@ -4,8 +4,11 @@ it, added on enable and removed on disable (one entry, never a stale one). The g
 and in the node editor's Add menu; a file that uses one holds its own copy (appended), so it evaluates on a
 machine without the add-on.
 
-The .blend is named by a hash of the groups' names and versions: a new version writes a new file and removes the
-old one. Nothing is written while Blender is starting (data is read-only then): a one-shot timer does it.
+The .blend is named by a hash of the groups' names and versions and of the Blender that builds them: a new version
+writes a new file and removes the old one. ``make build`` ships one in the zip (``node_library/``, built by the
+build's Blender, see tools/build_extension.py); the entry points there when it was built for this Blender, and
+otherwise the add-on writes its own into the user folder. Nothing is written while Blender is starting (data is
+read-only then): a one-shot timer does it.
 """
 
 import hashlib
@@ -26,6 +29,10 @@ CATALOG_FILE = "blender_assets.cats.txt"
 _NAMESPACE = uuid.UUID("6f1c8f0e-3b1e-4c43-9a55-7e2a1d0c5b21")
 
 
+#: Where the built extension keeps its shipped library (tools/build_extension.py writes it).
+SHIPPED_DIR = Path(__file__).resolve().parents[1] / "node_library"
+
+
 def library_dir():
     """The folder of the library (created), or None where Tessera runs as a legacy add-on."""
     try:
@@ -40,6 +47,7 @@ def _available():
 
 def library_file(directory):
     key = ";".join(f"{s.name}:{s.version}" for s in sorted(_available(), key=lambda s: s.name))
+    key += ";blender:{}.{}".format(*bpy.app.version[:2])  # a group built by another Blender may differ
     return Path(directory) / f"tessera_nodes_{hashlib.sha256(key.encode()).hexdigest()[:12]}.blend"
 
 
@@ -51,6 +59,7 @@ def write_library(directory):
     """Write the groups' .blend and the catalogs into ``directory`` (older Tessera .blends removed). Returns the
     file. Groups this file already had are left as they were; the ones built for writing are removed again."""
     directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
     path = library_file(directory)
     specs = _available()
     before = set(bpy.data.node_groups)
@@ -61,7 +70,7 @@ def write_library(directory):
             tree.asset_data.catalog_id = catalog_id(spec.catalog)
             tree.asset_data.description = f"Tessera: {spec.name}"
         tmp = path.with_suffix(".tmp.blend")
-        bpy.data.libraries.write(str(tmp), set(trees), fake_user=True)
+        bpy.data.libraries.write(str(tmp), set(trees), fake_user=True, compress=True)
         tmp.replace(path)  # never a half-written library
     finally:
         for tree in trees:
@@ -70,7 +79,8 @@ def write_library(directory):
             else:
                 bpy.data.node_groups.remove(tree)
     catalogs = sorted({s.catalog for s in specs} | {"Tessera"})
-    lines = ["# Tessera's node-group catalogs (written by the add-on)", "VERSION 1", ""]
+    built = "Blender {}.{}".format(*bpy.app.version[:2])
+    lines = [f"# Tessera's node-group catalogs (written by the add-on, {built})", "VERSION 1", ""]
     lines += [f"{catalog_id(c)}:{c}:{c.replace('/', '-')}" for c in catalogs]
     (directory / CATALOG_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
     for old in directory.glob("tessera_nodes_*.blend"):
@@ -83,12 +93,17 @@ def _entries():
     return [lib for lib in bpy.context.preferences.filepaths.asset_libraries if lib.name == LIBRARY_NAME]
 
 
+def _complete(directory):
+    return library_file(directory).exists() and (directory / CATALOG_FILE).exists()
+
+
 def register_library():
-    """Write the library if it is missing or outdated and add (or repoint) the one "Tessera" asset library."""
-    directory = library_dir()
+    """Add (or repoint) the one "Tessera" asset library: the shipped library where it was built for this Blender,
+    else the user folder's, written if it is missing or outdated."""
+    directory = SHIPPED_DIR if _complete(SHIPPED_DIR) else library_dir()
     if directory is None:
         return None
-    if not library_file(directory).exists() or not (directory / CATALOG_FILE).exists():
+    if not _complete(directory):
         write_library(directory)
     libraries = bpy.context.preferences.filepaths.asset_libraries
     entries = _entries()

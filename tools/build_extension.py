@@ -3,7 +3,8 @@
 Steps: validate the source manifest (tags checked against Blender's list); download the wheels of
 pyopencl and its pure-Python needs for each platform and for each Python the supported Blenders use (3.11 for
 4.2-5.0, 3.13 for 5.1 and 5.2), at the versions installed in this venv (the ones the tests ran with); stage a copy
-of the tree whose manifest lists them; build with ``blender_ext.py build --split-platforms``; validate each zip.
+of the tree whose manifest lists them, with the node-group asset library written into it by this venv's Blender;
+build with ``blender_ext.py build --split-platforms``; validate each zip.
 Blender installs the wheels that match its own Python. numpy is not bundled: Blender ships it.
 
 Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
@@ -78,6 +79,25 @@ def stage(wheel_dir, wheels, staging):
     manifest = f"{head}\nplatforms = [{platforms}]\nwheels = [\n{listing},\n]\n{sep}{tail}"
     (staging / "blender_manifest.toml").write_text(manifest, encoding="utf-8")
     tomllib.loads(manifest)  # fail here, not in Blender, if the edit broke the TOML
+    write_node_library(staging)
+
+
+#: Writes the node-group library into the staged package (run by this venv's Blender, the bpy module).
+_LIBRARY = """
+import importlib, sys
+from pathlib import Path
+staging = Path(sys.argv[1])
+sys.path.insert(0, str(staging.parent))
+import bpy
+library = importlib.import_module(staging.name + ".addon.node_library")
+print(library.write_library(staging / "node_library"))
+"""
+
+
+def write_node_library(staging):
+    """The .blend of every node group and its catalogs in ``staging/node_library`` (the add-on registers it as the
+    "Tessera" asset library when the installing Blender is the one that built it)."""
+    subprocess.run([sys.executable, "-c", _LIBRARY, str(staging)], check=True)
 
 
 def main(argv=None):

@@ -35,6 +35,19 @@ bpy.ops.mesh.primitive_plane_add()
 results["displacement_add"] = sorted(bpy.ops.tessera.displacement_add(width=32, height=32))
 stroke = [compat.stroke_element((16.0, 16.0, 0.0), 1.0, first=True)]
 results["displacement_stroke"] = sorted(bpy.ops.tessera.displacement_stroke(stroke=stroke, map_space=True))
+library = importlib.import_module(module + ".addon.node_library")
+groups = importlib.import_module(module + ".addon.node_groups")
+entries = [lib for lib in prefs.filepaths.asset_libraries if lib.name == "Tessera"]
+blends = glob.glob(os.path.join(entries[0].path, "tessera_nodes_*.blend")) if entries else []
+in_library = []
+if blends:
+    with bpy.data.libraries.load(blends[0], assets_only=True) as (source, _):
+        in_library = sorted(source.node_groups)
+results["library"] = {"entries": len(entries), "groups": in_library,
+                      "expected": sorted(s.name for s in library._available()),
+                      "shipped_here": library._complete(library.SHIPPED_DIR),
+                      "uses_shipped": bool(entries) and os.path.realpath(entries[0].path)
+                      == os.path.realpath(library.SHIPPED_DIR)}
 local = bpy.utils.user_resource("EXTENSIONS", path=".local")
 def bundled():
     names = {os.path.basename(p).split(".")[0]
@@ -105,6 +118,19 @@ def built_zips(bpy_module, tmp_root):
     return sorted(out.glob("tessera-*.zip"))
 
 
+def linux_builder_version(built_zips):
+    """(major, minor) of the Blender that built the zips' node library, from its catalog file's header line."""
+    import re
+    import zipfile
+
+    linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
+    with zipfile.ZipFile(linux) as z:
+        head = z.read("node_library/blender_assets.cats.txt").decode().splitlines()[0]
+    match = re.search(r"Blender (\d+)\.(\d+)", head)
+    assert match, head
+    return match.groups()
+
+
 def test_one_zip_per_platform_without_dev_files(built_zips):
     import zipfile
 
@@ -130,6 +156,14 @@ def test_install_enable_run_uninstall(built_zips, tmp_root):
     # callback does: 4.2 segfaults at exit after uninstalling any enabled extension that registered one
     assert proc.returncode == _minimal_extension_exit_code(tmp_root), proc.stdout[-3000:] + proc.stderr[-3000:]
     report = json.loads(lines[-1][len("RESULT"):])
+    library = report["results"].pop("library")
+    # the node groups' asset library: one entry, every group in it; the zip's own where this Blender built it
+    assert library["entries"] == 1 and library["groups"] == library["expected"] and len(library["groups"]) >= 4
+    assert library["uses_shipped"] == library["shipped_here"]
+    import bpy
+
+    if bpy.app.version[:2] == tuple(int(x) for x in linux_builder_version(built_zips)):
+        assert library["shipped_here"]  # built by this Blender: installed as shipped, nothing written
     assert report["enabled"] and report["results"] == dict.fromkeys(
         ("tessellate", "tubes", "terrain_add", "displacement_add", "displacement_stroke"), ["FINISHED"])
     assert report["faces"] == 12 * 6  # cube: 12 triangles, level 2 -> 6 each
