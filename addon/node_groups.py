@@ -74,6 +74,18 @@ class Graph:
         return self.node("GeometryNodeSwitch", [("Switch", condition), ("False", false), ("True", true)],
                          input_type=data_type).outputs[0]
 
+    def menu(self, data_type, menu, options):
+        """A Menu Switch driven by the group input socket ``menu``: ``options`` is ``[(item name, value), ...]``,
+        the first item the input's default. Returns the switch's output."""
+        node = self.node("GeometryNodeMenuSwitch", data_type=data_type)
+        node.enum_items.clear()
+        for i, (name, value) in enumerate(options):
+            node.enum_items.new(name)
+            self.feed(node.inputs[i + 1], value)
+        self.tree.links.new(menu, node.inputs[0])
+        self.tree.interface.items_tree[menu.name].default_value = options[0][0]  # items known once linked
+        return node.outputs[0]
+
     def input(self, kind, output=0):
         """The output ``output`` of a new input node (Position, Index, ...)."""
         return self.node(kind).outputs[output]

@@ -74,14 +74,8 @@ def _build(tree):
         t, b = _tangent_frame(g, uv, index, corner, normal)
         offsets["Tangent"] = g.vec("ADD", g.vec("ADD", g.vec("SCALE", t, c[0]), g.vec("SCALE", b, c[1])),
                                    g.vec("SCALE", normal, c[2]))
-    switch = g.node("GeometryNodeMenuSwitch", data_type="VECTOR")
-    switch.enum_items.clear()
-    for i, name in enumerate(maps()):
-        switch.enum_items.new(name)
-        g.feed(switch.inputs[i + 1], offsets[name])
-    tree.links.new(gi.outputs["Map"], switch.inputs[0])
-    tree.interface.items_tree["Map"].default_value = "Height"
-    moved = g.node("GeometryNodeSetPosition", [(0, gi.outputs["Geometry"]), ("Offset", switch.outputs[0])])
+    offset = g.menu("VECTOR", gi.outputs["Map"], [(name, offsets[name]) for name in maps()])
+    moved = g.node("GeometryNodeSetPosition", [(0, gi.outputs["Geometry"]), ("Offset", offset)])
     tree.links.new(moved.outputs[0], go.inputs[0])
 
 

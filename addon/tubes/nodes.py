@@ -3,14 +3,14 @@ needed to evaluate it. Numpy reference: `kernels.tubes.builder.build_tubes` with
 `kernels.tubes.frames.rotation_minimizing_frames` (the double-reflection method, Wang et al. 2008).
 
 Curve to Mesh sweeps a circle of ``Sides`` points along the curves' evaluated points; the group only chooses the
-frames, through the tilt. Blender's minimum-twist normals F are one frame field; the kernel's frames are
-``R_k = Rot(t_k, θ_k) F_k``. One double-reflection step S carries F_{k-1} to point k, and since S maps the axis
-t_{k-1} to t_k, ``θ_k = θ_{k-1} + δ_k`` with ``δ_k`` the signed angle from F_k to S F_{k-1} about t_k, a local
-quantity: Accumulate Field sums it per curve (no loop). The first point's δ is the angle from F_0 to the kernel's
-first normal (`frames.any_perpendicular`), and closed curves spread the angle left at the seam along their arc
-length, as the kernel does. The result goes into the tilt (plus the curve's own tilt), so Curve to Mesh itself
-places every ring. Round caps extend open curves past their ends by ``max(1, Sides // 4)`` points on the end's
-tangent with radius r cos φ (φ up to 90°, where the ring collapses into a pole that Merge by Distance welds);
+frames, as free curve normals. With the local frame field F_k = `frames.any_perpendicular`(t_k), the kernel's
+frames are ``R_k = Rot(t_k, θ_k) F_k`` with R_0 = F_0. One double-reflection step S carries R_{k-1} to point k,
+and since S maps the axis t_{k-1} to t_k, ``θ_k = θ_{k-1} + δ_k`` with ``δ_k`` the signed angle from F_k to
+S F_{k-1} about t_k, a local quantity: Accumulate Field sums it per curve (no loop). Closed curves spread the
+angle left at the seam along their arc length, as the kernel does; the curve's own tilt is applied on top by
+Curve to Mesh, as the kernel applies it. Round caps extend open curves past their ends by ``max(1, Sides // 4)``
+points on the end's tangent with radius r cos φ (φ up to 90°, where the ring collapses into a pole that Merge by
+Distance welds);
 flat caps are Curve to Mesh's Fill Caps. The pixel clamp keeps one pixel of radius for the scene's active camera
 (perspective; field of view and image width are inputs, since geometry nodes cannot read the render settings).
 Corner UVs: u along the curve (arc length fraction), v around (j / Sides), the seams closed at 1.
@@ -85,6 +85,12 @@ class _Tubes:
         e = g.xyz(is_x, is_y, is_z)
         return g.vec("NORMALIZE", g.vec("SUBTRACT", e, g.vec("SCALE", t, self.dot(e, t))))
 
+    def is_first_point(self):
+        """True at each curve's first point (a field on points)."""
+        index = self.g.node("GeometryNodeCurveOfPoint").outputs["Index in Curve"]
+        return self.g.node("FunctionNodeCompare", [("A", index), ("B", 0)], data_type="INT",
+                           operation="EQUAL").outputs[0]
+
     # --- stages --------------------------------------------------------------------------------------------------
     def radius(self):
         """r = Radius x curve radius, or max(r, min(s_pix / cos(π / n), Max Radius)) with the pixel clamp."""
@@ -110,31 +116,29 @@ class _Tubes:
         g = self.g
         m_int = g.math("MAXIMUM", 1.0, g.math("FLOOR", g.math("DIVIDE", self.inp("Sides"), 4.0)))
         m = g.math("MULTIPLY", m_int, g.math("SUBTRACT", 1.0, g.input("GeometryNodeInputSplineCyclic")))
-        count = g.node("GeometryNodePointsOfCurve", [("Sort Index", 0)]).outputs["Total"]
+        points = g.node("GeometryNodePointsOfCurve", [("Sort Index", 0)])  # read on the curve domain
         resample = g.node("GeometryNodeResampleCurve", [("Curve", curve), ("Count", g.math(
-            "ADD", count, g.math("MULTIPLY", m, 2.0)))])
+            "ADD", points.outputs["Total"], g.math("MULTIPLY", m, 2.0)))])
         set_node_mode(resample, "Mode", "COUNT", "Count")
         extended = resample.outputs[0]
 
-        index_in_curve = g.node("GeometryNodeCurveOfPoint").outputs["Index in Curve"]
-        curve_index = g.node("GeometryNodeCurveOfPoint").outputs["Curve Index"]
+        of_point = g.node("GeometryNodeCurveOfPoint")
+        index_in_curve, curve_index = of_point.outputs["Index in Curve"], of_point.outputs["Curve Index"]
 
-        def of_curve(value, data_type="INT"):  # a value of the source curve with this point's curve index
+        def of_curve(value):  # an integer of the source curve with this point's curve index
             return g.node("GeometryNodeSampleIndex", [("Geometry", curve), ("Value", value), ("Index", curve_index)],
-                          data_type=data_type, domain="CURVE").outputs[0]
+                          data_type="INT", domain="CURVE").outputs[0]
 
-        points = g.node("GeometryNodePointsOfCurve", [("Sort Index", 0)])
         first, n = of_curve(points.outputs["Point Index"]), of_curve(points.outputs["Total"])
-        m_here = m  # the same field, read here per point (the cyclic flag of the point's curve)
-        local = g.math("SUBTRACT", index_in_curve, m_here)
+        local = g.math("SUBTRACT", index_in_curve, m)  # m read per point: the cyclic flag of the point's curve
         kk = g.math("MINIMUM", g.math("MAXIMUM", local, 0.0), g.math("SUBTRACT", n, 1.0))
         src = g.math("ADD", first, kk)
         ring = g.math("MAXIMUM", g.math("MAXIMUM", g.math("MULTIPLY", local, -1.0),
                                           g.math("SUBTRACT", local, g.math("SUBTRACT", n, 1.0))), 0.0)
         side = g.math("SUBTRACT", 1.0, g.math("MULTIPLY", g.math("LESS_THAN", local, 0.0), 2.0))
-        phi = g.math("MULTIPLY", g.math("DIVIDE", ring, g.math("MAXIMUM", m_here, 1.0)), math.pi / 2)
-        pole = g.math("MULTIPLY", g.math("GREATER_THAN", m_here, 0.0),
-                      g.node("FunctionNodeCompare", [("A", ring), ("B", m_here)], data_type="FLOAT",
+        phi = g.math("MULTIPLY", g.math("DIVIDE", ring, g.math("MAXIMUM", m, 1.0)), math.pi / 2)
+        pole = g.math("MULTIPLY", g.math("GREATER_THAN", m, 0.0),
+                      g.node("FunctionNodeCompare", [("A", ring), ("B", m)], data_type="FLOAT",
                              operation="EQUAL").outputs[0])
         cos_phi = g.switch("FLOAT", pole, g.math("COSINE", phi), 0.0)
 
@@ -173,9 +177,7 @@ class _Tubes:
         curve = g.store(curve, "tessera_step", self.signed_angle(f, self.reflect(v1, b), t))
         step = g.named("tessera_step")
         in_curve = g.node("GeometryNodeCurveOfPoint")
-        is_first = g.node("FunctionNodeCompare", [("A", in_curve.outputs["Index in Curve"]), ("B", 0)],
-                          data_type="INT", operation="EQUAL").outputs[0]
-        acc = g.node("GeometryNodeAccumulateField", [("Value", g.switch("FLOAT", is_first, step, 0.0)),
+        acc = g.node("GeometryNodeAccumulateField", [("Value", g.switch("FLOAT", self.is_first_point(), step, 0.0)),
                                                      ("Group ID", in_curve.outputs["Curve Index"])],
                      data_type="FLOAT", domain="POINT")
         # closed curves: the frame carried round the seam misses the first frame by phi, spread along the arc
@@ -200,21 +202,12 @@ class _Tubes:
 def _build(tree):
     b = _Tubes(tree)
     g = b.g
-    caps = g.node("GeometryNodeMenuSwitch", data_type="INT")
-    caps.enum_items.clear()
-    for i, name in enumerate(("None", "Flat", "Round")):
-        caps.enum_items.new(name)
-        caps.inputs[i + 1].default_value = i
-    tree.links.new(b.inp("Caps"), caps.inputs[0])
-    tree.interface.items_tree["Caps"].default_value = "None"
-    caps = caps.outputs[0]
+    caps = g.menu("INT", b.inp("Caps"), [(name, i) for i, name in enumerate(("None", "Flat", "Round"))])
 
     resample = g.node("GeometryNodeResampleCurve", [("Curve", b.inp("Curve"))])
     set_node_mode(resample, "Mode", "EVALUATED", "Evaluated")
     curve = resample.outputs[0]
-    closed_start = g.math("MULTIPLY", g.input("GeometryNodeInputSplineCyclic"), g.node(
-        "FunctionNodeCompare", [("A", g.node("GeometryNodeCurveOfPoint").outputs["Index in Curve"]), ("B", 0)],
-        data_type="INT", operation="EQUAL").outputs[0])
+    closed_start = g.math("MULTIPLY", g.input("GeometryNodeInputSplineCyclic"), b.is_first_point())
     u = g.switch("FLOAT", closed_start, g.node("GeometryNodeSplineParameter").outputs["Factor"], -1.0)
     has_uv = g.math("GREATER_THAN", g.node("FunctionNodeStringLength", [(0, b.inp("UV Map"))]).outputs[0], 0.0)
     # -1 marks a closed curve's first point (u 0 there, 1 at the seam)
