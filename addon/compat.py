@@ -9,6 +9,9 @@ ask for it, and the version is compared only where the difference cannot be seen
 - stroke elements: 4.2's `OperatorStrokeElement` requires ``pen_flip`` when built from Python (`stroke_element`);
 - geometry-nodes modifier inputs: ``mod[identifier] = value`` until 5.1, ``mod.properties.inputs`` from 5.2
   (`set_modifier_input`); menu inputs by item name from 5.2, by an internal integer before (`menu_input_value`);
+- the Normal geometry node gives corner normals on the corner domain from 4.5, face normals on 4.2
+  (`NORMAL_NODE_CORNER_NORMALS`);
+- geometry nodes write custom normals (Set Mesh Normal) from 4.5 (`has_set_mesh_normal_node`);
 - the UV Tangent geometry node exists from 5.0 (`has_uv_tangent_node`, `UV_TANGENT_MESSAGE`);
 - materials: 5.0+ materials always have a node tree (``use_nodes`` is deprecated); 4.x needs the flag set
   (`use_material_nodes`);
@@ -30,6 +33,11 @@ FLOAT_CUSTOM_NORMALS = bpy.app.version >= (5, 0, 0)
 #: half a step of π/32767 and 2π/32767. Measured: 3.3e-4 on Suzanne (4.2.23, 4.5.15). Tests add it to their own
 #: tolerance for every stored normal they compare, so the 5.x tolerances stay what they were.
 CUSTOM_NORMAL_STORAGE_ERROR = 0.0 if FLOAT_CUSTOM_NORMALS else math.sqrt(2.0 * 2.0 ** -24) + 3.0 * math.pi / 65534
+
+#: The Normal geometry node gives Blender's corner normals (sharp edges, flat faces, custom normals) on the face
+#: corner domain in 4.5 and later (4.2: the face normal; 4.3 and 4.4 are not supported, so not
+#: checked). Nothing to ask Blender: the node is the same, only what it computes differs.
+NORMAL_NODE_CORNER_NORMALS = bpy.app.version >= (4, 5, 0)
 
 UV_TANGENT_MESSAGE = "Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)"
 
@@ -103,6 +111,11 @@ def menu_input_value(tree, item, label):
 def has_uv_tangent_node():
     """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
     return hasattr(bpy.types, "GeometryNodeUVTangent")
+
+
+def has_set_mesh_normal_node():
+    """True when geometry nodes can write custom normals (the Set Mesh Normal node, 4.5 and newer)."""
+    return hasattr(bpy.types, "GeometryNodeSetMeshNormal")
 
 
 def use_material_nodes(material):

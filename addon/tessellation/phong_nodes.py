@@ -7,36 +7,23 @@ new point p lies on a coarse triangle with barycentric coordinates b, and Phong'
 are linear in b: the coarse points carry n n^T (6 numbers) and (P.n) n as attributes, which Subdivide Mesh
 (bilinear) interpolates with the same weights as the positions, so every new point holds the sums of the coarse
 triangle it lies on (no search, so self-intersecting meshes are fine). The result is
-``p + a (p* - p)`` with the shape factor a (a field: per-vertex a works). Watertight: the coarse mesh's point
-normals, so shared edges stay shared.
+``p + a (p* - p)`` with the shape factor a (a field: per-vertex a works). The normals follow the kernel's sharp-edge
+policy (Watertight or Split, `surface_nodes`); the shading normals are the corner normals interpolated linearly and
+normalised, as the kernel shades Phong.
 """
 
-from ..node_groups import Graph, GroupSpec, register_group, socket
+from ..node_groups import Graph, GroupSpec, register_group
+from .surface_nodes import CORNER_NORMAL, set_shading, surface_interface
 
 GROUP_NAME = "Tessera Phong"
-VERSION = 3
-
-
-def surface_interface(g, shape_default, shape_description):
-    """The sockets the curved-surface groups share (Geometry, Level, Shape Factor -> Geometry); returns the group
-    input and output nodes and the triangulated input mesh."""
-    tree = g.tree
-    socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
-    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
-           description="Subdivision levels of every face (Subdivide Mesh)")
-    socket(tree, "Shape Factor", "NodeSocketFloat", default=shape_default, min_value=0.0, max_value=1.0,
-           description=shape_description)
-    socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The curved, finer mesh")
-    gi, go = g.node("NodeGroupInput"), g.node("NodeGroupOutput")
-    return gi, go, g.node("GeometryNodeTriangulate", [(0, gi.outputs["Geometry"])]).outputs[0]
+VERSION = 4
 
 
 def _build(tree):
     g = Graph(tree)
-    gi, go, coarse = surface_interface(g, 0.75, "0: flat triangles; 1: full Phong tessellation (0.75 as in the "
-                                                "paper); a field, so it can vary per vertex")
+    gi, go, coarse, normal = surface_interface(g, 0.75, "0: flat triangles; 1: full Phong tessellation (0.75 as "
+                                                        "in the paper); a field, so it can vary per vertex")
     position = g.node("GeometryNodeInputPosition").outputs[0]
-    normal = g.on("POINT", "FLOAT_VECTOR", g.node("GeometryNodeInputNormal").outputs[0])
     n = g.split(normal)
     diag = g.vec("MULTIPLY", normal, normal)  # (nx nx, ny ny, nz nz)
     off = g.xyz(g.math("MULTIPLY", n[0], n[1]), g.math("MULTIPLY", n[1], n[2]), g.math("MULTIPLY", n[2], n[0]))
@@ -60,9 +47,9 @@ def _build(tree):
     np_ = g.vec("ADD", g.vec("MULTIPLY", d, position), g.vec("ADD", a, b))  # (sum b_i n_i n_i^T) p
     offset = g.vec("SCALE", g.vec("SUBTRACT", c, np_), gi.outputs["Shape Factor"])
     moved = g.node("GeometryNodeSetPosition", [(0, fine), ("Offset", offset)]).outputs[0]
-    for name in names:
-        moved = g.node("GeometryNodeRemoveAttribute", [(0, moved), ("Name", name)]).outputs[0]
-    tree.links.new(moved, go.inputs[0])
+    # shading: the kernel's Phong normals, the corner normals interpolated linearly (as Subdivide Mesh carries them)
+    shaded = set_shading(g, moved, g.vec("NORMALIZE", g.named(CORNER_NORMAL, "FLOAT_VECTOR")))
+    tree.links.new(g.remove(shaded, (*names, CORNER_NORMAL)), go.inputs[0])
 
 
 SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation"))
