@@ -22,7 +22,7 @@ from ..compat import set_node_mode
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Tubes"
-VERSION = 1
+VERSION = 2
 _TEMP = ("tessera_u", "tessera_pole")
 
 
@@ -225,8 +225,8 @@ def _build(tree):
     if "Scale" in to_mesh.inputs:  # 4.5+: the radius scales the profile only through this input
         g.feed(to_mesh.inputs["Scale"], g.input("GeometryNodeInputRadius"))
     mesh = to_mesh.outputs[0]
-    with_uv = g.node("GeometryNodeStoreNamedAttribute", [(0, mesh), ("Name", b.inp("UV Map")),
-                                                         ("Value", _uv(g, b.inp("Sides")))],
+    uv = g.switch("VECTOR", fill, _quad_uv(g, b.inp("Sides")), _uv(g, b.inp("Sides")))
+    with_uv = g.node("GeometryNodeStoreNamedAttribute", [(0, mesh), ("Name", b.inp("UV Map")), ("Value", uv)],
                      data_type="FLOAT2", domain="CORNER").outputs[0]
     mesh = g.switch("GEOMETRY", has_uv, mesh, with_uv)
     merge = g.node("GeometryNodeMergeByDistance", [("Geometry", mesh), ("Selection", g.named(
@@ -246,6 +246,20 @@ def _uv(g, sides):
     j = g.math("FLOORED_MODULO", g.node("GeometryNodeVertexOfCorner", [(0, corner)]).outputs[0], sides)
     second = g.math("MULTIPLY", g.math("GREATER_THAN", k, 0.5), g.math("LESS_THAN", k, 2.5))  # corners 1, 2
     v = g.switch("FLOAT", g.math("MULTIPLY", second, g.math("LESS_THAN", j, 0.5)), g.math("DIVIDE", j, sides), 1.0)
+    u = g.named("tessera_u")
+    u = g.switch("FLOAT", g.math("LESS_THAN", u, 0.0), u, g.math("GREATER_THAN", k, 1.5))
+    return g.xyz(u, v, 0.0)
+
+
+def _quad_uv(g, sides):
+    """`_uv` where every face is a quad (no flat caps), from the corner index alone: Curve to Mesh writes the faces
+    ring-major, four corners each, so corner c has index in face c mod 4 and side (c div 4) mod n. No lookup of the
+    face or the vertex per corner (each costs as much as the rest together on millions of corners)."""
+    corner = g.input("GeometryNodeInputIndex")
+    k = g.math("FLOORED_MODULO", corner, 4.0)
+    side = g.math("FLOORED_MODULO", g.math("FLOOR", g.math("DIVIDE", corner, 4.0)), sides)
+    second = g.math("LESS_THAN", g.math("FLOORED_MODULO", g.math("ADD", k, 3.0), 4.0), 1.5)  # corners 1, 2: side + 1
+    v = g.math("DIVIDE", g.math("ADD", side, second), sides)
     u = g.named("tessera_u")
     u = g.switch("FLOAT", g.math("LESS_THAN", u, 0.0), u, g.math("GREATER_THAN", k, 1.5))
     return g.xyz(u, v, 0.0)
