@@ -63,6 +63,8 @@ assert not any('tessera' in name for name in bpy.context.preferences.addons.keys
 dg = bpy.context.evaluated_depsgraph_get()
 out = {}
 for ob in bpy.data.objects:
+    if ob.type == 'CAMERA':
+        continue
     me = ob.evaluated_get(dg).to_mesh()
     pos = np.empty(len(me.vertices) * 3, np.float32)
     me.attributes['position'].data.foreach_get('vector', pos)
@@ -90,18 +92,32 @@ def farm_scene(bpy, addon_module):
     image.pixels.foreach_set(rgba.ravel())
     image.update()
     image.pack()
-    inputs = {"Phong": {"Level": 2}, "PN": {"Level": 2}, "Tubes": {"Caps": "Round", "Sides": 6},
-              "Displace": {"Map": "Height", "Image": image, "Strength": 0.2}}
+    heights = bpy.data.images.new("Farm Heights", 33, 33)
+    texels = np.random.default_rng(3).uniform(0, 1, (33 * 33, 4)).astype(np.float32)
+    texels[:, 3] = 1.0
+    heights.pixels.foreach_set(texels.ravel())
+    heights.update()
+    heights.pack()
+    terrain = bpy.data.objects.new("Terrain", bpy.data.meshes.new("Terrain"))
+    bpy.context.scene.collection.objects.link(terrain)
+    bpy.ops.object.camera_add(location=(-9, -9, 6))  # the terrain's levels follow the active camera
+    bpy.context.scene.camera = bpy.context.active_object
+    bpy.context.active_object.name = "Camera"
+    inputs = {"Phong": {"Level": 2}, "PN": {"Level": 2, "Sharp Edges": "Split"},
+              "Tubes": {"Caps": "Round", "Sides": 6}, "Displace": {"Map": "Height", "Image": image,
+                                                                   "Strength": 0.2},
+              "Terrain": {"Image": heights, "Tile Size": 8, "Full-Detail Distance": 8.0, "Height Scale": 3.0}}
     for name, spec in (("Phong", "tessera.phong_nodes"), ("PN", "tessera.pn_nodes"), ("Tubes", "tubes.nodes"),
-                       ("Displace", "displacement.nodes")):
+                       ("Displace", "displacement.nodes"), ("Terrain", "terrain.nodes")):
         ob = bpy.data.objects[name]
         mod = ob.modifiers.new(name, "NODES")
         mod.node_group = ng.ensure_group(addon_module(f"addon.{spec.replace('tessera.', 'tessellation.')}").SPEC)
         ng.set_inputs(mod, inputs[name])
-    assert {ob.modifiers[-1].node_group.name for ob in bpy.data.objects} == set(ng.GROUPS)
+    meshes = [ob for ob in bpy.data.objects if ob.type != "CAMERA"]
+    assert {ob.modifiers[-1].node_group.name for ob in meshes} == set(ng.GROUPS)
     dg = bpy.context.evaluated_depsgraph_get()
     out = {}
-    for ob in bpy.data.objects:
+    for ob in meshes:
         me = ob.evaluated_get(dg).to_mesh()
         out[ob.name] = np.array([v.co for v in me.vertices], np.float32)
         ob.evaluated_get(dg).to_mesh_clear()
