@@ -20,9 +20,9 @@ import bpy
 from . import node_groups
 from .displacement import nodes as _displace_nodes  # noqa: F401 (registers its group)
 from .preferences import BASE_PACKAGE
+from .terrain import nodes as _terrain_nodes  # noqa: F401 (registers its group)
 from .tessellation import phong_nodes as _phong_nodes  # noqa: F401 (registers its group)
 from .tessellation import pn_nodes as _pn_nodes  # noqa: F401 (registers its group)
-from .terrain import nodes as _terrain_nodes  # noqa: F401 (registers its group)
 from .tubes import nodes as _tube_nodes  # noqa: F401 (registers its group)
 
 LIBRARY_NAME = "Tessera"

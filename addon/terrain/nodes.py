@@ -14,8 +14,9 @@ The map (W x H samples, channel 0 = R, row 0 at the bottom) is cut into tiles of
 - the tile is a grid of ``R = max(inner, sides)`` quads a side (one grid per R, built once in a Repeat zone and
   instanced per tile); the points of each side are then moved onto that side's own level (point m of L at
   ``x0 + m (x1 - x0) / L``, computed by both tiles with the same operations, so bit for bit the same), and Merge by
-  Distance (within 1e-4 texel; distinct points are at least 1/64 texel apart) welds what now coincides: neighbouring tiles share every side point, no T-junction, no crack; strips
-  along a coarser side become triangles.
+  Distance (within 1e-4 texel; distinct points are at least 1/64 texel apart) welds what now coincides:
+  neighbouring tiles share every side point, no T-junction, no crack; strips along a coarser side become
+  triangles.
 
 Heights are sampled (Linear, Extend) at texel coordinates (X + 0.5) / W, so at integer X the texel itself;
 positions are the kernel's terrain-local ``((X - (W-1)/2) texel, (Y - (H-1)/2) texel, h scale)``; UVs
