@@ -152,3 +152,12 @@ def test_levels_heights_and_welding_equal_the_kernel(clean_scene, bpy_module, ad
         area = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
         assert (area > 1e-9).all()
     assert set(np.unique(sizes)) <= {3, 4}
+
+
+def test_no_image_or_a_one_texel_map_gives_an_empty_mesh(clean_scene, bpy_module, addon_module):
+    """Nothing to mesh is an empty result, not an error (the modifier stack stays usable)."""
+    bpy = bpy_module
+    ob, mod = terrain_object(bpy, addon_module, None)
+    assert len(evaluated(bpy, ob)[0]) == 0
+    addon_module("addon.node_groups").set_inputs(mod, {"Image": height_image(bpy, np.ones((1, 5), np.float32))})
+    assert len(evaluated(bpy, ob)[0]) == 0
