@@ -17,8 +17,9 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   edges marked sharp at Loop level 3 (``tessera.loop_subdivide``);
 - ``out/demo_loop_hce.png``: a Cornell-like box; Suzanne's light baked by Cycles into its HCE, shown on the coarse
   mesh (left) and carried to Loop level 3 (right) as vertex colours (``tessera.bake_lighting_hce``);
-- ``out/demo_node_groups.png``: Suzanne as it is, and with the Tessera Phong and PN Triangles node groups as
-  modifiers (``tessera.node_group_add``; geometry nodes do the work);
+- ``out/demo_node_groups.png``: four objects made by Tessera's node groups alone, each captioned with its modifier
+  stack: Suzanne under PN Triangles, a sharp-rimmed cylinder under Phong (Split), a trefoil curve
+  under Tubes, a height-map image under Terrain (levels for the camera);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -425,29 +426,96 @@ def build_hce_scene():
 
 
 def build_node_groups_scene():
-    """Suzanne as it is (left), with the Tessera Phong group (middle) and the Tessera PN Triangles group (right) as
-    modifiers, Level 2: non-destructive, and evaluated by geometry nodes alone. Returns the triangle counts."""
+    """Four objects whose geometry comes from Tessera's node groups alone, each captioned with its modifier stack:
+    Suzanne under PN Triangles, a cylinder with sharp rims under Phong with Split sharp edges,
+    a trefoil curve under Tubes, a height-map image under Terrain (levels for the camera). Returns each object's
+    evaluated face count."""
     clear_scene()
+    ng = _addon_module("addon.node_groups")
     clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    ink = material("Ink", (0.08, 0.08, 0.1, 1.0))
+    add_camera((0.0, -12.0, 0.7), (1.5, 0.0, 0.0), lens=34)  # first: the terrain's levels follow it
+
+    monkey = add_suzanne((-4.6, 0.0, 0.0), clay)
+    bpy.ops.mesh.primitive_cylinder_add(vertices=10, radius=0.75, depth=1.3, location=(-1.5, 0.0, 0.0))
+    cylinder = bpy.context.active_object
+    bpy.ops.object.shade_smooth_by_angle(angle=0.7)  # smooth sides, sharp rims
+    trefoil = _trefoil_curve((1.5, 0.0, 0.0))
+    terrain = bpy.data.objects.new("Terrain", bpy.data.meshes.new("Terrain"))
+    bpy.context.scene.collection.objects.link(terrain)
+    terrain.location, terrain.rotation_euler = (4.5, 1.5, -0.5), (0.5, 0.0, 0.0)  # tilted to show its tiles
+    heights = np.asarray(_synth().ridged_terrain(129, seed=3), np.float32)
+    image = bpy.data.images.new("Ridges", 129, 129, float_buffer=True, is_data=True)
+    image.pixels.foreach_set(np.repeat(heights.ravel(), 4).astype(np.float32))
+    stacks = [
+        (monkey, "Suzanne, smooth", [("Tessera PN Triangles", {"Level": 2})]),
+        (cylinder, "Cylinder, sharp rims", [("Tessera Phong", {"Level": 3, "Shape Factor": 1.0,
+                                                               "Sharp Edges": "Split"})]),
+        (trefoil, "Trefoil curve", [("Tessera Tubes", {"Radius": 0.12, "Sides": 12, "Caps": "Round"})]),
+        (terrain, "Height-map image", [("Tessera Terrain", {"Image": image, "Texel Size": 0.017,
+                                                            "Height Scale": 0.9, "Tile Size": 16,
+                                                            "Full-Detail Distance": 9.0, "Material": clay})]),
+    ]
     counts = []
-    for x, group in ((-2.6, None), (0.0, "Tessera Phong"), (2.6, "Tessera PN Triangles")):
-        ob = add_suzanne((x, 0.0, 0.0), clay)
-        if group is not None:
-            for other in bpy.context.selected_objects:
-                other.select_set(False)
-            ob.select_set(True)
-            bpy.context.view_layer.objects.active = ob
-            if bpy.ops.tessera.node_group_add(group=group) != {"FINISHED"}:
-                sys.exit(f"demo: node_group_add {group} failed")
-        wire = wire_overlay(ob, wire_mat)
-        for mod in ob.modifiers:  # the wire copy shows the group's triangles too
-            copy = wire.modifiers.new(mod.name, "NODES")
-            copy.node_group = mod.node_group
-            wire.modifiers.move(len(wire.modifiers) - 1, 0)
+    for ob, source, stack in stacks:
+        if ob is not monkey:
+            ob.data.materials.append(clay)
+        for name, inputs in stack:
+            mod = ob.modifiers.new(name, "NODES")
+            mod.node_group = ng.ensure_group(ng.GROUPS[name])
+            ng.set_inputs(mod, inputs)
+        if ob.type == "MESH":
+            wire = wire_overlay(ob, wire_mat, thickness=0.003)
+            for mod in ob.modifiers:  # the wire copy shows the group's triangles too
+                copy = wire.modifiers.new(mod.name, "NODES")
+                copy.node_group = mod.node_group
+                ng.set_inputs(copy, {**dict(stack)[mod.name], "Material": wire_mat})
+                wire.modifiers.move(len(wire.modifiers) - 1, 0)
+        lines = [source] + [f"+ {name}" + "".join(f"\n    {k}: {_caption(v)}" for k, v in inputs.items()
+                                                  if k != "Material")
+                            for name, inputs in stack]
+        _caption_text(ob.location.x - 1.3, "\n".join(lines), ink)
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        counts.append(len(ob.evaluated_get(depsgraph).data.polygons))
-    add_camera((0.0, -10.5, 0.55), (1.5, 0.0, 0.0), lens=42)
+        counts.append(len(ob.evaluated_get(depsgraph).to_mesh().polygons))
+        ob.evaluated_get(depsgraph).to_mesh_clear()
     return counts
+
+
+def _caption(value):
+    return value.name if hasattr(value, "name") else (f"{value:g}" if isinstance(value, float) else str(value))
+
+
+def _caption_text(x, text, mat):
+    """A text object at the foot of a panel (rendered like geometry)."""
+    curve = bpy.data.curves.new("Caption", "FONT")
+    curve.body, curve.size = text, 0.2
+    ob = bpy.data.objects.new("Caption", curve)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.location, ob.rotation_euler = (x, 0.0, -1.6), (1.5708, 0.0, 0.0)
+    ob.data.materials.append(mat)
+    return ob
+
+
+def _trefoil_curve(location, points=90):
+    """A closed poly curve along a trefoil knot."""
+    t = np.linspace(0.0, 2.0 * np.pi, points, endpoint=False)
+    xyz = 0.33 * np.stack([np.sin(t) + 2 * np.sin(2 * t), np.cos(t) - 2 * np.cos(2 * t), -np.sin(3 * t)], 1)
+    data = bpy.data.curves.new("Trefoil", "CURVE")
+    data.dimensions = "3D"
+    spline = data.splines.new("POLY")
+    spline.points.add(points - 1)
+    spline.points.foreach_set("co", np.c_[xyz, np.ones(points)].ravel())
+    spline.use_cyclic_u = True
+    ob = bpy.data.objects.new("Trefoil", data)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.location = location
+    return ob
+
+
+def _addon_module(name):
+    import importlib
+
+    return importlib.import_module(f"bl_ext.tessera_demo.tessera.{name}")
 
 
 def export(tess):
@@ -503,7 +571,7 @@ def main():
     print(f"demo: lighting baked to HCE in {seconds:.1f} s, carried to Loop level 3 ({tris:,} triangles)")
     counts = build_node_groups_scene()
     render("demo_node_groups.png")
-    print(f"demo: Suzanne with the Tessera Phong / PN Triangles groups as modifiers: {counts} faces")
+    print(f"demo: node groups as modifiers (PN, Phong Split, Tubes, Terrain): {counts} faces")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",

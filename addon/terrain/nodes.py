@@ -58,6 +58,7 @@ def _interface(tree):
            description="Distance from the camera within which tiles get Max Level; beyond, the level falls with "
                        "the square of the distance")
     socket(tree, "UV Map", "NodeSocketString", default="UVMap", description="Name of the UVs (X/(W-1), Y/(H-1))")
+    socket(tree, "Material", "NodeSocketMaterial", description="The terrain's material (a new mesh has none)")
     socket(tree, "Geometry", "NodeSocketGeometry", in_out="OUTPUT", description="The terrain mesh")
 
 
@@ -218,6 +219,7 @@ def _build(tree):
                g.math("DIVIDE", texel[1], g.math("SUBTRACT", b.height, 1.0)), 0.0)
     mesh = g.node("GeometryNodeStoreNamedAttribute", [(0, mesh), ("Name", b.inp("UV Map")), ("Value", uv)],
                   data_type="FLOAT2", domain="CORNER").outputs[0]
+    mesh = g.node("GeometryNodeSetMaterial", [(0, mesh), ("Material", b.inp("Material"))]).outputs[0]
     tree.links.new(g.remove(mesh, (*_TILE, _BORDER, "tessera_texel")), b.go.inputs[0])
 
 
