@@ -8,6 +8,11 @@
   walks, radius per point), 8 sides, no caps, against Curve to Mesh with an 8-point Curve Circle profile scaled by
   the radius (Blender's own sweep, its minimum-twist frames, no UVs), with and without the group's UVs, and
   against ``tessera.tubes`` end to end; output quads per second.
+- ``terrain_group``: the "Tessera Terrain" group on a TERRAIN² float height map (synthetic ridges, tiles of 32,
+  distance levels for a camera over one corner) against ``tessera.terrain_bake`` with the same levels (Distance
+  Only, powers of two, no culling) re-meshing the same map for the same camera, and against Blender's nearest
+  built-in: a Grid of the map's full resolution with a Displace modifier (image texture on its UVs) evaluated;
+  output triangles per second.
 Timings: best of REPEAT, cases interleaved. Prints one JSON object per case. Run: make bench, or
 .venv/bin/python bench/node_groups.py
 """
@@ -34,7 +39,7 @@ def evaluate(bpy, ob, mod, set_level):
         len(evaluated.data.polygons)  # a subdivided mesh is made when it is first read (GPU subdivision defers it)
     seconds = time.perf_counter() - t
     me = evaluated.to_mesh()
-    n = sum(len(p.vertices) - 2 for p in me.polygons) if len(me.polygons) < 1000 else 2 * len(me.polygons)
+    n = len(me.loops) - 2 * len(me.polygons)  # triangles: a k-gon counts k - 2
     evaluated.to_mesh_clear()
     return seconds, n
 
@@ -70,6 +75,66 @@ def main():
     bpy.data.objects.remove(ob)
     spec = importlib.import_module(f"{name}.addon.tubes.nodes").SPEC
     run_tubes(bpy, groups, spec, random_walks(bpy, CURVES, POINTS))
+    synth = importlib.import_module(f"{name}.kernels.terrain.synth")
+    run_terrain(bpy, groups, importlib.import_module(f"{name}.addon.terrain.nodes").SPEC, synth)
+
+
+TERRAIN, TILE, TEXEL, HEIGHT, FULL_DETAIL = 1025, 32, 1.0, 150.0, 250.0
+
+
+def run_terrain(bpy, groups, spec, synth):
+    """The terrain group against terrain_bake and a displaced full-resolution grid: prints two JSON rows."""
+    import numpy as np
+
+    heights = np.asarray(synth.ridged_terrain(TERRAIN, seed=7), np.float32)
+    image = bpy.data.images.new("Bench Heights", TERRAIN, TERRAIN, float_buffer=True, is_data=True)
+    image.pixels.foreach_set(np.repeat(heights.ravel(), 4))
+    cam = bpy.data.objects.new("Bench Camera", bpy.data.cameras.new("Bench Camera"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location, cam.rotation_euler = (-450.0, -450.0, 220.0), (1.15, 0.0, -0.785)
+    bpy.context.scene.camera = cam
+    group_ob = bpy.data.objects.new("Terrain Group", bpy.data.meshes.new("Terrain Group"))
+    bpy.context.scene.collection.objects.link(group_ob)
+    inputs = {"Image": image, "Texel Size": TEXEL, "Height Scale": HEIGHT, "Tile Size": TILE,
+              "Full-Detail Distance": FULL_DETAIL}
+    bpy.ops.tessera.terrain_add(source="IMAGE", image_name=image.name, texel_size=TEXEL, height_scale=HEIGHT,
+                                tile_size=TILE, mode="DISTANCE", d_max=FULL_DETAIL, levels="POW2", culling=False)
+    baked = bpy.context.active_object
+    baked.location = (0.0, 0.0, 0.0)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=TERRAIN - 1, y_subdivisions=TERRAIN - 1,
+                                    size=TEXEL * (TERRAIN - 1), location=(0.0, 0.0, 0.0))
+    grid = bpy.context.active_object
+    texture = bpy.data.textures.new("Bench Heights", "IMAGE")
+    texture.image = image
+    best = {"group": float("inf"), "operator": float("inf"), "displace": float("inf")}
+    counts = {}
+    for _ in range(REPEAT):
+        mod = group_ob.modifiers.new("Terrain", "NODES")
+        mod.node_group = groups.ensure_group(spec)
+        seconds, counts["group"] = evaluate(bpy, group_ob, mod, lambda m: groups.set_inputs(m, inputs))
+        best["group"] = min(best["group"], seconds)
+        group_ob.modifiers.remove(mod)
+        bpy.context.view_layer.objects.active = baked
+        t = time.perf_counter()
+        bpy.ops.tessera.terrain_bake()
+        best["operator"] = min(best["operator"], time.perf_counter() - t)
+        counts["operator"] = len(baked.data.loops) - 2 * len(baked.data.polygons)
+        mod = grid.modifiers.new("Displace", "DISPLACE")
+
+        def displace(m):
+            m.texture, m.texture_coords, m.strength, m.mid_level = texture, "UV", HEIGHT, 0.0
+        seconds, counts["displace"] = evaluate(bpy, grid, mod, displace)
+        best["displace"] = min(best["displace"], seconds)
+        grid.modifiers.remove(mod)
+    rate = {k: counts[k] / best[k] for k in best}
+    for base, label in (("operator", "tessera.terrain_bake (Distance Only, powers of two, no culling), same camera"),
+                        ("displace", f"Grid {TERRAIN}x{TERRAIN} + Displace modifier (image on UVs) evaluation")):
+        print(json.dumps({"bench": "node_groups", "case": f"terrain_group_{TERRAIN}_vs_{base}",
+                          "output_triangles": counts["group"], "seconds": round(best["group"], 4),
+                          "triangles_per_second": round(rate["group"]), "baseline": label,
+                          "baseline_triangles": counts[base], "baseline_seconds": round(best[base], 4),
+                          "baseline_triangles_per_second": round(rate[base]),
+                          "speedup": round(rate["group"] / rate[base], 2)}), flush=True)
 
 
 CURVES, POINTS, SIDES = 3000, 40, 8
