@@ -1,0 +1,132 @@
+"""One-point parametric surfaces (seed 000 §2.3, §9.1): the coded equations' identities, the pattern counts, the
+welded meshes' topology (closed where the surface closes, the Euler characteristic of its topology, outward
+orientation), the many-instances path and Table 2.2's accounting."""
+
+import numpy as np
+import pytest
+from tessera.kernels.common.errors import InvalidInputError
+from tessera.kernels.surfaces import domain_mesh, parametric
+
+
+def random_uv(seed, n=2000):
+    rng = np.random.default_rng(seed)
+    return rng.random(n), rng.random(n)
+
+
+def test_the_coded_equations_satisfy_their_identities():
+    u, v = random_uv(0)
+    p = parametric.Sphere().point(u, v)
+    assert np.abs(np.linalg.norm(p, axis=1) - 1.0).max() < 1e-12
+    x, y, z = parametric.Torus().point(u, v).T
+    assert np.abs((np.hypot(x, y) - 1.0) ** 2 + z * z - 0.25).max() < 1e-12
+    x, y, z = parametric.Cone().point(u, v).T
+    assert np.abs(np.hypot(x, y) - 0.5 * (1 - z / 1.5)).max() < 1e-12 and z.min() >= 0 and z.max() <= 1.5
+    x, y, z = parametric.Steiner().point(u, v).T
+    assert np.abs(x * x * y * y + y * y * z * z + z * z * x * x - x * y * z).max() < 1e-15
+
+
+def test_the_printed_steiner_equation_is_the_typo():
+    """Errata 1: the printed y = a² sin u sin v / 2 does not satisfy the implicit equation; the coded one does."""
+    u, v = random_uv(1)
+    uu, vv = np.pi * u, np.pi * v
+    x, z = np.cos(vv) ** 2 * np.sin(2 * uu) / 2, np.cos(uu) * np.sin(2 * vv) / 2
+    y_printed = np.sin(uu) * np.sin(vv) / 2
+    assert np.abs(x * x * y_printed ** 2 + y_printed ** 2 * z * z + z * z * x * x - x * y_printed * z).max() > 1e-3
+
+
+@pytest.mark.parametrize("factor", [1, 2, 7, 64])
+def test_a_patch_of_factor_f_has_2f2_triangles(factor):
+    uv, tris = domain_mesh.domain_pattern(factor)
+    assert domain_mesh.pattern_counts(factor) == (len(uv), len(tris)) == ((factor + 1) ** 2, 2 * factor ** 2)
+    assert uv.min() == 0 and uv.max() == 1
+    a, b = uv[tris[:, 1]] - uv[tris[:, 0]], uv[tris[:, 2]] - uv[tris[:, 0]]
+    area = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    assert np.allclose(area, 1.0 / factor ** 2)  # counter-clockwise, the square tiled exactly
+    assert domain_mesh.pattern_counts(64)[1] == 8192  # the seed's torus
+
+
+def edge_uses(tris):
+    e = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return counts
+
+
+def signed_volume(mesh):
+    p = mesh.positions.astype(np.float64)[mesh.triangles]
+    return np.einsum("ti,ti->t", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum() / 6.0
+
+
+# (surface, Euler characteristic, boundary edges as a function of F, orientable and closed)
+TOPOLOGY = [
+    ("SPHERE", 2, lambda f: 0, True),
+    ("SUPERELLIPSOID", 2, lambda f: 0, True),
+    ("TORUS", 0, lambda f: 0, True),
+    ("TREFOIL", 0, lambda f: 0, True),
+    ("KLEIN", 0, lambda f: 0, False),
+    ("STEINER", 1, lambda f: 0, False),
+    ("CONE", 1, lambda f: f, False),
+    ("MOBIUS", 0, lambda f: 2 * f, False),
+]
+
+
+@pytest.mark.parametrize("factor", [8, 16])
+@pytest.mark.parametrize("name,chi,boundary,orientable_closed", TOPOLOGY)
+def test_welded_meshes_have_their_surfaces_topology(name, chi, boundary, orientable_closed, factor):
+    surface = parametric.SURFACES[name]()
+    mesh = domain_mesh.surface_mesh(surface, factor)
+    uses = edge_uses(mesh.triangles)
+    assert uses.max() == 2 and int((uses == 1).sum()) == boundary(factor)
+    n_edges = len(uses)
+    assert len(mesh.positions) - n_edges + len(mesh.triangles) == chi
+    assert len(np.unique(mesh.triangles)) == len(mesh.positions)  # no unused vertex
+    # every vertex sits where the formula puts its domain point
+    uv, _ = domain_mesh.domain_pattern(factor)
+    src = uv[mesh.source].astype(np.float64)
+    assert np.allclose(mesh.positions, surface.point(src[:, 0], src[:, 1]), atol=1e-6)
+    # corner UVs are the domain coordinates of the corner: the corner's vertex is at that point
+    corner = surface.point(mesh.uvs[..., 0].astype(np.float64), mesh.uvs[..., 1].astype(np.float64))
+    assert np.abs(corner - mesh.positions[mesh.triangles]).max() < 1e-5
+    if orientable_closed:
+        assert signed_volume(mesh) > 0  # outward
+
+
+def test_the_cone_faces_out():
+    """An open surface: the cone's normals point away from its axis."""
+    mesh = domain_mesh.surface_mesh(parametric.Cone(), 16)
+    p = mesh.positions.astype(np.float64)[mesh.triangles]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    radial = p.mean(axis=1) * [1, 1, 0]
+    assert (np.einsum("ti,ti->t", n, radial) > 0).all()
+
+
+@pytest.mark.parametrize("name", sorted(parametric.SURFACES))
+def test_bad_parameters_and_factors_are_refused(name):
+    cls = parametric.SURFACES[name]
+    field = next(iter(cls.__dataclass_fields__))
+    with pytest.raises(InvalidInputError):
+        domain_mesh.surface_mesh(cls(**{field: float("nan")}), 4)
+    with pytest.raises(InvalidInputError):
+        domain_mesh.surface_mesh(cls(), 0)
+    with pytest.raises(InvalidInputError):
+        domain_mesh.surface_mesh(cls(), 65)
+
+
+def test_many_instances_and_table_2_2():
+    rng = np.random.default_rng(3)
+    cps = rng.uniform(-10, 10, (5, 3))
+    torus = parametric.Torus()
+    pos = domain_mesh.instance_positions(torus, 8, cps).reshape(5, -1, 3)
+    uv, _ = domain_mesh.domain_pattern(8)
+    local = torus.point(uv[:, 0].astype(np.float64), uv[:, 1].astype(np.float64))
+    assert np.allclose(pos - cps[:, None, :], local[None], atol=1e-5)
+    # Table 2.2: 20000 tori of 8192 triangles: 5898.24 MB as a non-indexed buffer, 0.24 MB as control points
+    mesh_bytes, point_bytes = domain_mesh.upload_bytes(20000, 64)
+    assert (mesh_bytes, point_bytes) == (5_898_240_000, 240_000)
+    assert domain_mesh.upload_bytes(5000, 64)[0] == 1_474_560_000  # errata 5: 1474.56, not 1479.56
+
+
+def test_debug_colour():
+    p = parametric.Sphere().point(*random_uv(4, 10))
+    assert np.allclose(parametric.debug_colour(parametric.Sphere(), p), p + 0.6)
+    q = parametric.Torus().point(*random_uv(5, 10))
+    assert np.allclose(parametric.debug_colour(parametric.Torus(), q), q / np.linalg.norm(q, axis=1)[:, None] + 0.4)
