@@ -18,6 +18,7 @@ _modules = (
     "operators.custom_kernel",
     "operators.terrain",
     "operators.subdivision",
+    "operators.surfaces",
     "operators.node_groups",
     "addon.node_library",
     "addon.menus",

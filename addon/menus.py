@@ -1,4 +1,4 @@
-"""Menu entries: Object > Tessera."""
+"""Menu entries: Object > Tessera and Add > Tessera."""
 
 import bpy
 
@@ -17,20 +17,36 @@ class TESSERA_MT_object(bpy.types.Menu):
         self.layout.operator("tessera.terrain_bake", icon="VIEW_CAMERA")
 
 
+class TESSERA_MT_add(bpy.types.Menu):
+    bl_idname = "TESSERA_MT_add"
+    bl_label = "Tessera"
+
+    def draw(self, context):
+        self.layout.operator_context = "INVOKE_REGION_WIN"
+        self.layout.operator("tessera.parametric_surface_add", icon="SURFACE_NSURFACE")
+
+
+def _draw_add_menu(self, context):
+    self.layout.separator()
+    self.layout.menu(TESSERA_MT_add.bl_idname)
+
+
 def _draw_object_menu(self, context):
     self.layout.separator()
     self.layout.menu(TESSERA_MT_object.bl_idname)
 
 
-classes = (TESSERA_MT_object,)
+classes = (TESSERA_MT_object, TESSERA_MT_add)
 _register, _unregister = bpy.utils.register_classes_factory(classes)
 
 
 def register():
     _register()
     bpy.types.VIEW3D_MT_object.append(_draw_object_menu)
+    bpy.types.VIEW3D_MT_add.append(_draw_add_menu)
 
 
 def unregister():
+    bpy.types.VIEW3D_MT_add.remove(_draw_add_menu)
     bpy.types.VIEW3D_MT_object.remove(_draw_object_menu)
     _unregister()

@@ -292,6 +292,8 @@ def _setup_for(bpy, name, tmp_path):
     if name == "terrain_add":
         _height_image(bpy)
         return {"source": "IMAGE", "image_name": "hm"}
+    if name == "parametric_surface_add":  # needs nothing selected
+        return {}
     if name == "displacement_export":
         bpy.ops.mesh.primitive_plane_add()
         assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}

@@ -1,0 +1,71 @@
+"""Parametric-surface options, declared once from the kernel's surface dataclasses: one float property per shape
+parameter of each surface (``torus_major``, ``cone_height``, ...), with the dataclass's default, so a new surface
+in `kernels.surfaces.parametric.SURFACES` gets its options without code here. `surface_from` makes the kernel's
+surface from them; `draw_surface_options` shows the chosen surface's parameters only."""
+
+import dataclasses
+
+import bpy
+
+from ...kernels.common.limits import MAX_WORLD_VALUE
+from ...kernels.surfaces.domain_mesh import MAX_FACTOR
+from ...kernels.surfaces.parametric import SURFACES
+
+#: (identifier, label, description) of each surface, in menu order.
+SURFACE_ITEMS = (
+    ("SPHERE", "Sphere", "The seed's sphere (eq. 2-1)"),
+    ("CONE", "Cone", "The seed's cone (eq. 2-2), open at its base"),
+    ("TORUS", "Torus", "The seed's torus (eq. 2-3)"),
+    ("STEINER", "Steiner's Roman Surface", "Eq. 2-4 as coded (the printed y is a typo): the projective plane"),
+    ("KLEIN", "Klein Bottle", "The figure-8 Klein bottle"),
+    ("MOBIUS", "Möbius Band", "A band with a half twist"),
+    ("TREFOIL", "Trefoil Knot Tube", "A tube around the trefoil knot"),
+    ("SUPERELLIPSOID", "Superellipsoid", "Between an octahedron (2), a sphere (1) and a cube (→ 0)"),
+)
+
+
+def parameter_name(kind, field):
+    return f"{kind.lower()}_{field}"
+
+
+def _parameters():
+    """(property name, surface kind, dataclass field) of every shape parameter."""
+    return [(parameter_name(kind, f.name), kind, f) for kind, cls in SURFACES.items()
+            for f in dataclasses.fields(cls)]
+
+
+def _annotations():
+    out = {
+        "surface": bpy.props.EnumProperty(name="Surface", items=SURFACE_ITEMS, default="TORUS"),
+        "factor": bpy.props.IntProperty(name="Factor", default=32, min=1, max=MAX_FACTOR,
+                                        description="Quads along each side of the domain (2F² triangles, as a "
+                                                    "hardware tessellator makes them)"),
+    }
+    for name, _, f in _parameters():
+        out[name] = bpy.props.FloatProperty(name=f.name.replace("_", " ").title(), default=f.default,
+                                            min=1e-6, max=MAX_WORLD_VALUE, soft_max=10.0)
+    return out
+
+
+class SurfaceOptions:
+    """The parametric-surface options (``tessera.parametric_surface_add`` inherits them)."""
+
+    __annotations__ = _annotations()
+
+
+def surface_from(options):
+    """The kernel surface the options describe (a `kernels.surfaces.parametric` dataclass)."""
+    cls = SURFACES[options.surface]
+    return cls(**{f.name: getattr(options, parameter_name(options.surface, f.name))
+                  for f in dataclasses.fields(cls)})
+
+
+def draw_surface_options(layout, options):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(options, "surface")
+    col.prop(options, "factor")
+    for name, kind, _ in _parameters():
+        if kind == options.surface:
+            col.prop(options, name)
