@@ -146,3 +146,29 @@ def upload_bytes(instances, factor):
     bytes of N control points) = (N · 2F² · 3 · 12, N · 12)."""
     _, triangles = pattern_counts(factor)
     return instances * triangles * 3 * VERTEX_BYTES, instances * VERTEX_BYTES
+
+
+def bounding_radius(surface, factor=32):
+    """Largest distance of the surface from its control point (sampled on the factor-F domain, +1% margin)."""
+    uv, _ = domain_pattern(factor)
+    p = surface.point(uv[:, 0].astype(np.float64), uv[:, 1].astype(np.float64))
+    return 1.01 * float(np.linalg.norm(p, axis=1).max())
+
+
+def camera_factors(surface, control_points, camera, edge_pixels=8.0):
+    """A factor per instance from the camera (the seed's "level from the camera"): its bounding sphere's radius in
+    pixels r_px, and ``ceil(2π r_px / edge_pixels)`` segments around, in [1, MAX_FACTOR]. camera: a
+    `kernels.common.camera.Camera` in the control points' space; instances behind the eye get factor 1.
+    Returns (N,) int64."""
+    if not (np.isfinite(edge_pixels) and edge_pixels > 0):
+        raise InvalidInputError(f"Edge pixels must be a positive number; got {edge_pixels!r}")
+    cp = np.asarray(control_points, np.float64).reshape(-1, 3)
+    view, proj = np.asarray(camera.view, np.float64), np.asarray(camera.projection, np.float64)
+    focal = 0.5 * camera.height * proj[1, 1]
+    radius = bounding_radius(surface)
+    if camera.orthographic:
+        r_px = np.full(len(cp), radius * focal)
+    else:
+        depth = -(cp @ view[2, :3] + view[2, 3])  # distance in front of the eye
+        r_px = np.where(depth > 1e-12, radius * focal / np.maximum(depth, 1e-12), 0.0)
+    return np.clip(np.ceil(2 * np.pi * r_px / edge_pixels), 1, MAX_FACTOR).astype(np.int64)

@@ -167,10 +167,22 @@ class TrefoilTube:
         return self.scale * c + self.tube * ring
 
 
+def cos_sin_turns(t):
+    """(cos 2πt, sin 2πt), exact at quarter turns (each is computed on [0, 1/4) and turned by whole quarters), for
+    the superellipsoid, whose powers |x|^e turn cos(π/2) ≈ 6e-17 (or -4e-8 in float32) into visible offsets."""
+    t = np.asarray(t, np.float64)
+    q = np.floor(4.0 * t)
+    r = t - q / 4.0
+    c, s = np.cos(TWO_PI * r), np.sin(TWO_PI * r)
+    k = q.astype(np.int64) % 4
+    return np.choose(k, [c, -s, -c, s]), np.choose(k, [s, c, -s, -c])
+
+
 @dataclass(frozen=True)
 class Superellipsoid:
     """x = a cos^e1(η) cos^e2(ω), y = a cos^e1(η) sin^e2(ω), z = a sin^e1(η) (signed powers), η = π (1/2 - u)
-    from the +z pole, ω = 2π v. e1 = e2 = 1 is the sphere; small exponents tend to a cube, 2 to an octahedron."""
+    from the +z pole, ω = 2π v. e1 = e2 = 1 is the sphere; small exponents tend to a cube, 2 to an octahedron.
+    Angles go through `cos_sin_turns`, so the poles and the four meridians' zeros are exact (GPU likewise)."""
 
     size: float = 1.0
     e1: float = 0.5
@@ -180,13 +192,14 @@ class Superellipsoid:
 
     def point(self, u, v):
         _positive(size=self.size, e1=self.e1, e2=self.e2)
-        eta, om = np.pi * (0.5 - np.asarray(u, np.float64)), TWO_PI * np.asarray(v, np.float64)
+        cos_eta, sin_eta = cos_sin_turns(0.25 - 0.5 * np.asarray(u, np.float64))
+        cos_om, sin_om = cos_sin_turns(np.asarray(v, np.float64))
 
         def sp(x, e):
             return np.sign(x) * np.abs(x) ** e
 
-        ce = sp(np.cos(eta), self.e1)
-        return self.size * _stack(ce * sp(np.cos(om), self.e2), ce * sp(np.sin(om), self.e2), sp(np.sin(eta), self.e1))
+        ce = sp(cos_eta, self.e1)
+        return self.size * _stack(ce * sp(cos_om, self.e2), ce * sp(sin_om, self.e2), sp(sin_eta, self.e1))
 
 
 #: Every surface by the name the operator and the settings use.

@@ -130,3 +130,28 @@ def test_debug_colour():
     assert np.allclose(parametric.debug_colour(parametric.Sphere(), p), p + 0.6)
     q = parametric.Torus().point(*random_uv(5, 10))
     assert np.allclose(parametric.debug_colour(parametric.Torus(), q), q / np.linalg.norm(q, axis=1)[:, None] + 0.4)
+
+
+def test_camera_factors_fall_with_distance():
+    from tessera.kernels.common import camera
+
+    cam = camera.Camera(camera.look_at_view((0, -10, 0), (0, 0, 0)), camera.perspective(0.8, 1.0, 0.1, 1e4), 512, 512)
+    points = np.array([[0, 0, 0], [0, 20, 0], [0, 200, 0], [0, 2000, 0], [0, -20, 0]], np.float64)
+    f = domain_mesh.camera_factors(parametric.Torus(), points, cam, edge_pixels=4.0)
+    assert f[0] >= f[1] >= f[2] >= f[3] and f[0] > f[3] and f[4] == 1  # behind the eye: 1
+    assert f.min() >= 1 and f.max() <= domain_mesh.MAX_FACTOR
+    # radius in pixels at depth 10: 1.5 * focal / 10 with focal = 256 / tan(0.4)
+    r_px = domain_mesh.bounding_radius(parametric.Torus()) * 256 / np.tan(0.4) / 10
+    assert f[0] == min(64, int(np.ceil(2 * np.pi * r_px / 4.0)))
+
+
+def test_quarter_turns_are_exact():
+    t = np.array([0.0, 0.25, 0.5, 0.75, 1.0, -0.25, 0.125])
+    c, s = parametric.cos_sin_turns(t)
+    assert np.array_equal(c[:6], [1, 0, -1, 0, 1, 0]) and np.array_equal(s[:6], [0, 1, 0, -1, 0, -1])
+    assert np.allclose([c[6], s[6]], [np.cos(np.pi / 4), np.sin(np.pi / 4)], atol=1e-15)
+    u, v = random_uv(6)
+    c, s = parametric.cos_sin_turns(u)
+    assert np.allclose(c, np.cos(2 * np.pi * u), atol=1e-15) and np.allclose(s, np.sin(2 * np.pi * u), atol=1e-15)
+    poles = parametric.Superellipsoid(e1=0.3, e2=0.3).point(np.array([0.0, 1.0]), np.array([0.3, 0.7]))
+    assert np.array_equal(poles, [[0, 0, 1], [0, 0, -1]])  # no sqrt(6e-17) offsets

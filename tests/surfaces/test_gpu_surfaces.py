@@ -1,0 +1,54 @@
+"""The one-point GPU path of the parametric surfaces (tier: gpu): the vertices the shader places are the numpy
+kernel's (compute shader, same GLSL as the preview), and the instanced preview draws the same picture as the
+baked instances uploaded as one mesh."""
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.blender, pytest.mark.gpu]
+
+
+@pytest.mark.parametrize("name", ["SPHERE", "CONE", "TORUS", "STEINER", "KLEIN", "MOBIUS", "TREFOIL",
+                                  "SUPERELLIPSOID"])
+def test_gpu_vertices_equal_the_kernels(gpu_renderer, addon_module, name):
+    parametric = addon_module("kernels.surfaces.parametric")
+    domain_mesh = addon_module("kernels.surfaces.domain_mesh")
+    draw = addon_module("gpu_shaders.surfaces.draw")
+    surface = parametric.SURFACES[name]()
+    points = np.random.default_rng(1).uniform(-5, 5, (7, 3)).astype(np.float32)
+    got = draw.evaluate_on_gpu(surface, points, 16)
+    want = domain_mesh.instance_positions(surface, 16, points)
+    assert got.shape == want.shape
+    assert np.abs(got - want).max() <= 2e-6 * (1.0 + np.abs(want).max())
+    # and the baked mesh's vertices are among them, at their domain points (first instance, minus its point)
+    baked = domain_mesh.surface_mesh(surface, 16)
+    first = got[: (16 + 1) ** 2] - points[0]
+    assert np.abs(first[baked.source] - baked.positions).max() <= 2e-6 * (1.0 + np.abs(baked.positions).max())
+
+
+def test_the_instanced_preview_draws_what_the_uploaded_mesh_draws(gpu_renderer, addon_module):
+    parametric = addon_module("kernels.surfaces.parametric")
+    domain_mesh = addon_module("kernels.surfaces.domain_mesh")
+    draw = addon_module("gpu_shaders.surfaces.draw")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    camera = addon_module("kernels.common.camera")
+    torus = parametric.Torus()
+    rng = np.random.default_rng(4)
+    points = rng.uniform(-6, 6, (12, 3))
+    cam = camera.Camera(camera.look_at_view((3, -22, 9), (0, 0, 0)), camera.perspective(0.9, 1.0, 0.1, 100), 200, 200)
+    vp = cam.projection @ cam.view
+    factors = domain_mesh.camera_factors(torus, points, cam, edge_pixels=6.0)
+    assert len(np.unique(factors)) > 1  # several factors: several draws
+    data = draw.SurfaceDrawData(torus, points, factors)
+    meshes = [domain_mesh.surface_mesh(torus, int(f)) for f in factors]
+    positions = np.concatenate([m.positions + p.astype(np.float32) for m, p in zip(meshes, points, strict=True)])
+    starts = np.cumsum([0] + [len(m.positions) for m in meshes])[:-1]
+    tris = np.concatenate([m.triangles + s for m, s in zip(meshes, starts, strict=True)])
+    assert data.triangle_count == sum(2 * int(f) ** 2 for f in factors)
+    cpu = offscreen.render_triangles(positions, tris, vp, size=(200, 200), color=(1, 1, 1, 1), lit=False)
+    gpu = offscreen.render(lambda: data.draw(vp, color=(1, 1, 1, 1), lit=False), size=(200, 200))
+    a, b = cpu[..., 0] > 127, gpu[..., 0] > 127
+    assert a.sum() > 1500
+    assert np.mean(a == b) >= 0.998, np.mean(a == b)
+    # what crossed to the GPU: 16 bytes a control point and the patterns, far less than the mesh
+    assert data.uploaded_bytes < positions.nbytes + tris.nbytes
