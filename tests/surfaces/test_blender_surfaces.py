@@ -30,7 +30,10 @@ def test_the_baked_mesh_is_the_kernels_surface(clean_scene, bpy_module, addon_mo
     parametric = addon_module("kernels.surfaces.parametric")
     domain_mesh = addon_module("kernels.surfaces.domain_mesh")
     bpy.context.scene.cursor.location = (1.0, 2.0, 3.0)
-    assert bpy.ops.tessera.parametric_surface_add(surface=kind, factor=12) == {"FINISHED"}
+    try:
+        assert bpy.ops.tessera.parametric_surface_add(surface=kind, factor=12) == {"FINISHED"}
+    finally:
+        bpy.context.scene.cursor.location = (0.0, 0.0, 0.0)  # later tests add objects at the cursor
     ob = bpy.context.active_object
     assert tuple(ob.location) == (1.0, 2.0, 3.0) and ob.select_get()
     cls = parametric.SURFACES[kind]  # the options' defaults are the kernel's, kept by Blender as float32
