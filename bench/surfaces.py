@@ -1,0 +1,114 @@
+"""One-point parametric surfaces: the seed's Tables 2.1 / 2.2 (seed 000 §2.4), here.
+
+N tori of 8,192 triangles (factor 64, integer partitioning: 2F²), scattered in a cube, drawn into a 256x256
+offscreen with depth test, in the same run:
+
+- ``one_point``: the GPU path: N control points (one RGBA32F texel each) and the factor-64 pattern, the torus
+  evaluated in the vertex shader, one instanced draw;
+- ``mesh``: the same tori computed on the CPU (`kernels.surfaces.domain_mesh.instance_positions`) and uploaded as
+  one vertex buffer, drawn in one call. As in the seed, non-indexed float3 positions: every triangle's three
+  corners (the seed's "CPU tori in one vertex buffer"); what is uploaded is measured from the arrays handed to the
+  batch (positions, and the constant normals the flat-mesh shader takes: twice the seed's 12 bytes a vertex).
+  Both are drawn unlit, a flat colour, as the seed's position-only vertices (the one-point shader then skips its
+  four extra evaluations for the normal). Built while it fits the memory of this machine (``MESH_LIMIT_BYTES``); beyond, only the analytic bytes.
+
+Per N: bytes (Table 2.2's accounting, and measured), frame time (draw + a one-pixel read back, so the GPU's work
+is included; ``mesh_upload_draw_ms`` adds building the buffer and its upload, what a changed surface costs), and
+their ratios. On a CPU-only machine the renderer is Mesa llvmpipe, a software rasteriser: absolute times are not
+a GPU's; the device tool runs the same on a real GPU where one is lent.
+Run: .venv/bin/python bench/surfaces.py [--full]   (--full: N up to 20,000; else up to 2,500)
+"""
+
+import importlib
+import json
+import sys
+import time
+
+import numpy as np
+from _setup import enable_extension
+
+SIZE = 256
+FACTOR = 64
+COUNTS = (1, 10, 100, 500, 1000, 2500, 5000, 10000, 20000)
+MESH_LIMIT_BYTES = 1 << 30  # 1 GiB of positions at most for the uploaded-mesh path
+
+
+def timed(fn, repeat=3):
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def main():
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    package = enable_extension()
+    mod = lambda name: importlib.import_module(f"{package}.{name}")  # noqa: E731
+    import gpu
+    from gpu_extras.batch import batch_for_shader
+
+    renderer = mod("addon.gpu_context").ensure_gpu_context()
+    parametric, domain_mesh = mod("kernels.surfaces.parametric"), mod("kernels.surfaces.domain_mesh")
+    draw, offscreen, loader = mod("gpu_shaders.surfaces.draw"), mod("gpu_shaders.offscreen"), mod("gpu_shaders.loader")
+    camera = mod("kernels.common.camera")
+    torus = parametric.Torus()
+    vp = camera.look_at((60.0, -80.0, 50.0), (0, 0, 0), fov_deg=40, far=1000.0)
+    box = gpu.types.GPUOffScreen(SIZE, SIZE)
+    shader = loader.shader("flat_mesh", offscreen._describe_flat_mesh)
+    print(json.dumps({"bench": "surfaces", "case": "renderer", "renderer": renderer,
+                      "backend": gpu.platform.backend_type_get(), "triangles_per_torus": 2 * FACTOR * FACTOR}))
+
+    def frame(fn):
+        with box.bind():
+            fb = gpu.state.active_framebuffer_get()
+            fb.clear(color=(0, 0, 0, 1), depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            fn()
+            fb.read_color(SIZE // 2, SIZE // 2, 1, 1, 4, 0, "UBYTE")
+            gpu.state.depth_test_set("NONE")
+
+    counts = COUNTS if "--full" in sys.argv else COUNTS[:6]
+    uv, tris = domain_mesh.domain_pattern(FACTOR)
+    for n in counts:
+        points = np.random.default_rng(n).uniform(-40, 40, (n, 3))
+        mesh_bytes, point_bytes = domain_mesh.upload_bytes(n, FACTOR)
+        row = {"bench": "surfaces", "case": f"tori_{n}", "tori": n, "triangles": n * 2 * FACTOR * FACTOR,
+               "analytic_mesh_bytes": mesh_bytes, "analytic_one_point_bytes": point_bytes,
+               "analytic_ratio": mesh_bytes / point_bytes}
+        data = draw.SurfaceDrawData(torus, points, FACTOR)
+        row["one_point_bytes"] = data.uploaded_bytes
+        row["one_point_draw_ms"] = 1e3 * timed(lambda data=data: frame(lambda: data.draw(vp, lit=False)))
+        row["one_point_upload_draw_ms"] = 1e3 * timed(lambda points=points: frame(
+            lambda: draw.SurfaceDrawData(torus, points, FACTOR).draw(vp, lit=False)), repeat=2)
+        if mesh_bytes <= MESH_LIMIT_BYTES:
+            def upload(points=points):
+                corners = domain_mesh.instance_positions(torus, FACTOR, points).reshape(n, -1, 3)[:, tris]
+                pos = np.ascontiguousarray(corners.reshape(-1, 3))
+                normals = np.zeros_like(pos)
+                normals[:, 2] = 1.0
+                return batch_for_shader(shader, "TRIS", {"pos": pos, "nor": normals}), pos.nbytes + normals.nbytes
+
+            resident, pos_bytes = upload()
+
+            def draw_mesh(batch):
+                offscreen.set_shading(shader, vp, (0.8, 0.8, 0.8, 1.0), False)
+                batch.draw(shader)
+
+            row["mesh_bytes"] = pos_bytes
+            row["mesh_draw_ms"] = 1e3 * timed(lambda: frame(lambda: draw_mesh(resident)))
+            row["mesh_upload_draw_ms"] = 1e3 * timed(lambda: frame(lambda: draw_mesh(upload()[0])), repeat=2)
+            row["mesh_over_one_point_bytes"] = pos_bytes / data.uploaded_bytes
+            row["mesh_over_one_point_draw"] = row["mesh_draw_ms"] / row["one_point_draw_ms"]
+            row["mesh_upload_over_one_point_upload"] = row["mesh_upload_draw_ms"] / row["one_point_upload_draw_ms"]
+            del resident
+        print(json.dumps(row), flush=True)
+    box.free()
+
+
+if __name__ == "__main__":
+    main()
