@@ -10,7 +10,8 @@ offscreen with depth test, in the same run:
   corners (the seed's "CPU tori in one vertex buffer"); what is uploaded is measured from the arrays handed to the
   batch (positions, and the constant normals the flat-mesh shader takes: twice the seed's 12 bytes a vertex).
   Both are drawn unlit, a flat colour, as the seed's position-only vertices (the one-point shader then skips its
-  four extra evaluations for the normal). Built while it fits the memory of this machine (``MESH_LIMIT_BYTES``); beyond, only the analytic bytes.
+  four extra evaluations for the normal). Built while it fits the memory of this machine (``MESH_LIMIT_BYTES``);
+  beyond, only the analytic bytes.
 
 Per N: bytes (Table 2.2's accounting, and measured), frame time (draw + a one-pixel read back, so the GPU's work
 is included; ``mesh_upload_draw_ms`` adds building the buffer and its upload, what a changed surface costs), and
@@ -86,7 +87,7 @@ def main():
         row["one_point_upload_draw_ms"] = 1e3 * timed(lambda points=points: frame(
             lambda: draw.SurfaceDrawData(torus, points, FACTOR).draw(vp, lit=False)), repeat=2)
         if mesh_bytes <= MESH_LIMIT_BYTES:
-            def upload(points=points):
+            def upload(points=points, n=n):
                 corners = domain_mesh.instance_positions(torus, FACTOR, points).reshape(n, -1, 3)[:, tris]
                 pos = np.ascontiguousarray(corners.reshape(-1, 3))
                 normals = np.zeros_like(pos)
@@ -100,7 +101,7 @@ def main():
                 batch.draw(shader)
 
             row["mesh_bytes"] = pos_bytes
-            row["mesh_draw_ms"] = 1e3 * timed(lambda: frame(lambda: draw_mesh(resident)))
+            row["mesh_draw_ms"] = 1e3 * timed(lambda resident=resident: frame(lambda: draw_mesh(resident)))
             row["mesh_upload_draw_ms"] = 1e3 * timed(lambda: frame(lambda: draw_mesh(upload()[0])), repeat=2)
             row["mesh_over_one_point_bytes"] = pos_bytes / data.uploaded_bytes
             row["mesh_over_one_point_draw"] = row["mesh_draw_ms"] / row["one_point_draw_ms"]
