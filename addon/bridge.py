@@ -369,6 +369,61 @@ def read_curve_object(ob, radius_scale=1.0):
     return lines, notes
 
 
+@dataclass
+class SplineArrays:
+    """One spline of a Curve data-block: kind ``BEZIER``, ``POLY`` or ``NURBS``; co (n, 3) float64; handle_left and
+    handle_right (n, 3) float64 (Bézier) or None; radius and tilt (n,) float64; cyclic; material_index."""
+
+    kind: str
+    co: np.ndarray
+    handle_left: np.ndarray | None
+    handle_right: np.ndarray | None
+    radius: np.ndarray
+    tilt: np.ndarray
+    cyclic: bool
+    material_index: int = 0
+
+
+def read_splines(curve):
+    """The control points of every spline of a `bpy.types.Curve` as `SplineArrays` (object space)."""
+    out = []
+    for s in curve.splines:
+        bezier = s.type == "BEZIER"
+        points = s.bezier_points if bezier else s.points
+        n = len(points)
+        if n == 0:
+            continue
+        if bezier:
+            co = _get(points, "co", n, np.float32, 3).astype(np.float64)
+            hl = _get(points, "handle_left", n, np.float32, 3).astype(np.float64)
+            hr = _get(points, "handle_right", n, np.float32, 3).astype(np.float64)
+        else:
+            co, hl, hr = _get(points, "co", n, np.float32, 4)[:, :3].astype(np.float64), None, None
+        out.append(SplineArrays(s.type, co, hl, hr, _control_values(s, "radius"), _control_values(s, "tilt"),
+                                bool(s.use_cyclic_u), s.material_index))
+    return out
+
+
+def write_poly_curve(name, splines, dimensions="3D"):
+    """A new `bpy.types.Curve` of POLY splines from `SplineArrays` (their co, radius, tilt, cyclic and material;
+    handles ignored). Removed again if anything fails."""
+    data = bpy.data.curves.new(name, "CURVE")
+    try:
+        data.dimensions = dimensions
+        for sp in splines:
+            s = data.splines.new("POLY")
+            n = len(sp.co)
+            s.points.add(n - 1)
+            s.points.foreach_set("co", np.c_[sp.co, np.ones(n)].astype(np.float32).ravel())
+            s.points.foreach_set("radius", np.asarray(sp.radius, np.float32))
+            s.points.foreach_set("tilt", np.asarray(sp.tilt, np.float32))
+            s.use_cyclic_u, s.material_index = sp.cyclic, sp.material_index
+    except BaseException:
+        bpy.data.curves.remove(data)
+        raise
+    return data
+
+
 def read_hair_curves(curves, default_radius):
     """Points of a hair `Curves` data-block as `Polylines` in object space.
 

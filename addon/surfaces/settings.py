@@ -1,15 +1,21 @@
-"""Parametric-surface options, declared once from the kernel's surface dataclasses: one float property per shape
-parameter of each surface (``torus_major``, ``cone_height``, ...), with the dataclass's default, so a new surface
-in `kernels.surfaces.parametric.SURFACES` gets its options without code here. `surface_from` makes the kernel's
-surface from them; `draw_surface_options` shows the chosen surface's parameters only."""
+"""Surface and curve options.
+
+Parametric surfaces: declared once from the kernel's surface dataclasses, one float property per shape parameter of
+each surface (``torus_major``, ``cone_height``, ...) with the dataclass's default, so a new surface in
+`kernels.surfaces.parametric.SURFACES` gets its options without code here. `surface_from` makes the kernel's surface
+from them; `draw_surface_options` shows the chosen surface's parameters only.
+
+Adaptive curves: `CurveOptions`, made into the kernel's `CurveSampling` by `curve_sampling`."""
 
 import dataclasses
 
 import bpy
 
-from ...kernels.common.limits import MAX_WORLD_VALUE
+from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
+from ...kernels.surfaces.adaptive_curves import CurveSampling
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
 from ...kernels.surfaces.parametric import SURFACES
+from ..cameras import CAMERA_ITEMS
 
 #: (identifier, label, description) of each surface, in menu order.
 SURFACE_ITEMS = (
@@ -69,3 +75,51 @@ def draw_surface_options(layout, options):
     for name, kind, _ in _parameters():
         if kind == options.surface:
             col.prop(options, name)
+
+
+CURVE_MODE_ITEMS = (
+    ("CURVATURE", "Curvature", "Segments per Bézier segment from its control polygon's curvature (seed eq. 4.5: "
+                               "6 for a straight one, up to Max Segments)"),
+    ("TOLERANCE", "Tolerance", "As many segments as keep the polyline within Tolerance of the curve"),
+    ("SCREEN", "Screen", "As many segments as keep the polyline within Pixels of the curve for the camera"),
+)
+
+
+class CurveOptions:
+    """The options of ``tessera.curve_adaptive`` (`kernels.surfaces.adaptive_curves.CurveSampling`)."""
+
+    mode: bpy.props.EnumProperty(name="Sampling", items=CURVE_MODE_ITEMS, default="CURVATURE")
+    max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024,
+                                        description="Most segments one Bézier segment gets (the seed's 32)")
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=0.01, min=1e-9, max=MAX_WORLD_VALUE,
+                                       subtype="DISTANCE", description="Largest distance from the curve")
+    pixels: bpy.props.FloatProperty(name="Pixels", default=1.0, min=0.01, max=MAX_PIXELS,
+                                    description="Largest distance from the curve on screen")
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+    copies: bpy.props.IntProperty(name="Copies", default=1, min=1, max=1000,
+                                  description="Polylines per spline, each moved by Copy Offset × k / Copies "
+                                              "(the seed's hair copies)")
+    copy_offset: bpy.props.FloatVectorProperty(name="Copy Offset", default=(0.0, 0.0, 0.1), size=3,
+                                               min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE, subtype="TRANSLATION")
+
+
+def curve_sampling(options):
+    """The kernel's `CurveSampling` from `CurveOptions`."""
+    return CurveSampling(mode=options.mode, max_segments=options.max_segments, tolerance=options.tolerance,
+                         pixels=options.pixels, copies=options.copies, offset=tuple(options.copy_offset))
+
+
+def draw_curve_options(layout, options):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(options, "mode")
+    col.prop(options, "max_segments")
+    if options.mode == "TOLERANCE":
+        col.prop(options, "tolerance")
+    elif options.mode == "SCREEN":
+        col.prop(options, "pixels")
+        col.prop(options, "camera_source")
+    col.prop(options, "copies")
+    if options.copies > 1:
+        col.prop(options, "copy_offset")

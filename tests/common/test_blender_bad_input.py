@@ -294,6 +294,9 @@ def _setup_for(bpy, name, tmp_path):
         return {"source": "IMAGE", "image_name": "hm"}
     if name == "parametric_surface_add":  # needs nothing selected
         return {}
+    if name == "curve_adaptive":
+        bpy.ops.curve.primitive_bezier_curve_add()
+        return {}
     if name == "displacement_export":
         bpy.ops.mesh.primitive_plane_add()
         assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}

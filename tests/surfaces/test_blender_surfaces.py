@@ -62,3 +62,76 @@ def test_a_bad_parameter_adds_nothing(clean_scene, bpy_module):
     with pytest.raises(RuntimeError, match="Radius must be a finite number"):
         bpy.ops.tessera.parametric_surface_add(surface="SPHERE", sphere_radius=float("nan"))
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+
+
+def bezier_object(bpy, co, hl, hr, cyclic=False, radius=None):
+    data = bpy.data.curves.new("Bez", "CURVE")
+    data.dimensions = "3D"
+    s = data.splines.new("BEZIER")
+    s.bezier_points.add(len(co) - 1)
+    s.bezier_points.foreach_set("co", np.asarray(co, np.float32).ravel())
+    s.bezier_points.foreach_set("handle_left", np.asarray(hl, np.float32).ravel())
+    s.bezier_points.foreach_set("handle_right", np.asarray(hr, np.float32).ravel())
+    if radius is not None:
+        s.bezier_points.foreach_set("radius", np.asarray(radius, np.float32))
+    s.use_cyclic_u = cyclic
+    ob = bpy.data.objects.new("Bez", data)
+    bpy.context.scene.collection.objects.link(ob)
+    for other in bpy.context.selected_objects:
+        other.select_set(False)
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    return ob
+
+
+def poly_points(ob):
+    out = []
+    for s in ob.data.splines:
+        co = np.empty(len(s.points) * 4, np.float32)
+        s.points.foreach_get("co", co)
+        r = np.empty(len(s.points), np.float32)
+        s.points.foreach_get("radius", r)
+        out.append((co.reshape(-1, 4)[:, :3], r, s.use_cyclic_u, s.type))
+    return out
+
+
+@pytest.mark.parametrize("cyclic", [False, True])
+def test_curve_to_adaptive_polyline_samples_where_it_bends(clean_scene, bpy_module, addon_module, cyclic):
+    bpy = bpy_module
+    bz = addon_module("kernels.common.bezier_curves")
+    co = np.array([[0, 0, 0], [4, 0, 0], [4.2, 0.3, 0], [8, 3, 1]], np.float32)  # straight, then a sharp bend
+    hl = co - np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0], [1, 1, 0]], np.float32)
+    hr = co + np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0], [1, 1, 0]], np.float32)
+    src = bezier_object(bpy, co, hl, hr, cyclic, radius=[1, 2, 3, 4])
+    assert bpy.ops.tessera.curve_adaptive() == {"FINISHED"}
+    out = bpy.context.active_object
+    assert out is not src and out.type == "CURVE" and out.matrix_world == src.matrix_world
+    [(pts, radius, out_cyclic, kind)] = poly_points(out)
+    assert kind == "POLY" and out_cyclic == cyclic
+    control = bz.segment_controls(co, hl, hr, cyclic)
+    counts = bz.curvature_counts(control)
+    assert counts[0] == 6 and counts.max() == 32  # the straight segment gets the minimum, the bend the cap
+    want = bz.sample(control, counts, cyclic)
+    assert np.allclose(pts, want.points, atol=1e-5)
+    assert radius[0] == 1 and radius[counts[0]] == 2
+
+
+def test_curve_copies_and_bad_splines(clean_scene, bpy_module):
+    bpy = bpy_module
+    co = np.array([[0, 0, 0], [2, 1, 0]], np.float32)
+    bezier_object(bpy, co, co - [0.5, 0, 0], co + [0.5, 0, 0])
+    assert bpy.ops.tessera.curve_adaptive(copies=6, copy_offset=(0, 0, 0.6)) == {"FINISHED"}
+    polys = poly_points(bpy.context.active_object)
+    assert len(polys) == 6
+    assert np.allclose(polys[5][0] - polys[0][0], [0, 0, 0.5], atol=1e-6)
+    # a curve with only a NURBS spline: refused, nothing added
+    data = bpy.data.curves.new("Nurbs", "CURVE")
+    s = data.splines.new("NURBS")
+    s.points.add(3)
+    ob = bpy.data.objects.new("Nurbs", data)
+    bpy.context.scene.collection.objects.link(ob)
+    bpy.context.view_layer.objects.active = ob
+    before = len(bpy.data.objects), len(bpy.data.curves)
+    with pytest.raises(RuntimeError, match="convert them to Bézier"):
+        bpy.ops.tessera.curve_adaptive()
+    assert (len(bpy.data.objects), len(bpy.data.curves)) == before

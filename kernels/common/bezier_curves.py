@@ -1,0 +1,116 @@
+"""Cubic Bézier splines sampled where they bend (digest 001 §4.3 eq. 4.5, §5.5.2 and §11.4): each segment gets its
+own count of equal parameter steps, from the curvature of its control polygon (``max(6, min(32, 10 κ_max))``,
+rounded up) or from a tolerance (world units, or pixels for a camera). Shared by the adaptive polyline operator
+and the tubes.
+
+A spline is its points and handles as Blender keeps them: segment i runs from point i (its right handle) to point
+i + 1 (that point's left handle); a cyclic spline adds the segment from the last point back to the first. Samples
+of consecutive segments share their end points, so the polyline is continuous and closes exactly on cyclic splines.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .curvature import curvature_level, curve_kappa
+from .errors import InvalidInputError
+
+#: The curvature metric's cap on segments (eq. 4.5's t_tessmax) and its gain (one point per tenth of height).
+MAX_SEGMENTS = 32
+GAIN = 10.0
+#: Most segments one span may get from a tolerance (a guard against tolerances far below the curve's size).
+MAX_TOLERANCE_SEGMENTS = 1024
+
+
+@dataclass
+class SampledSpline:
+    """points (n, 3) float64; segment (n,) int64 and t (n,) float64: the Bézier segment each sample lies on and
+    its parameter there (so per-point values such as radius and tilt can be interpolated); counts (S,) int64
+    segments per Bézier segment; cyclic: the polyline closes (its last point is not repeated)."""
+
+    points: np.ndarray
+    segment: np.ndarray
+    t: np.ndarray
+    counts: np.ndarray
+    cyclic: bool
+
+
+def segment_controls(co, handle_left, handle_right, cyclic):
+    """Control polygons (S, 4, 3) of a spline's segments. co, handle_left, handle_right: (n, 3)."""
+    co, hl, hr = (np.asarray(a, np.float64).reshape(-1, 3) for a in (co, handle_left, handle_right))
+    n = len(co)
+    if n < 2:
+        return np.zeros((0, 4, 3))
+    j = np.arange(n if cyclic else n - 1)
+    k = (j + 1) % n
+    return np.stack([co[j], hr[j], hl[k], co[k]], axis=1)
+
+
+def curvature_counts(control, gain=GAIN, t_max=MAX_SEGMENTS):
+    """Eq. 4.5 per segment, rounded up (equal spacing): (S, 4, 3) -> (S,) int64 in [6, t_max]."""
+    return np.ceil(curvature_level(curve_kappa(control), n_control=4, gain=gain, t_max=t_max)).astype(np.int64)
+
+
+def tolerance_counts(control, tolerance):
+    """Segments so the polyline stays within ``tolerance`` of the curve: the chord of a step h deviates at most
+    h² max|B''| / 8 from a curve whose second derivative is bounded by 6 max(|P0 - 2P1 + P2|, |P1 - 2P2 + P3|),
+    so k = ceil(sqrt(3 M / (4 tolerance))). tolerance: a number or (S,) per segment (world units).
+    Returns (S,) int64 in [1, MAX_TOLERANCE_SEGMENTS]."""
+    c = np.asarray(control, np.float64)
+    tol = np.broadcast_to(np.asarray(tolerance, np.float64), (len(c),))
+    if not (np.all(np.isfinite(tol)) and np.all(tol > 0)):
+        raise InvalidInputError("The curve tolerance must be a positive number")
+    m = np.maximum(np.linalg.norm(c[:, 0] - 2 * c[:, 1] + c[:, 2], axis=1),
+                   np.linalg.norm(c[:, 1] - 2 * c[:, 2] + c[:, 3], axis=1))
+    return np.clip(np.ceil(np.sqrt(0.75 * m / tol)), 1, MAX_TOLERANCE_SEGMENTS).astype(np.int64)
+
+
+def pixel_tolerance(control, camera, pixels):
+    """World tolerance per segment for ``pixels`` on screen: the size of a pixel at the depth of the segment's
+    nearest control point (its farthest point sets nothing: the near end needs the detail). camera: a
+    `kernels.common.camera.Camera` in the curve's space. (S,) float64."""
+    if not (np.isfinite(pixels) and pixels > 0):
+        raise InvalidInputError(f"The tolerance in pixels must be a positive number; got {pixels!r}")
+    c = np.asarray(control, np.float64)
+    view, proj = np.asarray(camera.view, np.float64), np.asarray(camera.projection, np.float64)
+    focal = 0.5 * camera.height * proj[1, 1]
+    if camera.orthographic:
+        return np.full(len(c), pixels / focal)
+    depth = -(c @ view[2, :3] + view[2, 3])  # (S, 4) in front of the eye
+    near = np.maximum(depth.min(axis=1), 1e-6 * (1.0 + np.abs(depth).max()))
+    return pixels * near / focal
+
+
+def evaluate(control, t):
+    """Points of cubic segments: control (S, 4, 3), t (S, k) -> (S, k, 3) (Bernstein form)."""
+    c = np.asarray(control, np.float64)
+    t = np.asarray(t, np.float64)[..., None]
+    s = 1.0 - t
+    return (s ** 3 * c[:, None, 0] + 3 * s * s * t * c[:, None, 1] + 3 * s * t * t * c[:, None, 2]
+            + t ** 3 * c[:, None, 3])
+
+
+def sample(control, counts, cyclic):
+    """A `SampledSpline`: segment i split into counts[i] equal steps of t; shared ends written once."""
+    c = np.asarray(control, np.float64)
+    counts = np.asarray(counts, np.int64)
+    if len(c) == 0:
+        return SampledSpline(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0), counts, bool(cyclic))
+    segment = np.repeat(np.arange(len(c)), counts)
+    first = np.repeat(np.cumsum(counts) - counts, counts)
+    t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
+    if not cyclic:  # the last end point
+        segment, t = np.append(segment, len(c) - 1), np.append(t, 1.0)
+    points = evaluate(c[segment], t[:, None])[:, 0]
+    if not cyclic:
+        points[-1] = c[-1, 3]
+    return SampledSpline(points, segment, t, counts, bool(cyclic))
+
+
+def offset_copies(points, copies, offset):
+    """The seed's OL0 (§5.5.2): ``copies`` polylines, copy k moved by ``offset * k / copies`` (k = 0 .. copies - 1:
+    the first is the curve itself). points: (n, 3) -> (copies, n, 3)."""
+    if int(copies) != copies or copies < 1:
+        raise InvalidInputError(f"Copies must be a whole number of at least 1; got {copies!r}")
+    k = np.arange(int(copies), dtype=np.float64)[:, None, None] / copies
+    return np.asarray(points, np.float64)[None] + k * np.asarray(offset, np.float64).reshape(1, 1, 3)
