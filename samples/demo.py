@@ -20,6 +20,7 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
 - ``out/demo_node_groups.png``: four objects made by Tessera's node groups alone, each captioned with its modifier
   stack: Suzanne under PN Triangles, a sharp-rimmed cylinder under Phong (Split), a trefoil curve
   under Tubes, a height-map image under Terrain (levels for the camera);
+- ``out/demo_surfaces.png``: the one-point parametric surfaces (``tessera.parametric_surface_add``), wireframe;
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -518,6 +519,32 @@ def _addon_module(name):
     return importlib.import_module(f"bl_ext.tessera_demo.tessera.{name}")
 
 
+def build_surfaces_scene():
+    """The one-point parametric surfaces, baked by ``tessera.parametric_surface_add`` (factor 24, the long trefoil
+    tube 48) with their wireframes: sphere, cone, torus, Steiner's Roman surface, Klein bottle, Möbius band, trefoil
+    tube, superellipsoid. Returns the triangle counts."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    counts = []
+    kinds = ("SPHERE", "CONE", "TORUS", "STEINER", "KLEIN", "MOBIUS", "TREFOIL", "SUPERELLIPSOID")
+    scale = {"KLEIN": 0.42, "STEINER": 2.4, "TORUS": 0.8, "MOBIUS": 1.0, "TREFOIL": 1.5}
+    for i, kind in enumerate(kinds):
+        x, z = -5.4 + 3.6 * (i % 4), 1.4 - 3.0 * (i // 4)
+        bpy.context.scene.cursor.location = (x, 0.0, z)
+        factor = 48 if kind == "TREFOIL" else 24
+        if bpy.ops.tessera.parametric_surface_add(surface=kind, factor=factor) != {"FINISHED"}:
+            sys.exit(f"demo: parametric_surface_add {kind} failed")
+        ob = bpy.context.active_object
+        ob.scale = (scale.get(kind, 1.0),) * 3
+        ob.rotation_euler = (0.5, 0.0, 0.4)
+        ob.data.materials.append(clay)
+        wire_overlay(ob, wire_mat, thickness=0.01)
+        counts.append(len(ob.data.polygons))
+    bpy.context.scene.cursor.location = (0.0, 0.0, 0.0)
+    add_camera((0.0, -17.0, 0.0), (1.5708, 0.0, 0.0), lens=38)
+    return counts
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -572,11 +599,14 @@ def main():
     counts = build_node_groups_scene()
     render("demo_node_groups.png")
     print(f"demo: node groups as modifiers (PN, Phong Split, Tubes, Terrain): {counts} faces")
+    counts = build_surfaces_scene()
+    render("demo_surfaces.png")
+    print(f"demo: one-point parametric surfaces: {counts} triangles")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
                  "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
-                 "demo_node_groups.png"):
+                 "demo_node_groups.png", "demo_surfaces.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
