@@ -454,6 +454,14 @@ def point_float_attribute(data, name, count):
     return _get(attr.data, "value", count, np.float32).astype(np.float64)
 
 
+def point_vector_attribute(data, name, count):
+    """A 3-component float POINT attribute (FLOAT_VECTOR) of a mesh as (count, 3) float64, or a clear error."""
+    attr = data.attributes.get(name)
+    if attr is None or attr.domain != "POINT" or attr.data_type != "FLOAT_VECTOR":
+        raise InvalidInputError(f"{data.name!r} has no vector point attribute named {name!r}")
+    return _get(attr.data, "vector", count, np.float32, 3).astype(np.float64)
+
+
 def read_wire_mesh(mesh):
     """Vertex positions (V, 3) float32 and edges (E, 2) int32 of a mesh (its wire, faces ignored)."""
     n_v = len(mesh.vertices)

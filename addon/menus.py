@@ -25,6 +25,7 @@ class TESSERA_MT_add(bpy.types.Menu):
     def draw(self, context):
         self.layout.operator_context = "INVOKE_REGION_WIN"
         self.layout.operator("tessera.parametric_surface_add", icon="SURFACE_NSURFACE")
+        self.layout.operator("tessera.vector_field_texture", icon="FORCE_VORTEX")
 
 
 def _draw_add_menu(self, context):

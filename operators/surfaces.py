@@ -1,24 +1,29 @@
 """``tessera.parametric_surface_add``: a one-point parametric surface (seed 000 §2.3) baked into a mesh at the 3D
 cursor: welded where it closes, with its domain coordinates as UVs. ``tessera.curve_adaptive``: a curve's Bézier
-splines as polylines sampled where they bend (digest 001 §5.5.2)."""
+splines as polylines sampled where they bend (digest 001 §5.5.2). ``tessera.vector_field_texture``: a steady
+field's line-integral-convolution image (digest 001 §5.5.4)."""
 
 import bpy
 import numpy as np
 
 from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
+from ..addon.gpu_context import ensure_gpu_context
 from ..addon.guarded import guarded
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
+    FieldOptions,
     SurfaceOptions,
     curve_sampling,
     draw_curve_options,
+    draw_field_options,
     draw_surface_options,
     surface_from,
 )
-from ..kernels.common.errors import InvalidInputError
+from ..kernels.common.errors import GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.surfaces import vector_field as vf
 from ..kernels.surfaces.adaptive_curves import adaptive_spline
 from ..kernels.surfaces.domain_mesh import surface_mesh
 from .selection import select_only
@@ -119,5 +124,71 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_curve_adaptive)
+class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
+    """Render a steady vector field (a preset, or vectors on a grid mesh) as a line-integral-convolution image for
+    materials: noise advected along the field, denser when the camera is near"""
+
+    bl_idname = "tessera.vector_field_texture"
+    bl_label = "Vector Field Texture"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def draw(self, context):
+        draw_field_options(self.layout, self)
+
+    def _field(self, context):
+        if self.field != "MESH":
+            return vf.AnalyticField(self.field, slice_z=self.slice_z, speed=self.speed)
+        ob = bpy.data.objects.get(self.field_object) or context.active_object
+        if ob is None or ob.type != "MESH":
+            raise InvalidInputError("Choose a grid mesh object holding the field (Grid Object), or make one active")
+        n = len(ob.data.vertices)
+        positions, _ = bridge.read_wire_mesh(ob.data)
+        vectors = bridge.point_vector_attribute(ob.data, self.attribute, n) * self.speed
+        return vf.grid_field_from_points(positions, vectors)
+
+    def _camera_distance(self, context):
+        cam, ob = context.scene.camera, context.active_object
+        if cam is None:
+            return self.far  # no camera: the sparsest lattice
+        target = ob.matrix_world.translation if ob is not None else (0.0, 0.0, 0.0)
+        return float((cam.matrix_world.translation - target).length)
+
+    @guarded
+    def execute(self, context, tx):
+        if self.near >= self.far:
+            raise InvalidInputError(f"Near ({self.near:g}) must be less than Far ({self.far:g})")
+        field = self._field(context)
+        per_side = vf.seeds_per_side(self.seeds, self._camera_distance(context), self.near, self.far)
+        points, values = vf.seed_points(per_side, self.noise_seed)
+        backend = self.backend
+        if backend != "CPU":
+            try:
+                ensure_gpu_context()
+                backend = "GPU"
+            except GPUContextError as err:
+                if backend == "GPU":
+                    raise
+                self.report({"INFO"}, f"{err}; using numpy")
+                backend = "CPU"
+        if backend == "GPU":
+            from ..gpu_shaders.surfaces.lic import lic_on_gpu
+
+            total, count = lic_on_gpu(field, points, values, self.width, self.height, self.step, self.steps)
+        else:
+            total, count = vf.splat(vf.advect(points, field, self.step, self.steps), values, self.width,
+                                    self.height)
+        grey = np.where(count > 0, total / np.maximum(count, 1), 0.5).astype(np.float32)
+        if not np.all(np.isfinite(grey)):
+            raise InvalidInputError("The field gave points that are not finite numbers: lower the Step or Speed")
+        image = tx.track(bpy.data.images.new("Vector Field", self.width, self.height, float_buffer=True,
+                                             is_data=True))
+        rgba = np.ones((self.height, self.width, 4), np.float32)
+        rgba[..., :3] = grey[..., None]
+        bridge.write_image_pixels(image, rgba)
+        image.pack()
+        self.report({"INFO"}, f"{image.name}: {per_side}² seeds x {self.steps} steps on the {backend}")
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_curve_adaptive, TESSERA_OT_vector_field_texture)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -123,3 +123,55 @@ def draw_curve_options(layout, options):
     col.prop(options, "copies")
     if options.copies > 1:
         col.prop(options, "copy_offset")
+
+
+FIELD_ITEMS = (
+    ("ABC", "ABC Flow", "The Arnold-Beltrami-Childress flow on a slice of its periodic cube"),
+    ("VORTEX", "Vortex", "A smooth vortex round the centre"),
+    ("MESH", "Grid Mesh", "Vectors of a point attribute on a grid mesh object (its x and y, over its area)"),
+)
+BACKEND_ITEMS = (
+    ("AUTO", "Auto", "The GPU where a GPU context can be made (a compute shader), else numpy"),
+    ("GPU", "GPU", "Blender's GPU module: advection by compute shader, additive point splats"),
+    ("CPU", "CPU", "The numpy reference"),
+)
+
+
+class FieldOptions:
+    """The options of ``tessera.vector_field_texture``."""
+
+    field: bpy.props.EnumProperty(name="Field", items=FIELD_ITEMS, default="ABC")
+    field_object: bpy.props.StringProperty(name="Grid Object", description="Mesh object whose grid holds the field")
+    attribute: bpy.props.StringProperty(name="Attribute", default="velocity",
+                                        description="Vector point attribute of the grid holding the field")
+    slice_z: bpy.props.FloatProperty(name="Slice", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                     description="z of the ABC flow's slice (radians of its 2π-periodic cube)")
+    speed: bpy.props.FloatProperty(name="Speed", default=1.0, min=-1e6, max=1e6, description="Velocity factor")
+    width: bpy.props.IntProperty(name="Width", default=512, min=8, max=8192)
+    height: bpy.props.IntProperty(name="Height", default=512, min=8, max=8192)
+    seeds: bpy.props.IntProperty(name="Seeds", default=128, min=1, max=4096,
+                                 description="Seed points per side when the camera is far (up to 4 times more near)")
+    near: bpy.props.FloatProperty(name="Near", default=2.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE",
+                                  description="Camera distance at and below which the seeds are densest")
+    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE",
+                                 description="Camera distance at and beyond which the seeds are sparsest")
+    step: bpy.props.FloatProperty(name="Step", default=0.002, min=1e-6, max=1.0,
+                                  description="Euler step h (domain units: the texture is 1 across)")
+    steps: bpy.props.IntProperty(name="Steps", default=40, min=1, max=10000, description="Euler steps per seed")
+    noise_seed: bpy.props.IntProperty(name="Noise Seed", default=0, min=0, max=2**31 - 1)
+    backend: bpy.props.EnumProperty(name="Evaluate On", items=BACKEND_ITEMS, default="AUTO")
+
+
+def draw_field_options(layout, options):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(options, "field")
+    if options.field == "MESH":
+        col.prop_search(options, "field_object", bpy.data, "objects")
+        col.prop(options, "attribute")
+    elif options.field == "ABC":
+        col.prop(options, "slice_z")
+    col.prop(options, "speed")
+    for name in ("width", "height", "seeds", "near", "far", "step", "steps", "noise_seed", "backend"):
+        col.prop(options, name)

@@ -292,7 +292,7 @@ def _setup_for(bpy, name, tmp_path):
     if name == "terrain_add":
         _height_image(bpy)
         return {"source": "IMAGE", "image_name": "hm"}
-    if name == "parametric_surface_add":  # needs nothing selected
+    if name in ("parametric_surface_add", "vector_field_texture"):  # need nothing selected
         return {}
     if name == "curve_adaptive":
         bpy.ops.curve.primitive_bezier_curve_add()
