@@ -21,6 +21,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   stack: Suzanne under PN Triangles, a sharp-rimmed cylinder under Phong (Split), a trefoil curve
   under Tubes, a height-map image under Terrain (levels for the camera);
 - ``out/demo_surfaces.png``: the one-point parametric surfaces (``tessera.parametric_surface_add``), wireframe;
+- ``out/demo_lic.png``: line-integral-convolution textures of the ABC flow and a vortex
+  (``tessera.vector_field_texture``);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -545,6 +547,31 @@ def build_surfaces_scene():
     return counts
 
 
+def build_lic_picture(name="demo_lic.png"):
+    """``tessera.vector_field_texture`` for the ABC flow and a vortex (512², GPU where a context can be made), side
+    by side in one PNG. Returns (seconds, backend report)."""
+    import OpenImageIO as oiio
+
+    halves = []
+    t0 = time.perf_counter()
+    for field in ("ABC", "VORTEX"):
+        before = set(bpy.data.images)
+        if bpy.ops.tessera.vector_field_texture(field=field, width=512, height=512, seeds=160, steps=60,
+                                                step=0.0015, slice_z=0.6) != {"FINISHED"}:
+            sys.exit(f"demo: vector_field_texture {field} failed")
+        [image] = set(bpy.data.images) - before
+        px = np.empty(512 * 512 * 4, np.float32)
+        image.pixels.foreach_get(px)
+        halves.append(px.reshape(512, 512, 4)[::-1, :, 0])
+    seconds = time.perf_counter() - t0
+    both = np.concatenate([halves[0], np.ones((512, 8)), halves[1]], axis=1)
+    out = oiio.ImageOutput.create(str(OUT / name))
+    out.open(str(OUT / name), oiio.ImageSpec(both.shape[1], 512, 1, "uint8"))
+    out.write_image(np.ascontiguousarray(np.round(np.clip(both, 0, 1) * 255).astype(np.uint8))[..., None])
+    out.close()
+    return seconds
+
+
 def export(tess):
     for ob in bpy.context.scene.objects:
         ob.select_set(ob is tess)
@@ -602,11 +629,13 @@ def main():
     counts = build_surfaces_scene()
     render("demo_surfaces.png")
     print(f"demo: one-point parametric surfaces: {counts} triangles")
+    seconds = build_lic_picture()
+    print(f"demo: vector-field textures (ABC flow, vortex) in {seconds:.1f} s")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
                  "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
-                 "demo_node_groups.png", "demo_surfaces.png"):
+                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")

@@ -3,8 +3,8 @@
 A steady 2-D field over the unit square (an analytic preset, or vectors sampled on a W x H grid) is drawn by
 advecting seed points laid on a regular lattice: every point carries a noise value, moves by explicit Euler
 (x ← x + h f(x), eq. 5.1) for a number of steps, and splats its value into the pixel it is in after each step; the
-image is the mean of the values splatted into each pixel, so streaks follow the streamlines. The seed lattice is
-denser when the camera is nearer (the seed's distance metric per point, a linear map between Near and Far).
+image is the mean of the values splatted into each pixel, so streaks follow the streamlines. The seed lattice (one
+jittered seed per cell) is denser when the camera is nearer (the seed's distance metric per point, a linear map between Near and Far).
 
 `advect` and `splat` are the numpy reference of the GPU path (`gpu_shaders.surfaces.lic`: a compute shader steps
 the points, ping-pong, and additive point drawing accumulates), and `lic_image` puts them together.
@@ -89,14 +89,16 @@ def seeds_per_side(base, distance, near, far, max_factor=4.0):
 
 
 def seed_points(per_side, seed=0):
-    """A per_side² lattice of cell centres with a noise value each: points (N, 2) float32, values (N,) float32 in
-    [0, 1) (white noise from ``seed``)."""
+    """A per_side² lattice of cells with one seed in each, jittered inside its cell (a bare lattice lines up with
+    the pixels and bands), and a noise value each: points (N, 2) float32, values (N,) float32 in [0, 1) (white
+    noise). Both from ``seed``."""
     if per_side < 1:
         raise InvalidInputError("The seed lattice needs at least one point per side")
-    c = (np.arange(per_side) + 0.5) / per_side
-    x, y = np.meshgrid(c, c)
-    points = np.stack([x.ravel(), y.ravel()], 1).astype(np.float32)
-    return points, np.random.default_rng(seed).random(len(points)).astype(np.float32)
+    rng = np.random.default_rng(seed)
+    i, j = np.meshgrid(np.arange(per_side), np.arange(per_side))
+    cells = np.stack([i.ravel(), j.ravel()], 1)
+    points = ((cells + rng.random(cells.shape)) / per_side).astype(np.float32)
+    return points, rng.random(len(points)).astype(np.float32)
 
 
 def advect(points, field, step, steps):
