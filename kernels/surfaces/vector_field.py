@@ -4,7 +4,8 @@ A steady 2-D field over the unit square (an analytic preset, or vectors sampled 
 advecting seed points laid on a regular lattice: every point carries a noise value, moves by explicit Euler
 (x ← x + h f(x), eq. 5.1) for a number of steps, and splats its value into the pixel it is in after each step; the
 image is the mean of the values splatted into each pixel, so streaks follow the streamlines. The seed lattice (one
-jittered seed per cell) is denser when the camera is nearer (the seed's distance metric per point, a linear map between Near and Far).
+jittered seed per cell) is denser when the camera is nearer (the seed's distance metric per point, a linear map
+between Near and Far).
 
 `advect` and `splat` are the numpy reference of the GPU path (`gpu_shaders.surfaces.lic`: a compute shader steps
 the points, ping-pong, and additive point drawing accumulates), and `lic_image` puts them together.
