@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .curvature import curvature_level, curve_kappa
 from .errors import InvalidInputError
+from .level_metrics import curvature_level, curve_kappa
 
 #: The curvature metric's cap on segments (eq. 4.5's t_tessmax) and its gain (one point per tenth of height).
 MAX_SEGMENTS = 32

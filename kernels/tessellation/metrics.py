@@ -12,39 +12,20 @@ and per-face-side ``(T, 3)`` inputs (the latter is how a GPU patch sees them; te
 
 import numpy as np
 
-from ..common.curvature import curvature_level, curve_kappa  # noqa: F401 (eqs. 4.4 / 4.5, part of the metrics)
 from ..common.errors import InvalidInputError
+from ..common.level_metrics import (  # noqa: F401 (eqs. 4.1-4.5, part of the metrics)
+    DISTANCE_MAPS,
+    curvature_level,
+    curve_kappa,
+    distance_level,
+)
 from ..common.partition import MAX_LEVEL
 
-DISTANCE_MAPS = ("LINEAR", "INVERSE")
 POWER_OF_TWO = ("NONE", "CEIL", "FLOOR", "NEAREST")
 
 
 def _dot(a, b):
     return np.einsum("...i,...i->...", a, b)
-
-
-def distance_level(d, d_min, d_max, t_max, mapping="LINEAR"):
-    """Camera-distance level (Eqs. 4.1-4.3), clamped to ``[1, t_max]``.
-
-    d: (...) distances. ``LINEAR``: ``t_max`` at ``d_min`` falling linearly to 1 at ``d_max``. ``INVERSE``:
-    the z-buffer-like ``A/d + B`` through the same two points (more levels near the camera).
-    """
-    if not d_max > d_min > 0 and mapping == "INVERSE":
-        raise InvalidInputError("The inverse distance map needs 0 < near distance < far distance")
-    if not d_max > d_min:
-        raise InvalidInputError("The far distance must be larger than the near distance")
-    d = np.asarray(d, dtype=np.float64)
-    if mapping == "LINEAR":
-        t = 1.0 + (t_max - 1.0) * (d_max - d) / (d_max - d_min)
-    elif mapping == "INVERSE":
-        a = (t_max - 1.0) * d_max * d_min / (d_max - d_min)
-        b = (d_max - t_max * d_min) / (d_max - d_min)
-        with np.errstate(divide="ignore"):
-            t = np.where(d > 0, a / np.maximum(d, np.finfo(np.float64).tiny) + b, t_max)
-    else:
-        raise InvalidInputError(f"Unknown distance map {mapping!r}; expected one of {', '.join(DISTANCE_MAPS)}")
-    return np.clip(t, 1.0, t_max)
 
 
 def edge_midpoints(a, b):

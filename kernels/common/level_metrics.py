@@ -1,0 +1,59 @@
+"""Level metrics every capability shares (digest 001 §4): the camera-distance map (eqs. 4.1-4.3) and the
+curvature of control polygons (§4.3, eqs. 4.4 and 4.5; scale-invariant: scaling a control polygon leaves its κ⁺
+unchanged). Used by the curved triangle patches (`kernels.tessellation.adaptive`), the adaptive curves and the
+Bézier surface patches."""
+
+import numpy as np
+
+from .errors import InvalidInputError
+
+DISTANCE_MAPS = ("LINEAR", "INVERSE")
+
+
+def _dot(a, b):
+    return np.einsum("...i,...i->...", a, b)
+
+
+def curve_kappa(control):
+    """Eq. 4.4: the largest ``|p_i - (p_{i-1} + p_{i+1}) / 2| / |p_{i+1} - p_{i-1}|`` over interior points.
+
+    control: (..., n, d) control polygons, n >= 3. Degenerate chords (zero denominator) count as the
+    cap (``inf``) when the numerator is non-zero, 0 otherwise (digest 001 §10 item 5). Returns (...).
+    """
+    c = np.asarray(control, np.float64)
+    if c.shape[-2] < 3:
+        return np.zeros(c.shape[:-2])
+    num = c[..., 1:-1, :] - 0.5 * (c[..., :-2, :] + c[..., 2:, :])
+    den = c[..., 2:, :] - c[..., :-2, :]
+    num, den = np.sqrt(_dot(num, num)), np.sqrt(_dot(den, den))
+    kappa = np.divide(num, den, out=np.where(num > 0, np.inf, 0.0), where=den > 0)
+    return kappa.max(axis=-1)
+
+
+def curvature_level(kappa, n_control=4, gain=10.0, t_max=32.0, minimum=None):
+    """Eq. 4.5: ``max(minimum, min(t_max, gain * kappa))``; ``minimum`` defaults to ``2 (n - 1)``."""
+    low = 2.0 * (n_control - 1) if minimum is None else float(minimum)
+    return np.maximum(low, np.minimum(t_max, gain * np.asarray(kappa, np.float64)))
+
+
+def distance_level(d, d_min, d_max, t_max, mapping="LINEAR"):
+    """Camera-distance level (Eqs. 4.1-4.3), clamped to ``[1, t_max]``.
+
+    d: (...) distances. ``LINEAR``: ``t_max`` at ``d_min`` falling linearly to 1 at ``d_max``. ``INVERSE``:
+    the z-buffer-like ``A/d + B`` through the same two points (more levels near the camera).
+    """
+    if not d_max > d_min > 0 and mapping == "INVERSE":
+        raise InvalidInputError("The inverse distance map needs 0 < near distance < far distance")
+    if not d_max > d_min:
+        raise InvalidInputError("The far distance must be larger than the near distance")
+    d = np.asarray(d, dtype=np.float64)
+    if mapping == "LINEAR":
+        t = 1.0 + (t_max - 1.0) * (d_max - d) / (d_max - d_min)
+    elif mapping == "INVERSE":
+        a = (t_max - 1.0) * d_max * d_min / (d_max - d_min)
+        b = (d_max - t_max * d_min) / (d_max - d_min)
+        with np.errstate(divide="ignore"):
+            t = np.where(d > 0, a / np.maximum(d, np.finfo(np.float64).tiny) + b, t_max)
+    else:
+        raise InvalidInputError(f"Unknown distance map {mapping!r}; expected one of {', '.join(DISTANCE_MAPS)}")
+    return np.clip(t, 1.0, t_max)
