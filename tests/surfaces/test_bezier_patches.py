@@ -4,7 +4,6 @@ highest at the knob and the base, distance levels high near and low far."""
 
 import numpy as np
 import pytest
-
 from tessera.kernels.common import camera
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.surfaces import bezier_patches as bp
