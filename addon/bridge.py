@@ -404,6 +404,38 @@ def read_splines(curve):
     return out
 
 
+def read_surface_patches(curve):
+    """The bicubic Bézier patches of a SURFACE curve's splines, in object space: ``(patches (P, 4, 4, 3) float64,
+    skipped)``, skipped naming each spline that is not piecewise bicubic Bézier (order 4, not cyclic, unit
+    weights, 4 points with endpoint or Bézier knots or 3k + 1 with Bézier knots, in both directions). Points are
+    stored u fastest: net[i, j] = point j * count_u + i."""
+    patches, skipped = [], []
+    for k, s in enumerate(curve.splines):
+        nu, nv = s.point_count_u, s.point_count_v
+        co = _get(s.points, "co", len(s.points), np.float32, 4).astype(np.float64)
+
+        def bezier(count, endpoint, bez):
+            return (count == 4 and (endpoint or bez)) or (bez and count > 4 and (count - 1) % 3 == 0)
+
+        why = None
+        if s.type != "NURBS" or s.order_u != 4 or s.order_v != 4:
+            why = f"order {s.order_u} x {s.order_v} (bicubic needs 4 x 4)"
+        elif s.use_cyclic_u or s.use_cyclic_v:
+            why = "cyclic"
+        elif not np.allclose(co[:, 3], 1.0):
+            why = "rational (weights other than 1)"
+        elif not (bezier(nu, s.use_endpoint_u, s.use_bezier_u) and bezier(nv, s.use_endpoint_v, s.use_bezier_v)):
+            why = f"{nu} x {nv} points without Bézier knots (turn on Bezier, or Endpoint for 4 x 4)"
+        if why:
+            skipped.append(f"spline {k}: {why}")
+            continue
+        net = co[:, :3].reshape(nv, nu, 3).transpose(1, 0, 2)  # net[i (u), j (v)]
+        for a in range(0, nu - 1, 3):
+            for b in range(0, nv - 1, 3):
+                patches.append(net[a:a + 4, b:b + 4])
+    return (np.array(patches) if patches else np.zeros((0, 4, 4, 3))), skipped
+
+
 def write_poly_curve(name, splines, dimensions="3D"):
     """A new `bpy.types.Curve` of POLY splines from `SplineArrays` (their co, radius, tilt, cyclic and material;
     handles ignored). Removed again if anything fails."""

@@ -16,6 +16,7 @@ class TESSERA_MT_object(bpy.types.Menu):
         self.layout.operator("tessera.terrain_add", icon="RNDCURVE")
         self.layout.operator("tessera.terrain_bake", icon="VIEW_CAMERA")
         self.layout.operator("tessera.curve_adaptive", icon="CURVE_BEZCURVE")
+        self.layout.operator("tessera.surface_tessellate", icon="SURFACE_NSURFACE")
 
 
 class TESSERA_MT_add(bpy.types.Menu):

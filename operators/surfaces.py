@@ -14,15 +14,19 @@ from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
     FieldOptions,
+    PatchOptions,
     SurfaceOptions,
     curve_sampling,
     draw_curve_options,
     draw_field_options,
+    draw_patch_options,
     draw_surface_options,
+    patch_lod,
     surface_from,
 )
 from ..kernels.common.errors import GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
+from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
 from ..kernels.surfaces.adaptive_curves import adaptive_spline
 from ..kernels.surfaces.domain_mesh import surface_mesh
@@ -190,5 +194,57 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_curve_adaptive, TESSERA_OT_vector_field_texture)
+class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
+    """Turn the active surface object's bicubic Bézier patches into a mesh with levels per patch side from their
+    curvature or the camera: shared sides get one level, so the mesh is welded with no crack"""
+
+    bl_idname = "tessera.surface_tessellate"
+    bl_label = "Tessellate Surface"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if context.mode != "OBJECT" or ob is None or ob.type != "SURFACE":
+            cls.poll_message_set("Select a surface object (NURBS surface patches) in Object Mode")
+            return False
+        return True
+
+    def draw(self, context):
+        draw_patch_options(self.layout, self)
+
+    @guarded
+    def execute(self, context, tx):
+        ob = context.active_object
+        patches, skipped = bridge.read_surface_patches(ob.data)
+        if len(patches) == 0:
+            raise InvalidInputError(f"Surface {ob.name!r} has no bicubic Bézier patch"
+                                    + (": " + "; ".join(skipped) if skipped else ""))
+        lod = patch_lod(self)
+        eye = None
+        if lod.mode != "CURVATURE":
+            cam = object_camera(camera_for(context, self.camera_source, "Distance levels"), ob.matrix_world)
+            eye = cam.eye
+        edges = bp.patch_edges(patches)
+        edge_levels, inner = bp.patch_levels(patches, edges, lod, eye)
+        mesh = bp.tessellate_patches(patches, edge_levels, inner, edges)
+        arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles,
+                            corner_attributes={"UVMap": mesh.corner_uv}, attribute_types={"UVMap": "FLOAT2"})
+        data = tx.track(bridge.write_mesh(f"{ob.data.name}.tessellated", arrays))
+        data.shade_smooth()
+        for mat in ob.data.materials:
+            data.materials.append(mat)
+        new = tx.new_object(f"{ob.name}.tessellated", data)
+        new.matrix_world = ob.matrix_world.copy()
+        context.collection.objects.link(new)
+        select_only(context, [new])
+        note = f"; {len(skipped)} spline(s) left out: " + "; ".join(skipped) if skipped else ""
+        self.report({"WARNING" if skipped else "INFO"},
+                    f"{len(patches)} patches, sides {int(edge_levels.min())}-{int(edge_levels.max())} segments, "
+                    f"{len(mesh.triangles):,} triangles{note}")
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_curve_adaptive, TESSERA_OT_vector_field_texture,
+           TESSERA_OT_surface_tessellate)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -13,6 +13,7 @@ import bpy
 
 from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.surfaces.adaptive_curves import CurveSampling
+from ...kernels.surfaces.bezier_patches import PatchLod
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
 from ...kernels.surfaces.parametric import SURFACES
 from ..cameras import CAMERA_ITEMS
@@ -175,3 +176,50 @@ def draw_field_options(layout, options):
     col.prop(options, "speed")
     for name in ("width", "height", "seeds", "near", "far", "step", "steps", "noise_seed", "backend"):
         col.prop(options, name)
+
+
+PATCH_MODE_ITEMS = (
+    ("CURVATURE", "Curvature", "Levels from the control nets' curvature (seed eq. 4.5 on rows, columns, diagonals)"),
+    ("DISTANCE", "Distance", "Levels from the camera distance: sides from their nearest control point, the inside "
+                             "from the net's centroid"),
+    ("BOTH", "Both", "The larger of the two"),
+)
+
+
+class PatchOptions:
+    """The options of ``tessera.surface_tessellate`` (`kernels.surfaces.bezier_patches.PatchLod`)."""
+
+    mode: bpy.props.EnumProperty(name="Levels", items=PATCH_MODE_ITEMS, default="CURVATURE")
+    max_level: bpy.props.IntProperty(name="Max Level", default=32, min=1, max=64,
+                                     description="Most segments on a side or inside (the seed's 32)")
+    inner_rows: bpy.props.EnumProperty(name="Inner Curvature", default="ALL", items=(
+        ("ALL", "All Rows", "Every row and column of the net (seed §4.1.2)"),
+        ("INTERIOR", "Interior Rows", "Only the net's two inner rows and columns (seed §5.3.3)")))
+    degenerate: bpy.props.EnumProperty(name="Collapsed Rows", default="CAP", items=(
+        ("CAP", "Cap", "A row of the net that is one point counts as the most curved (the seed's behaviour)"),
+        ("ZERO", "Flat", "Such a row counts as straight")))
+    near: bpy.props.FloatProperty(name="Near", default=1.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE")
+    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE")
+    mapping: bpy.props.EnumProperty(name="Distance Map", default="LINEAR", items=(
+        ("LINEAR", "Linear", "Max Level at Near, falling linearly to 1 at Far"),
+        ("INVERSE", "Inverse", "Like a z-buffer: more levels near the camera")))
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+
+
+def patch_lod(options):
+    return PatchLod(mode=options.mode, max_level=options.max_level, inner_rows=options.inner_rows,
+                    near=options.near, far=options.far, mapping=options.mapping, degenerate=options.degenerate)
+
+
+def draw_patch_options(layout, options):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(options, "mode")
+    col.prop(options, "max_level")
+    if options.mode != "DISTANCE":
+        col.prop(options, "inner_rows")
+        col.prop(options, "degenerate")
+    if options.mode != "CURVATURE":
+        for name in ("near", "far", "mapping", "camera_source"):
+            col.prop(options, name)

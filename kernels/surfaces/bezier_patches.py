@@ -29,7 +29,7 @@ import numpy as np
 
 from ..common.errors import InvalidInputError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level
-from ..common.quad_pattern import pattern
+from ..common.quad_pattern import pattern, pattern_codes
 
 MODES = ("CURVATURE", "DISTANCE", "BOTH")
 MAX_LEVEL = 64
@@ -81,12 +81,15 @@ class PatchEdges:
 @dataclass
 class PatchMesh:
     """positions (V, 3) float32; triangles (T, 3) int32 (counter-clockwise in each patch's (u, v)); uv (V, 2)
-    float32 and patch (V,) int64: where each vertex was evaluated (a shared vertex: its first patch)."""
+    float32 and patch (V,) int64: where each vertex was evaluated (a shared vertex: its first patch);
+    triangle_patch (T,) int64 and corner_uv (T, 3, 2) float32: each triangle's patch and its corners' (u, v) in it."""
 
     positions: np.ndarray
     triangles: np.ndarray
     uv: np.ndarray
     patch: np.ndarray
+    triangle_patch: np.ndarray
+    corner_uv: np.ndarray
 
 
 def bernstein(t):
@@ -221,7 +224,7 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side_uv, np.stack([iu, iv], 1)])
     patch = np.concatenate([np.repeat(np.arange(n_p), 4), fp[e_of], p_of])
 
-    tris = []
+    tris, tri_patch, tri_uv = [], [], []
     keys = np.concatenate([side_counts, n_in[:, None]], axis=1)
     classes, inverse = np.unique(keys, axis=0, return_inverse=True)
     for cls, key in enumerate(classes):
@@ -237,7 +240,10 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
         cols += [base_i + in_first[ps] + q for q in range(mloc * mloc)]
         lmap = np.stack(cols, 1)
         tris.append(lmap[:, tmpl].reshape(-1, 3))
-    tris = np.concatenate(tris)
+        tri_patch.append(np.repeat(ps, len(tmpl)))
+        local_uv = _pattern_uv(pattern_codes(*(int(x) for x in key)), key)
+        tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
+    tris, tri_patch, tri_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(tri_uv)
     # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
     # of corners and side points (inner points are never merged)
     shared = n_c + len(edge_pts)
@@ -245,9 +251,21 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     remap = np.concatenate([first[inv.ravel()], np.arange(shared, len(positions))])
     tris = remap[tris]
     keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
-    tris = tris[keep]
+    tris, tri_patch, tri_uv = tris[keep], tri_patch[keep], tri_uv[keep]
     used = np.zeros(len(positions), bool)
     used[tris.ravel()] = True
     new_id = np.cumsum(used) - 1
     return PatchMesh(positions[used].astype(np.float32), new_id[tris].astype(np.int32),
-                     uv[used].astype(np.float32), patch[used])
+                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv.astype(np.float32))
+
+
+def _pattern_uv(codes, key):
+    """(u, v) of each local vertex of a pattern from `pattern_codes` rows (kind, a, b) and the class key
+    (c0, c1, c2, c3, n): corners, side points k / c in each side's direction, inner (i / n, j / n)."""
+    kind, a, b = codes[:, 0].astype(int), codes[:, 1].astype(np.float64), codes[:, 2].astype(np.float64)
+    c = np.asarray(key[:4], np.float64)
+    n = float(key[4])
+    t = np.divide(a, c[np.clip(kind - 1, 0, 3)])
+    u = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4], [a, t, 1.0, t, 0.0], a / n)
+    v = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4], [b, 0.0, t, 1.0, t], b / n)
+    return np.stack([u, v], 1)

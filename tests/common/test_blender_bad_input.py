@@ -297,6 +297,11 @@ def _setup_for(bpy, name, tmp_path):
     if name == "curve_adaptive":
         bpy.ops.curve.primitive_bezier_curve_add()
         return {}
+    if name == "surface_tessellate":
+        bpy.ops.surface.primitive_nurbs_surface_surface_add()
+        bpy.context.active_object.data.splines[0].use_endpoint_u = True
+        bpy.context.active_object.data.splines[0].use_endpoint_v = True
+        return {}
     if name == "displacement_export":
         bpy.ops.mesh.primitive_plane_add()
         assert bpy.ops.tessera.displacement_add(width=16, height=16) == {"FINISHED"}

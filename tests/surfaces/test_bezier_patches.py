@@ -30,6 +30,9 @@ def check_mesh(patches, edges, edge_levels, inner, mesh):
     assert int((counts == 1).sum()) == open_boundary_levels(patches, edges, edge_levels)  # no crack anywhere else
     on = bp.evaluate(patches[mesh.patch], mesh.uv[:, None, 0].astype(np.float64), mesh.uv[:, None, 1])[:, 0]
     assert np.abs(on - mesh.positions).max() < 1e-5  # every vertex on its patch
+    corner = bp.evaluate(patches[mesh.triangle_patch], mesh.corner_uv[..., 0].astype(np.float64),
+                         mesh.corner_uv[..., 1].astype(np.float64))
+    assert np.abs(corner - mesh.positions[mesh.triangles]).max() < 1e-5  # corner UVs: where each corner is
     p = mesh.positions.astype(np.float64)[mesh.triangles]
     area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
     assert (area > 0).all()

@@ -169,3 +169,67 @@ def test_vector_field_from_a_grid_mesh(clean_scene, bpy_module):
                                                 backend="CPU") == {"FINISHED"}
     with pytest.raises(RuntimeError, match="no vector point attribute named 'wind'"):
         bpy.ops.tessera.vector_field_texture(field="MESH", attribute="wind", backend="CPU")
+
+
+def surface_object(bpy, patches):
+    """A SURFACE object with one 4 x 4 NURBS spline (endpoint knots: a Bézier patch) per control net."""
+    obs = []
+    for net in patches:
+        bpy.ops.surface.primitive_nurbs_surface_surface_add()
+        ob = bpy.context.active_object
+        s = ob.data.splines[0]
+        co = np.c_[np.asarray(net, np.float64).transpose(1, 0, 2).reshape(16, 3), np.ones(16)]  # u fastest
+        s.points.foreach_set("co", co.astype(np.float32).ravel())
+        s.use_endpoint_u = s.use_endpoint_v = True
+        ob.location = (0.0, 0.0, 0.0)
+        obs.append(ob)
+    for ob in bpy.context.selected_objects:
+        ob.select_set(False)
+    for ob in obs:
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = obs[0]
+    bpy.ops.object.join()
+    return bpy.context.active_object
+
+
+def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bp = addon_module("kernels.surfaces.bezier_patches")
+    patches, names = addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
+    ob = surface_object(bpy, patches)
+    assert len(ob.data.splines) == 24
+    read, skipped = addon_module("addon.bridge").read_surface_patches(ob.data)
+    assert skipped == [] and np.allclose(read, patches.astype(np.float32))
+    assert bpy.ops.tessera.surface_tessellate(mode="CURVATURE") == {"FINISHED"}
+    out = bpy.context.active_object
+    edges = bp.patch_edges(read)
+    el, inner = bp.patch_levels(read, edges, bp.PatchLod())
+    want = bp.tessellate_patches(read, el, inner, edges)
+    pos, tris, uv, corner_edges = mesh_arrays(out.data)
+    assert np.array_equal(pos, want.positions) and np.array_equal(tris, want.triangles)
+    assert np.allclose(uv, want.corner_uv)
+    uses = np.bincount(corner_edges, minlength=len(out.data.edges))
+    assert uses.max() == 2  # welded: only the rim's and the lid's open circles are boundary
+    assert (uses == 1).sum() == sum(int(el[e]) for e in range(len(edges.control))
+                                    if np.allclose(edges.control[e, :, 2], 2.4)
+                                    and np.isclose(np.hypot(*edges.control[e, 0, :2]), (1.3, 1.4)).any())
+    # distance levels for the scene camera: near -> finer than far
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    bpy.context.scene.camera = cam
+    counts = []
+    for y in (-3.0, -60.0):
+        cam.location = (0.0, y, 1.5)
+        bpy.context.view_layer.objects.active = ob
+        assert bpy.ops.tessera.surface_tessellate(mode="DISTANCE", near=2.0, far=50.0) == {"FINISHED"}
+        counts.append(len(bpy.context.active_object.data.polygons))
+    assert counts[0] > 4 * counts[1]
+
+
+def test_tessellate_surface_refuses_what_is_not_bicubic_bezier(clean_scene, bpy_module):
+    bpy = bpy_module
+    bpy.ops.surface.primitive_nurbs_surface_surface_add()  # 4 x 4 but uniform knots: a B-spline, not a Bézier patch
+    before = len(bpy.data.objects), len(bpy.data.meshes)
+    with pytest.raises(RuntimeError, match="without Bézier knots"):
+        bpy.ops.tessera.surface_tessellate()
+    assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
