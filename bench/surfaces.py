@@ -17,6 +17,10 @@ Per N: bytes (Table 2.2's accounting, and measured), frame time (draw + a one-pi
 is included; ``mesh_upload_draw_ms`` adds building the buffer and its upload, what a changed surface costs), and
 their ratios. On a CPU-only machine the renderer is Mesa llvmpipe, a software rasteriser: absolute times are not
 a GPU's; the device tool runs the same on a real GPU where one is lent.
+- ``teapot``: *Tessellate Surface* (``tessera.surface_tessellate``, curvature levels) on the teapot's body of
+  revolution (24 bicubic patches as a surface object) end to end, against Blender's own conversion of the same
+  surface object to a mesh (its evaluation at a resolution giving about the same triangles, copied into a new mesh
+  object), triangles per second.
 Run: .venv/bin/python bench/surfaces.py [--full]   (--full: N up to 20,000; else up to 2,500)
 """
 
@@ -73,6 +77,7 @@ def main():
             fb.read_color(SIZE // 2, SIZE // 2, 1, 1, 4, 0, "UBYTE")
             gpu.state.depth_test_set("NONE")
 
+    run_teapot(bpy, mod)
     counts = COUNTS if "--full" in sys.argv else COUNTS[:6]
     uv, tris = domain_mesh.domain_pattern(FACTOR)
     for n in counts:
@@ -109,6 +114,68 @@ def main():
             del resident
         print(json.dumps(row), flush=True)
     box.free()
+
+
+def teapot_surface(bpy, nets):
+    """A SURFACE object holding ``nets`` (P, 4, 4, 3) as 4 x 4 endpoint-knot NURBS splines (Bézier patches)."""
+    made = []
+    for net in nets:
+        bpy.ops.surface.primitive_nurbs_surface_surface_add()
+        spline = bpy.context.active_object.data.splines[0]
+        spline.points.foreach_set("co", np.c_[net.transpose(1, 0, 2).reshape(16, 3), np.ones(16)].ravel())
+        spline.use_endpoint_u = spline.use_endpoint_v = True
+        made.append(bpy.context.active_object)
+    for ob in made:
+        ob.location = (0.0, 0.0, 0.0)
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = made[0]
+    bpy.ops.object.join()
+    return bpy.context.active_object
+
+
+def run_teapot(bpy, mod):
+    nets, _ = mod("kernels.surfaces.revolved_teapot").teapot_patches()
+    surface = teapot_surface(bpy, nets)
+
+    def ours():
+        bpy.context.view_layer.objects.active = surface
+        bpy.ops.tessera.surface_tessellate(mode="CURVATURE")
+        out = bpy.context.active_object
+        n, data = len(out.data.polygons), out.data
+        bpy.data.objects.remove(out)
+        bpy.data.meshes.remove(data)
+        return n
+
+    def blenders():
+        surface.data.update_tag()  # re-evaluate, as a changed surface would
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        depsgraph.update()
+        me = bpy.data.meshes.new_from_object(surface.evaluated_get(depsgraph))
+        ob = bpy.data.objects.new("converted", me)
+        bpy.context.scene.collection.objects.link(ob)
+        n = sum(len(p.vertices) - 2 for p in me.polygons)
+        bpy.data.objects.remove(ob)
+        bpy.data.meshes.remove(me)
+        return n
+
+    n_ours = ours()
+
+    def blender_count(res):
+        surface.data.resolution_u = surface.data.resolution_v = res
+        return blenders()
+
+    # the resolution whose triangle count is nearest ours (Blender's resolution counts per control point)
+    res = min(range(1, 33), key=lambda r: abs(blender_count(r) - n_ours))
+    surface.data.resolution_u = surface.data.resolution_v = res
+
+    n_blender = blenders()
+    t_ours, t_blender = timed(ours, 5), timed(blenders, 5)
+    print(json.dumps({"bench": "surfaces", "case": "teapot_tessellate_surface", "patches": len(nets),
+                      "triangles": n_ours, "seconds": round(t_ours, 4),
+                      "baseline": f"Blender's surface to mesh (resolution {res}), copied into a new object",
+                      "baseline_triangles": n_blender, "baseline_seconds": round(t_blender, 4),
+                      "speedup_per_triangle": round((n_ours / t_ours) / (n_blender / t_blender), 2)}), flush=True)
+    bpy.data.objects.remove(surface)
 
 
 if __name__ == "__main__":

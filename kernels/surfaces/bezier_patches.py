@@ -24,6 +24,7 @@ Levels (`patch_levels`):
 """
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -211,17 +212,23 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     n_in = np.where((n_in == 1) & ~strip, 2, n_in)
     m = n_in - 1
     in_first = np.concatenate([[0], np.cumsum(m * m)])[:-1]
+    inner_pts = np.empty((int((m * m).sum()), 3))
+    inner_uv = np.empty((len(inner_pts), 2))
     p_of = np.repeat(np.arange(n_p), m * m)
-    local = np.arange(len(p_of)) - in_first[p_of]
-    mm = np.maximum(m[p_of], 1)
-    iu = (local % mm + 1) / n_in[p_of]
-    iv = (local // mm + 1) / n_in[p_of]
-    inner_pts = np.einsum("nk,nl,nklc->nc", bernstein(iu), bernstein(iv), c[p_of])
+    for n in np.unique(n_in[m > 0]):  # one tensor product per inner count: rows j, columns i, as the pattern
+        ps = np.flatnonzero(n_in == n)
+        t_in = np.arange(1, n) / n
+        b_in = bernstein(t_in)
+        grid = np.einsum("ik,jl,pklc->pjic", b_in, b_in, c[ps], optimize=True).reshape(len(ps), -1, 3)
+        rows = in_first[ps][:, None] + np.arange((n - 1) ** 2)[None]
+        inner_pts[rows] = grid
+        jj, ii = np.divmod(np.arange((n - 1) ** 2), n - 1)
+        inner_uv[rows] = np.stack([t_in[ii], t_in[jj]], 1)[None]
 
     n_c = 4 * n_p
     base_e, base_i = n_c, n_c + len(edge_pts)
     positions = np.concatenate([corners.reshape(-1, 3), edge_pts, inner_pts])
-    uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side_uv, np.stack([iu, iv], 1)])
+    uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side_uv, inner_uv])
     patch = np.concatenate([np.repeat(np.arange(n_p), 4), fp[e_of], p_of])
 
     tris, tri_patch, tri_uv = [], [], []
@@ -230,18 +237,17 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     for cls, key in enumerate(classes):
         ps = np.flatnonzero(inverse.ravel() == cls)
         tmpl = pattern(*(int(x) for x in key))
-        cols = [4 * ps + q for q in range(4)]
-        for s in range(4):
-            e, r = edges.edge[ps, s], edges.reversed[ps, s]
-            cnt = int(key[s]) - 1
-            for q in range(cnt):  # the side's q-th interior point in the patch's direction
-                cols.append(base_e + e_first[e] + np.where(r, cnt - 1 - q, q))
+        cols = [4 * ps[:, None] + np.arange(4)[None]]
+        for side in range(4):
+            e, r = edges.edge[ps, side], edges.reversed[ps, side]
+            q = np.arange(int(key[side]) - 1)[None]  # the side's interior points in the patch's direction
+            cols.append(base_e + e_first[e][:, None] + np.where(r[:, None], q.shape[1] - 1 - q, q))
         mloc = int(key[4]) - 1
-        cols += [base_i + in_first[ps] + q for q in range(mloc * mloc)]
-        lmap = np.stack(cols, 1)
+        cols.append(base_i + in_first[ps][:, None] + np.arange(mloc * mloc)[None])
+        lmap = np.concatenate(cols, 1)
         tris.append(lmap[:, tmpl].reshape(-1, 3))
         tri_patch.append(np.repeat(ps, len(tmpl)))
-        local_uv = _pattern_uv(pattern_codes(*(int(x) for x in key)), key)
+        local_uv = _pattern_uv(tuple(int(x) for x in key))
         tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
     tris, tri_patch, tri_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(tri_uv)
     # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
@@ -259,9 +265,11 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
                      uv[used].astype(np.float32), patch[used], tri_patch, tri_uv.astype(np.float32))
 
 
-def _pattern_uv(codes, key):
-    """(u, v) of each local vertex of a pattern from `pattern_codes` rows (kind, a, b) and the class key
-    (c0, c1, c2, c3, n): corners, side points k / c in each side's direction, inner (i / n, j / n)."""
+@lru_cache(maxsize=4096)
+def _pattern_uv(key):
+    """(u, v) of each local vertex of the pattern of class key (c0, c1, c2, c3, n), from its `pattern_codes`:
+    corners, side points k / c in each side's direction, inner (i / n, j / n)."""
+    codes = pattern_codes(*key)
     kind, a, b = codes[:, 0].astype(int), codes[:, 1].astype(np.float64), codes[:, 2].astype(np.float64)
     c = np.asarray(key[:4], np.float64)
     n = float(key[4])
