@@ -21,6 +21,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   stack: Suzanne under PN Triangles, a sharp-rimmed cylinder under Phong (Split), a trefoil curve
   under Tubes, a height-map image under Terrain (levels for the camera);
 - ``out/demo_surfaces.png``: the one-point parametric surfaces (``tessera.parametric_surface_add``), wireframe;
+- ``out/demo_teapot.png``: the Utah teapot's body of revolution (24 bicubic patches) by ``tessera.surface_tessellate``,
+  curvature levels and distance levels for the camera, wireframe;
 - ``out/demo_lic.png``: line-integral-convolution textures of the ABC flow and a vortex
   (``tessera.vector_field_texture``);
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
@@ -547,6 +549,43 @@ def build_surfaces_scene():
     return counts
 
 
+def build_teapot_scene():
+    """The teapot's body of revolution (24 bicubic patches as a surface object) tessellated by
+    ``tessera.surface_tessellate``: curvature levels (left: the knob and the base finest), and distance levels for
+    the scene camera (right: the near side finer), wireframe on top. Returns the two triangle counts."""
+    clear_scene()
+    clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
+    nets, _ = _addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
+    made = []
+    for net in nets:
+        bpy.ops.surface.primitive_nurbs_surface_surface_add()
+        spline = bpy.context.active_object.data.splines[0]
+        spline.points.foreach_set("co", np.c_[net.transpose(1, 0, 2).reshape(16, 3), np.ones(16)].ravel())
+        spline.use_endpoint_u = spline.use_endpoint_v = True
+        made.append(bpy.context.active_object)
+    for ob in made:
+        ob.location = (0.0, 0.0, 0.0)
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = made[0]
+    bpy.ops.object.join()
+    surface = bpy.context.active_object
+    add_camera((0.0, -13.0, 5.5), (1.27, 0.0, 0.0), lens=35)
+    counts = []
+    for x, kw in ((-2.6, {"mode": "CURVATURE"}), (2.6, {"mode": "DISTANCE", "near": 11.0, "far": 17.0,
+                                                         "max_level": 24})):
+        surface.location = (x, 0.0, 0.0)
+        bpy.context.view_layer.objects.active = surface
+        bpy.context.view_layer.update()
+        if bpy.ops.tessera.surface_tessellate(**kw) != {"FINISHED"}:
+            sys.exit("demo: surface_tessellate failed")
+        ob = bpy.context.active_object
+        ob.data.materials.append(clay)
+        wire_overlay(ob, wire_mat, thickness=0.008)
+        counts.append(len(ob.data.polygons))
+    bpy.data.objects.remove(surface)
+    return counts
+
+
 def build_lic_picture(name="demo_lic.png"):
     """``tessera.vector_field_texture`` for the ABC flow and a vortex (512², GPU where a context can be made), side
     by side in one PNG. Returns (seconds, backend report)."""
@@ -629,13 +668,16 @@ def main():
     counts = build_surfaces_scene()
     render("demo_surfaces.png")
     print(f"demo: one-point parametric surfaces: {counts} triangles")
+    counts = build_teapot_scene()
+    render("demo_teapot.png")
+    print(f"demo: the teapot's body by Tessellate Surface, curvature / distance levels: {counts} triangles")
     seconds = build_lic_picture()
     print(f"demo: vector-field textures (ABC flow, vortex) in {seconds:.1f} s")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
                  "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
-                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png"):
+                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png", "demo_teapot.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
