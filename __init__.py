@@ -28,10 +28,12 @@ _modules = (
     "addon.terrain.panel",
     "addon.subdivision.panel",
     "addon.node_panel",
+    "addon.surfaces.panel",
     "addon.tubes.preview",
     "addon.terrain.preview",
     "addon.tessellation.preview",
     "addon.subdivision.preview",
+    "addon.surfaces.preview",
     "addon.displacement.brush_cursor",
     "addon.displacement.brush_tool",
 )

@@ -1,7 +1,7 @@
 """The one ``tessera`` pointer on each ID type that Tessera stores settings on.
 
-- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain``, ``loop`` (each capability's
-  settings);
+- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain``, ``loop``, ``surface`` (each
+  capability's settings);
 - ``Scene.tessera``: ``brush`` (the displacement brush shared by the tool and stroke replays);
 - ``Image.tessera``: ``serial`` (strokes applied to a map image, for undo).
 
@@ -13,11 +13,13 @@ import bpy
 
 from .displacement import settings as displacement_settings
 from .subdivision import settings as loop_settings
+from .surfaces import settings as surface_settings
 from .terrain import settings as terrain_settings
 from .tessellation import settings as tessellation_settings
 from .tubes import settings as tube_settings
 
-_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings, loop_settings)
+_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings, loop_settings,
+             surface_settings)
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
@@ -26,6 +28,7 @@ class TESSERA_PG_object(bpy.types.PropertyGroup):
     displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement)
     terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
     loop: bpy.props.PointerProperty(type=loop_settings.TESSERA_PG_loop)
+    surface: bpy.props.PointerProperty(type=surface_settings.TESSERA_PG_surface)
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):

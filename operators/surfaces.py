@@ -9,13 +9,15 @@ import numpy as np
 from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.gpu_context import ensure_gpu_context
-from ..addon.guarded import guarded
+from ..addon.guarded import check_numbers, guarded
+from ..addon.preferences import get_preferences
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
     FieldOptions,
     PatchOptions,
     SurfaceOptions,
+    copy_surface_options,
     curve_sampling,
     draw_curve_options,
     draw_field_options,
@@ -24,7 +26,8 @@ from ..addon.surfaces.settings import (
     patch_lod,
     surface_from,
 )
-from ..kernels.common.errors import GPUContextError, InvalidInputError
+from ..addon.surfaces.sources import control_points
+from ..kernels.common.errors import BudgetError, GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
@@ -35,11 +38,15 @@ from .selection import select_only
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
     """Add a parametric surface (sphere, cone, torus, Steiner's surface, Klein bottle, Möbius band, trefoil tube,
-    superellipsoid) as a mesh, welded where it closes, with UVs"""
+    superellipsoid): a mesh welded where it closes, with UVs, or a live object drawn by the GPU from one point"""
 
     bl_idname = "tessera.parametric_surface_add"
     bl_label = "Parametric Surface"
     bl_options = {"REGISTER", "UNDO"}
+
+    output: bpy.props.EnumProperty(name="Output", default="MESH", items=(
+        ("MESH", "Mesh", "Bake the surface into a mesh"),
+        ("LIVE", "Live", "An empty drawn as the surface by the GPU (no mesh; Bake Surface makes one on demand)")))
 
     @classmethod
     def poll(cls, context):
@@ -49,21 +56,78 @@ class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
         return True
 
     def draw(self, context):
+        self.layout.prop(self, "output")
         draw_surface_options(self.layout, self)
 
     @guarded
     def execute(self, context, tx):
-        mesh = surface_mesh(surface_from(self), self.factor)
         label = dict((k, name) for k, name, _ in SURFACE_ITEMS)[self.surface]
-        arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles,
-                            corner_attributes={"UVMap": mesh.uvs}, attribute_types={"UVMap": "FLOAT2"})
-        data = tx.track(bridge.write_mesh(label, arrays))
-        data.shade_smooth()
-        ob = tx.new_object(label, data)
+        if self.output == "LIVE":
+            surface_from(self).point(np.zeros(1), np.zeros(1))  # refuse bad parameters now, not in the viewport
+            ob = tx.new_object(label, None)
+            copy_surface_options(self, ob.tessera.surface)
+            ob.tessera.surface.is_surface = True
+            ob.empty_display_size = 0.25
+            words = "drawn live from one point"
+        else:
+            mesh = surface_mesh(surface_from(self), self.factor)
+            data = tx.track(bridge.write_mesh(label, _surface_arrays(mesh)))
+            data.shade_smooth()
+            ob = tx.new_object(label, data)
+            words = f"{len(mesh.positions):,} vertices, {len(mesh.triangles):,} triangles"
         ob.location = context.scene.cursor.location
         context.collection.objects.link(ob)
         select_only(context, [ob])
-        self.report({"INFO"}, f"{label}: {len(mesh.positions):,} vertices, {len(mesh.triangles):,} triangles")
+        self.report({"INFO"}, f"{label}: {words}")
+        return {"FINISHED"}
+
+
+def _surface_arrays(mesh, offsets=None):
+    """`MeshArrays` of a baked `DomainMesh`, or of one copy of it at each of ``offsets`` (N, 3)."""
+    pos, tris, uvs = mesh.positions, mesh.triangles, mesh.uvs
+    if offsets is not None:
+        n = len(pos)
+        pos = (pos[None] + np.asarray(offsets, np.float32)[:, None]).reshape(-1, 3)
+        tris = (tris[None] + (np.arange(len(offsets)) * n)[:, None, None]).reshape(-1, 3)
+        uvs = np.broadcast_to(uvs, (len(offsets),) + uvs.shape).reshape(-1, 3, 2)
+    return MeshArrays(positions=pos, triangles=tris.astype(np.int32), corner_attributes={"UVMap": uvs},
+                      attribute_types={"UVMap": "FLOAT2"})
+
+
+class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
+    """Bake the active live surface into a mesh: one welded copy at each of its control points, at its Factor"""
+
+    bl_idname = "tessera.parametric_surface_bake"
+    bl_label = "Bake Surface"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if context.mode != "OBJECT" or ob is None or not ob.tessera.surface.is_surface:
+            cls.poll_message_set("Select a live parametric surface (Add > Tessera > Parametric Surface, Live)")
+            return False
+        return True
+
+    @guarded
+    def execute(self, context, tx):
+        ob = context.active_object
+        s = ob.tessera.surface
+        check_numbers(s)
+        points = control_points(ob)
+        budget = get_preferences(context).memory_budget_bytes
+        per = surface_mesh(surface_from(s), s.factor)
+        size = len(points) * (per.positions.nbytes + per.triangles.nbytes + per.uvs.nbytes) * 4
+        if budget and size > budget:
+            raise BudgetError(f"{len(points):,} surfaces at factor {s.factor} need about {size / 2**20:,.0f} MiB, "
+                              f"over the memory budget of {budget / 2**20:,.0f} MiB: lower the Factor")
+        data = tx.track(bridge.write_mesh(f"{ob.name}.baked", _surface_arrays(per, points)))
+        data.shade_smooth()
+        new = tx.new_object(f"{ob.name}.baked", data)
+        new.matrix_world = ob.matrix_world.copy()
+        context.collection.objects.link(new)
+        select_only(context, [new])
+        self.report({"INFO"}, f"{len(points):,} surface(s), {len(data.polygons):,} triangles")
         return {"FINISHED"}
 
 
@@ -245,6 +309,6 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_curve_adaptive, TESSERA_OT_vector_field_texture,
-           TESSERA_OT_surface_tessellate)
+classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_parametric_surface_bake, TESSERA_OT_curve_adaptive,
+           TESSERA_OT_vector_field_texture, TESSERA_OT_surface_tessellate)
 register, unregister = bpy.utils.register_classes_factory(classes)

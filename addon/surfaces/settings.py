@@ -17,6 +17,7 @@ from ...kernels.surfaces.bezier_patches import PatchLod
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
 from ...kernels.surfaces.parametric import SURFACES
 from ..cameras import CAMERA_ITEMS
+from ..viewport import invalidator, with_update
 
 #: (identifier, label, description) of each surface, in menu order.
 SURFACE_ITEMS = (
@@ -58,6 +59,36 @@ class SurfaceOptions:
     """The parametric-surface options (``tessera.parametric_surface_add`` inherits them)."""
 
     __annotations__ = _annotations()
+
+
+#: The invalidation topic of the live surfaces' settings (`addon.viewport`).
+TOPIC = "surfaces"
+_changed = invalidator(TOPIC)
+
+
+class TESSERA_PG_surface(bpy.types.PropertyGroup):
+    """``Object.tessera.surface``: an object with no mesh of its own drawn as a one-point surface (the GPU path:
+    one instance per control point) and baked on demand."""
+
+    __annotations__ = {
+        **with_update(SurfaceOptions, _changed),
+        "is_surface": bpy.props.BoolProperty(name="Parametric Surface", default=False, update=_changed,
+                                             description="Draw this object as its parametric surface"),
+        "instance_object": bpy.props.PointerProperty(
+            name="Control Points", type=bpy.types.Object, update=_changed,
+            description="A mesh whose vertices are control points: one surface at each (none: one surface at this "
+                        "object's origin)"),
+        "factor_mode": bpy.props.EnumProperty(name="Factor From", default="FIXED", update=_changed, items=(
+            ("FIXED", "Fixed", "Every instance at Factor"),
+            ("CAMERA", "Camera", "Each instance's factor from its size on screen (Edge Pixels a segment)"))),
+        "edge_pixels": bpy.props.FloatProperty(name="Edge Pixels", default=8.0, min=0.5, max=MAX_PIXELS,
+                                               update=_changed, description="Segment length on screen"),
+    }
+
+
+def copy_surface_options(source, target):
+    for name in SurfaceOptions.__annotations__:
+        setattr(target, name, getattr(source, name))
 
 
 def surface_from(options):
@@ -223,3 +254,7 @@ def draw_patch_options(layout, options):
     if options.mode != "CURVATURE":
         for name in ("near", "far", "mapping", "camera_source"):
             col.prop(options, name)
+
+
+classes = (TESSERA_PG_surface,)
+register, unregister = bpy.utils.register_classes_factory(classes)

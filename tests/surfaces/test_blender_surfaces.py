@@ -233,3 +233,18 @@ def test_tessellate_surface_refuses_what_is_not_bicubic_bezier(clean_scene, bpy_
     with pytest.raises(RuntimeError, match="without Bézier knots"):
         bpy.ops.tessera.surface_tessellate()
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+
+
+def test_bake_surface_refuses_a_control_object_that_is_not_a_mesh(clean_scene, bpy_module):
+    bpy = bpy_module
+    assert bpy.ops.tessera.parametric_surface_add(surface="SPHERE", output="LIVE") == {"FINISHED"}
+    live = bpy.context.active_object
+    bpy.ops.curve.primitive_bezier_curve_add()
+    live.tessera.surface.instance_object = bpy.context.active_object
+    bpy.context.view_layer.objects.active = live
+    before = len(bpy.data.meshes)
+    with pytest.raises(RuntimeError, match="Control Points must be a mesh"):
+        bpy.ops.tessera.parametric_surface_bake()
+    assert len(bpy.data.meshes) == before
+    with pytest.raises(RuntimeError, match="Radius must be a finite number"):
+        bpy.ops.tessera.parametric_surface_add(surface="SPHERE", output="LIVE", sphere_radius=float("nan"))

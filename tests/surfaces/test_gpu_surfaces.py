@@ -52,3 +52,41 @@ def test_the_instanced_preview_draws_what_the_uploaded_mesh_draws(gpu_renderer, 
     assert np.mean(a == b) >= 0.998, np.mean(a == b)
     # what crossed to the GPU: 16 bytes a control point and the patterns, far less than the mesh
     assert data.uploaded_bytes < positions.nbytes + tris.nbytes
+
+
+def test_a_live_surface_draws_what_bake_surface_makes(clean_scene, gpu_renderer, bpy_module, addon_module):
+    """Add > Parametric Surface (Live): an empty with no mesh, drawn at every vertex of a control mesh by the
+    preview; Bake Surface makes the same surfaces as a mesh: both pictures agree."""
+    bpy = bpy_module
+    preview = addon_module("addon.surfaces.preview")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    camera = addon_module("kernels.common.camera")
+    meshes = len(bpy.data.meshes)
+    assert bpy.ops.tessera.parametric_surface_add(surface="TREFOIL", factor=20, output="LIVE") == {"FINISHED"}
+    live = bpy.context.active_object
+    assert live.type == "EMPTY" and live.tessera.surface.is_surface and len(bpy.data.meshes) == meshes
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1, radius=4.0, location=(0.5, 0.0, 0.0))
+    points_ob = bpy.context.active_object
+    live.tessera.surface.instance_object = points_ob
+    live.location = (0.0, 0.0, 1.0)
+    bpy.context.view_layer.update()
+    cam = camera.Camera(camera.look_at_view((4, -16, 7), (0, 0, 0)), camera.perspective(0.9, 1.0, 0.1, 100), 200, 200)
+    model = np.array(live.matrix_world)
+    entry = preview.entry_for(live, camera.Camera(cam.view @ model, cam.projection, 200, 200))
+    assert entry.draw.triangle_count == 12 * 2 * 20 * 20  # fixed factor, one instance per vertex
+    gpu = offscreen.render(lambda: entry.draw.draw(cam.projection @ cam.view @ model, color=(1, 1, 1, 1), lit=False),
+                           size=(200, 200))
+    bpy.context.view_layer.objects.active = live
+    assert bpy.ops.tessera.parametric_surface_bake() == {"FINISHED"}
+    baked = bpy.context.active_object
+    pos = np.array([v.co for v in baked.data.vertices], np.float32)
+    tris = np.array([p.vertices[:] for p in baked.data.polygons], np.int32)
+    cpu = offscreen.render_triangles(pos, tris, cam.projection @ cam.view @ np.array(baked.matrix_world),
+                                     size=(200, 200), color=(1, 1, 1, 1), lit=False)
+    a, b = cpu[..., 0] > 127, gpu[..., 0] > 127
+    assert a.sum() > 1500 and np.mean(a == b) >= 0.998
+    # factors from the camera: near instances finer than far ones
+    live.tessera.surface.factor_mode = "CAMERA"
+    far = preview.instance_factors(live, preview.control_points(live),
+                                   camera.Camera(cam.view @ model, cam.projection, 200, 200))
+    assert len(np.unique(far)) > 1

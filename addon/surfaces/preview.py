@@ -1,0 +1,44 @@
+"""Live one-point surfaces in the 3D viewport: objects with ``tessera.surface.is_surface`` (empties made by *Add ›
+Tessera › Parametric Surface* with Output Live) are drawn on the GPU, one instance of the quad-domain pattern per
+control point (the object's origin, or the vertices of its Control Points mesh), the formula evaluated in the
+vertex shader. The control points are uploaded once (again when the object, its control mesh or its settings
+change); with Factor From Camera each instance's factor follows the view. Nothing is drawn in background mode."""
+
+import bpy
+import numpy as np
+
+from ...kernels.common.camera import Camera
+from ..viewport import Preview, PreviewEntry
+from .settings import TOPIC, surface_from
+from .sources import control_points, instance_factors
+
+
+def entry_for(ob, camera=None):
+    """The live surface's draw data for ``camera`` (its factors), or None when it cannot be built."""
+    from ...gpu_shaders.surfaces.draw import SurfaceDrawData
+
+    src = ob.tessera.surface.instance_object
+    entry = PREVIEW.entry(ob, lambda: PreviewEntry(None, data_uid=src.data.session_uid if src else None,
+                                                   source=(control_points(ob),)))
+    if entry is None:
+        return None
+    points = entry.source[0]
+    factors = instance_factors(ob, points, camera)
+    key = factors.tobytes()
+    if entry.view != key:
+        entry.draw, entry.view = SurfaceDrawData(surface_from(ob.tessera.surface), points, factors), key
+    return entry
+
+
+def _draw(context, region, view, proj):
+    for ob in context.visible_objects:
+        if not ob.tessera.surface.is_surface:
+            continue
+        model = np.array(ob.matrix_world)
+        entry = entry_for(ob, Camera(view @ model, proj, region.width, region.height))
+        if entry is not None:
+            entry.draw.draw(proj @ view @ model)
+
+
+PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC)
+register, unregister = PREVIEW.register, PREVIEW.unregister
