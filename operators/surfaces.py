@@ -27,11 +27,11 @@ from ..addon.surfaces.settings import (
     surface_from,
 )
 from ..addon.surfaces.sources import control_points
+from ..kernels.common.bezier_curves import adaptive_spline
 from ..kernels.common.errors import BudgetError, GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
-from ..kernels.surfaces.adaptive_curves import adaptive_spline
 from ..kernels.surfaces.domain_mesh import surface_mesh
 from .selection import select_only
 

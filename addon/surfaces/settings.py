@@ -11,8 +11,8 @@ import dataclasses
 
 import bpy
 
+from ...kernels.common.bezier_curves import CurveSampling
 from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
-from ...kernels.surfaces.adaptive_curves import CurveSampling
 from ...kernels.surfaces.bezier_patches import PatchLod
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
 from ...kernels.surfaces.parametric import SURFACES
@@ -118,7 +118,7 @@ CURVE_MODE_ITEMS = (
 
 
 class CurveOptions:
-    """The options of ``tessera.curve_adaptive`` (`kernels.surfaces.adaptive_curves.CurveSampling`)."""
+    """The options of ``tessera.curve_adaptive`` (`kernels.common.bezier_curves.CurveSampling`)."""
 
     mode: bpy.props.EnumProperty(name="Sampling", items=CURVE_MODE_ITEMS, default="CURVATURE")
     max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024,

@@ -59,6 +59,12 @@ class TubeOptions:
                                           max=math.pi / 2, description="Keep a point only where the tangent has "
                                           "turned this much (0: keep all points)")
     uvs: bpy.props.BoolProperty(name="UVs", default=True, description="UV map: U along the tube, V around it")
+    curve_sampling: bpy.props.EnumProperty(name="Curve Sampling", default="RESOLUTION", items=(
+        ("RESOLUTION", "Resolution", "Curve objects at Blender's own resolution (every segment the same)"),
+        ("CURVATURE", "Curvature", "Bézier segments from their curvature (seed eq. 4.5): 6 where straight, up to "
+                                   "Max Segments in a bend")))
+    max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024,
+                                        description="Most segments a Bézier segment gets by curvature")
 
 
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
@@ -109,6 +115,9 @@ def draw_tube_settings(layout, s):
         col.prop(s, "max_radius")
     if s.sides_mode == "CAMERA" or s.aa_clamp:
         col.prop(s, "camera_source")
+    col.prop(s, "curve_sampling")
+    if s.curve_sampling == "CURVATURE":
+        col.prop(s, "max_segments")
     col.prop(s, "refine")
     if s.refine > 1:
         col.prop(s, "refine_kind")

@@ -6,6 +6,9 @@ and the tubes.
 A spline is its points and handles as Blender keeps them: segment i runs from point i (its right handle) to point
 i + 1 (that point's left handle); a cyclic spline adds the segment from the last point back to the first. Samples
 of consecutive segments share their end points, so the polyline is continuous and closes exactly on cyclic splines.
+
+`adaptive_spline` samples a whole spline by a `CurveSampling` (curvature, world tolerance or pixels), with radius and
+tilt interpolated along each segment and the seed's "copies" (OL0, §5.5.2): N offset copies, for hair.
 """
 
 from dataclasses import dataclass
@@ -114,3 +117,70 @@ def offset_copies(points, copies, offset):
         raise InvalidInputError(f"Copies must be a whole number of at least 1; got {copies!r}")
     k = np.arange(int(copies), dtype=np.float64)[:, None, None] / copies
     return np.asarray(points, np.float64)[None] + k * np.asarray(offset, np.float64).reshape(1, 1, 3)
+
+
+# --- whole splines: the sampling options, radius and tilt along, the seed's copies ---------------------------
+
+MODES = ("CURVATURE", "TOLERANCE", "SCREEN")
+
+
+@dataclass(frozen=True)
+class CurveSampling:
+    """mode: CURVATURE (eq. 4.5: max(6, min(max_segments, 10 κ))), TOLERANCE (world units) or SCREEN (pixels, needs
+    a camera); copies and offset: the seed's OL0 (copy k moved by offset k / copies)."""
+
+    mode: str = "CURVATURE"
+    max_segments: int = MAX_SEGMENTS
+    tolerance: float = 0.01
+    pixels: float = 1.0
+    copies: int = 1
+    offset: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise InvalidInputError(f"mode must be one of {', '.join(MODES)}; got {self.mode!r}")
+        if not 6 <= self.max_segments <= MAX_TOLERANCE_SEGMENTS:
+            raise InvalidInputError(f"Max Segments must be from 6 to {MAX_TOLERANCE_SEGMENTS}; got "
+                                    f"{self.max_segments!r}")
+
+
+@dataclass
+class AdaptiveSpline:
+    """One output polyline: points (n, 3), radius (n,), tilt (n,) float64, cyclic; counts (S,) segments per Bézier
+    segment of its source."""
+
+    points: np.ndarray
+    radius: np.ndarray
+    tilt: np.ndarray
+    cyclic: bool
+    counts: np.ndarray
+
+
+def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, settings, camera=None):
+    """Sample one Bézier spline (control points (n, 3), handles (n, 3), radius and tilt (n,)) by ``settings``
+    (`CurveSampling`); camera: a `kernels.common.camera.Camera` in the spline's space, for SCREEN. Returns the
+    `AdaptiveSpline` of each copy (a list of ``settings.copies``)."""
+    control = segment_controls(co, handle_left, handle_right, cyclic)
+    if len(control) == 0:
+        raise InvalidInputError("A Bézier spline needs at least two points")
+    if settings.mode == "CURVATURE":
+        counts = curvature_counts(control, t_max=settings.max_segments)
+    else:
+        if settings.mode == "SCREEN":
+            if camera is None:
+                raise InvalidInputError("Sampling for the screen needs a camera")
+            tol = pixel_tolerance(control, camera, settings.pixels)
+        else:
+            tol = settings.tolerance
+        counts = np.minimum(tolerance_counts(control, tol), settings.max_segments)
+    s = sample(control, counts, cyclic)
+    n = len(np.asarray(co))
+    k = (s.segment + 1) % n
+
+    def along(values):
+        v = np.asarray(values, np.float64)
+        return v[s.segment] + s.t * (v[k] - v[s.segment])
+
+    r, tl = along(radius), along(tilt)
+    return [AdaptiveSpline(p, r, tl, bool(cyclic), counts) for p in offset_copies(s.points, settings.copies,
+                                                                                     settings.offset)]

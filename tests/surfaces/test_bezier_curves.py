@@ -93,7 +93,7 @@ def test_six_offset_copies():
 
 
 def test_adaptive_spline_interpolates_radius_and_tilt_and_copies():
-    from tessera.kernels.surfaces.adaptive_curves import CurveSampling, adaptive_spline
+    from tessera.kernels.common.bezier_curves import CurveSampling, adaptive_spline
 
     co = np.array([[0, 0, 0], [3, 0, 0], [3, 3, 0.5]], float)
     hl, hr = co - [0.5, 1, 0], co + [0.5, 1, 0]

@@ -141,3 +141,33 @@ def test_poly_bezier_and_nurbs_splines_in_one_curve(clean_scene, bpy_module, add
     assert np.all(use == 2) and not out.data.validate(verbose=False)
     bpy.data.objects.remove(ob)
     bpy.data.curves.remove(cu)
+
+
+def test_curvature_sampling_puts_rings_where_the_curve_bends(clean_scene, bpy_module, addon_module):
+    """Curve Sampling Curvature: each Bézier segment gets its eq. 4.5 count of rings (6 straight, up to 32 in a
+    bend), the ring centres on the Bézier, the radius along each segment."""
+    bpy = bpy_module
+    bz = addon_module("kernels.common.bezier_curves")
+    data = bpy.data.curves.new("Bend", "CURVE")
+    data.dimensions = "3D"
+    s = data.splines.new("BEZIER")
+    s.bezier_points.add(2)
+    co = np.array([[0, 0, 0], [4, 0, 0], [4.2, 0.3, 0]], np.float32)
+    hl = co - np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0]], np.float32)
+    hr = co + np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0]], np.float32)
+    for name, values in (("co", co), ("handle_left", hl), ("handle_right", hr)):
+        s.bezier_points.foreach_set(name, values.ravel())
+    s.bezier_points.foreach_set("radius", np.array([1, 1, 2], np.float32))
+    ob = bpy.data.objects.new("Bend", data)
+    bpy.context.scene.collection.objects.link(ob)
+    out = run_tubes(bpy, ob, radius=0.05, sides=6, caps="NONE", curve_sampling="CURVATURE")
+    control = bz.segment_controls(co, hl, hr, False)
+    counts = bz.curvature_counts(control)
+    assert counts[0] == 6 and counts[1] == 32
+    pos, _ = mesh_arrays(out.data)
+    rings = pos.reshape(-1, 6, 3)
+    want = bz.sample(control, counts, False)
+    assert len(rings) == counts.sum() + 1
+    assert np.allclose(rings.mean(axis=1), want.points, atol=1e-5)
+    radii = np.linalg.norm(rings - rings.mean(axis=1, keepdims=True), axis=2).mean(axis=1)
+    assert np.allclose(radii[[0, 6, -1]], [0.05, 0.05, 0.10], rtol=1e-3)
