@@ -139,7 +139,7 @@ def run_teapot(bpy, mod):
 
     def ours():
         bpy.context.view_layer.objects.active = surface
-        bpy.ops.tessera.surface_tessellate(mode="CURVATURE")
+        bpy.ops.tessera.surface_tessellate(metrics={"CURVATURE"})
         out = bpy.context.active_object
         n, data = len(out.data.polygons), out.data
         bpy.data.objects.remove(out)

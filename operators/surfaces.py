@@ -285,12 +285,11 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
             raise InvalidInputError(f"Surface {ob.name!r} has no bicubic Bézier patch"
                                     + (": " + "; ".join(skipped) if skipped else ""))
         lod = patch_lod(self)
-        eye = None
-        if lod.mode != "CURVATURE":
-            cam = object_camera(camera_for(context, self.camera_source, "Distance levels"), ob.matrix_world)
-            eye = cam.eye
+        cam = None
+        if set(lod.metrics) & {"DISTANCE", "EDGE_LENGTH"}:
+            cam = object_camera(camera_for(context, self.camera_source, "Camera levels"), ob.matrix_world)
         edges = bp.patch_edges(patches)
-        edge_levels, inner = bp.patch_levels(patches, edges, lod, eye)
+        edge_levels, inner = bp.patch_levels(patches, edges, lod, cam)
         mesh = bp.tessellate_patches(patches, edge_levels, inner, edges)
         arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles,
                             corner_attributes={"UVMap": mesh.corner_uv}, attribute_types={"UVMap": "FLOAT2"})

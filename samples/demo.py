@@ -571,7 +571,7 @@ def build_teapot_scene():
     surface = bpy.context.active_object
     add_camera((0.0, -13.0, 5.5), (1.27, 0.0, 0.0), lens=35)
     counts = []
-    for x, kw in ((-2.6, {"mode": "CURVATURE"}), (2.6, {"mode": "DISTANCE", "near": 11.0, "far": 17.0,
+    for x, kw in ((-2.6, {"metrics": {"CURVATURE"}}), (2.6, {"metrics": {"DISTANCE"}, "near": 11.0, "far": 17.0,
                                                          "max_level": 24})):
         surface.location = (x, 0.0, 0.0)
         bpy.context.view_layer.objects.active = surface

@@ -12,6 +12,7 @@ import dataclasses
 import bpy
 
 from ...kernels.common.bezier_curves import CurveSampling
+from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.surfaces.bezier_patches import PatchLod
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
@@ -209,18 +210,19 @@ def draw_field_options(layout, options):
         col.prop(options, name)
 
 
-PATCH_MODE_ITEMS = (
-    ("CURVATURE", "Curvature", "Levels from the control nets' curvature (seed eq. 4.5 on rows, columns, diagonals)"),
-    ("DISTANCE", "Distance", "Levels from the camera distance: sides from their nearest control point, the inside "
-                             "from the net's centroid"),
-    ("BOTH", "Both", "The larger of the two"),
+PATCH_METRIC_ITEMS = (
+    ("CURVATURE", "Curvature", "From the control nets' curvature (seed eq. 4.5 on rows, columns, diagonals)"),
+    ("DISTANCE", "Distance", "From the camera distance: sides from their nearest control point, the inside from the "
+                             "net's centroid"),
+    ("EDGE_LENGTH", "Edge Length", "From each side's projected length for the camera, Edge Pixels a segment"),
 )
 
 
 class PatchOptions:
     """The options of ``tessera.surface_tessellate`` (`kernels.surfaces.bezier_patches.PatchLod`)."""
 
-    mode: bpy.props.EnumProperty(name="Levels", items=PATCH_MODE_ITEMS, default="CURVATURE")
+    metrics: bpy.props.EnumProperty(name="Metrics", items=PATCH_METRIC_ITEMS, default={"CURVATURE"},
+                                    options={"ENUM_FLAG"}, description="Levels from these, the largest wins")
     max_level: bpy.props.IntProperty(name="Max Level", default=32, min=1, max=64,
                                      description="Most segments on a side or inside (the seed's 32)")
     inner_rows: bpy.props.EnumProperty(name="Inner Curvature", default="ALL", items=(
@@ -234,26 +236,35 @@ class PatchOptions:
     mapping: bpy.props.EnumProperty(name="Distance Map", default="LINEAR", items=(
         ("LINEAR", "Linear", "Max Level at Near, falling linearly to 1 at Far"),
         ("INVERSE", "Inverse", "Like a z-buffer: more levels near the camera")))
+    edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", default=10.0, min=0.5, max=MAX_PIXELS,
+                                         description="Segment length on screen for the Edge Length metric")
     camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
 
 
 def patch_lod(options):
-    return PatchLod(mode=options.mode, max_level=options.max_level, inner_rows=options.inner_rows,
-                    near=options.near, far=options.far, mapping=options.mapping, degenerate=options.degenerate)
+    if not options.metrics:
+        raise InvalidInputError("Choose at least one metric for the levels")
+    return PatchLod(metrics=tuple(sorted(options.metrics)), max_level=options.max_level,
+                    inner_rows=options.inner_rows, near=options.near, far=options.far, mapping=options.mapping,
+                    edge_pixels=options.edge_pixels, degenerate=options.degenerate)
 
 
 def draw_patch_options(layout, options):
     layout.use_property_split = True
     layout.use_property_decorate = False
     col = layout.column()
-    col.prop(options, "mode")
+    col.prop(options, "metrics")
     col.prop(options, "max_level")
-    if options.mode != "DISTANCE":
+    if "CURVATURE" in options.metrics:
         col.prop(options, "inner_rows")
         col.prop(options, "degenerate")
-    if options.mode != "CURVATURE":
-        for name in ("near", "far", "mapping", "camera_source"):
+    if "DISTANCE" in options.metrics:
+        for name in ("near", "far", "mapping"):
             col.prop(options, name)
+    if "EDGE_LENGTH" in options.metrics:
+        col.prop(options, "edge_pixels")
+    if options.metrics & {"DISTANCE", "EDGE_LENGTH"}:
+        col.prop(options, "camera_source")
 
 
 classes = (TESSERA_PG_surface,)

@@ -1,7 +1,7 @@
-"""Level metrics every capability shares (digest 001 §4): the camera-distance map (eqs. 4.1-4.3) and the
-curvature of control polygons (§4.3, eqs. 4.4 and 4.5; scale-invariant: scaling a control polygon leaves its κ⁺
-unchanged). Used by the curved triangle patches (`kernels.tessellation.adaptive`), the adaptive curves and the
-Bézier surface patches."""
+"""Level metrics every capability shares (digest 001 §4): the camera-distance map (eqs. 4.1-4.3), the projected
+size of a sphere (§4.4, the projected-edge metric's core) and the curvature of control polygons (§4.3, eqs. 4.4 and
+4.5; scale-invariant: scaling a control polygon leaves its κ⁺ unchanged). Used by the curved triangle patches
+(`kernels.tessellation.adaptive`), the adaptive curves and the Bézier surface patches."""
 
 import numpy as np
 
@@ -56,4 +56,32 @@ def distance_level(d, d_min, d_max, t_max, mapping="LINEAR"):
             t = np.where(d > 0, a / np.maximum(d, np.finfo(np.float64).tiny) + b, t_max)
     else:
         raise InvalidInputError(f"Unknown distance map {mapping!r}; expected one of {', '.join(DISTANCE_MAPS)}")
+    return np.clip(t, 1.0, t_max)
+
+
+def projected_sphere_levels(m, d, projection, height, e_max, t_max):
+    """Pixels a sphere of diameter ``d`` at eye-space point ``m`` spans on screen, over ``e_max`` (digest 001 §4.4,
+    corrected): ``m`` and ``m + (0, d, 0)`` are projected, so the result does not depend on which way the measured
+    thing points. m: (..., 3) eye space (looking down -z); d: (...); projection: (4, 4) row-major; height: viewport
+    height in pixels. A sphere reaching behind the eye plane gets ``t_max``; one entirely behind gets 1.
+    Returns (...) float64 in ``[1, t_max]``."""
+    if e_max <= 0:
+        raise InvalidInputError("The target edge length in pixels must be positive")
+    m = np.asarray(m, np.float64)
+    d = np.asarray(d, np.float64)
+    proj = np.asarray(projection, np.float64)
+
+    def ndc_y(x, y, z):
+        clip_y = proj[1, 0] * x + proj[1, 1] * y + proj[1, 2] * z + proj[1, 3]
+        clip_w = proj[3, 0] * x + proj[3, 1] * y + proj[3, 2] * z + proj[3, 3]
+        return clip_y, clip_w
+
+    y0, w0 = ndc_y(m[..., 0], m[..., 1], m[..., 2])
+    y1, w1 = ndc_y(m[..., 0], m[..., 1] + d, m[..., 2])
+    ahead = (w0 > 0) & (w1 > 0)
+    safe0, safe1 = np.where(ahead, w0, 1.0), np.where(ahead, w1, 1.0)
+    pixels = np.abs(y1 / safe1 - y0 / safe0) * (height * 0.5)
+    t = np.where(ahead, pixels / e_max, 1.0)
+    crosses = m[..., 2] + 0.5 * d > 0
+    t = np.where(crosses & (m[..., 2] - 0.5 * d < 0), t_max, t)
     return np.clip(t, 1.0, t_max)

@@ -19,8 +19,10 @@ Levels (`patch_levels`):
   digest ambiguity 4) and the 9 cells' diagonal κ× (eq. 4.6): if the largest κ× exceeds both, it sets both;
 - distance: a side from the smallest distance of its 4 control points to the eye, the inner from the net's
   centroid, through the linear (or inverse) map between Near and Far;
-- both: the larger of the two. Levels are whole segment counts; one inner count per patch, the larger of u and v
-  (the pattern's single inner level).
+- projected edge length (§4.4): a side as a sphere as wide as its control polygon is long, at its centroid, over
+  Edge Pixels; the inside from the net's longest row or column at its centroid;
+- any of these together: the largest. Levels are whole segment counts; one inner count per patch, the larger of u
+  and v (the pattern's single inner level).
 """
 
 from dataclasses import dataclass
@@ -29,10 +31,10 @@ from functools import lru_cache
 import numpy as np
 
 from ..common.errors import InvalidInputError
-from ..common.level_metrics import curvature_level, curve_kappa, distance_level
+from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes
 
-MODES = ("CURVATURE", "DISTANCE", "BOTH")
+METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH")
 MAX_LEVEL = 64
 #: Control-net indices (i, j) of each side, in the side's direction.
 _SIDES = (
@@ -45,24 +47,28 @@ _SIDES = (
 
 @dataclass(frozen=True)
 class PatchLod:
-    """How levels are chosen: mode CURVATURE, DISTANCE or BOTH; max_level (≤ 64, the curvature metric's cap
-    t_tessmax); inner_rows ALL or INTERIOR; near, far, mapping (LINEAR or INVERSE): the distance map; degenerate:
+    """How levels are chosen: metrics, some of CURVATURE, DISTANCE, EDGE_LENGTH (combined by maximum); max_level
+    (≤ 64, the curvature metric's cap t_tessmax); inner_rows ALL or INTERIOR; near, far, mapping (LINEAR or
+    INVERSE): the distance map; edge_pixels: the projected-edge metric's segment length on screen; degenerate:
     what a row of the net that collapses to one point (κ⁺ = 0/0) counts for the inner levels: CAP (the seed's GPU,
     and what makes the teapot's knob and base its finest patches; digest 001 §10 item 5) or ZERO (no bend)."""
 
-    mode: str = "CURVATURE"
+    metrics: tuple = ("CURVATURE",)
     max_level: int = 32
     inner_rows: str = "ALL"
     near: float = 1.0
     far: float = 20.0
     mapping: str = "LINEAR"
+    edge_pixels: float = 10.0
     degenerate: str = "CAP"
 
     def __post_init__(self):
+        if not self.metrics or not set(self.metrics) <= set(METRICS):
+            raise InvalidInputError(f"metrics must be some of {', '.join(METRICS)}; got {self.metrics!r}")
+        if not (np.isfinite(self.edge_pixels) and self.edge_pixels > 0):
+            raise InvalidInputError(f"Edge Pixels must be a positive number; got {self.edge_pixels!r}")
         if self.degenerate not in ("CAP", "ZERO"):
             raise InvalidInputError(f"degenerate must be CAP or ZERO; got {self.degenerate!r}")
-        if self.mode not in MODES:
-            raise InvalidInputError(f"mode must be one of {', '.join(MODES)}; got {self.mode!r}")
         if self.inner_rows not in ("ALL", "INTERIOR"):
             raise InvalidInputError(f"inner_rows must be ALL or INTERIOR; got {self.inner_rows!r}")
         if not 1 <= self.max_level <= MAX_LEVEL:
@@ -144,13 +150,20 @@ def diagonal_kappa(control):
     return k.reshape(len(c), -1).max(axis=1)
 
 
-def patch_levels(control, edges, lod, eye=None):
-    """Levels: (edge levels (E,) int64, inner levels (P,) int64) in [1, max_level]. eye: (3,) the camera in the
-    patches' space, needed for DISTANCE and BOTH."""
+def _polygon_length(points):
+    """Lengths of control polygons (..., n, 3) -> (...): an upper bound of their curves' lengths."""
+    return np.linalg.norm(np.diff(points, axis=-2), axis=-1).sum(axis=-1)
+
+
+def patch_levels(control, edges, lod, camera=None):
+    """Levels: (edge levels (E,) int64, inner levels (P,) int64) in [1, max_level]. camera: a
+    `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
     c = check_patches(control)
     edge_level = np.ones(len(edges.control), np.int64)
     inner = np.ones(len(c), np.int64)
-    if lod.mode in ("CURVATURE", "BOTH"):
+    if (set(lod.metrics) & {"DISTANCE", "EDGE_LENGTH"}) and camera is None:
+        raise InvalidInputError("Distance and edge-length levels need a camera")
+    if "CURVATURE" in lod.metrics:
         edge_level = np.maximum(edge_level, _eq45(curve_kappa(edges.control), lod.max_level))
         rows = slice(None) if lod.inner_rows == "ALL" else slice(1, 3)
         along_u, along_v = c[:, :, rows].transpose(0, 2, 1, 3), c[:, rows, :]  # (P, rows, 4, 3) each
@@ -163,10 +176,20 @@ def patch_levels(control, edges, lod, eye=None):
         diag = k_x > np.maximum(k_u, k_v)
         k_in = np.where(diag, k_x, np.maximum(k_u, k_v))
         inner = np.maximum(inner, _eq45(k_in, lod.max_level))
-    if lod.mode in ("DISTANCE", "BOTH"):
-        if eye is None:
-            raise InvalidInputError("Distance levels need a camera")
-        eye = np.asarray(eye, np.float64)
+    if "EDGE_LENGTH" in lod.metrics:  # a sphere of the control polygon's length, at its centroid (§4.4)
+        view = np.asarray(camera.view, np.float64)
+
+        def projected(centre, length):
+            m = centre @ view[:3, :3].T + view[:3, 3]
+            t = projected_sphere_levels(m, length, camera.projection, camera.height, lod.edge_pixels,
+                                        float(lod.max_level))
+            return np.ceil(t).astype(np.int64)
+
+        edge_level = np.maximum(edge_level, projected(edges.control.mean(axis=1), _polygon_length(edges.control)))
+        size = np.maximum(_polygon_length(c).max(axis=1), _polygon_length(c.transpose(0, 2, 1, 3)).max(axis=1))
+        inner = np.maximum(inner, projected(c.reshape(len(c), -1, 3).mean(axis=1), size))
+    if "DISTANCE" in lod.metrics:
+        eye = camera.eye
         d_edge = np.linalg.norm(edges.control - eye, axis=-1).min(axis=1)
         d_in = np.linalg.norm(c.reshape(len(c), -1, 3).mean(axis=1) - eye, axis=-1)
 

@@ -18,6 +18,7 @@ from ..common.level_metrics import (  # noqa: F401 (eqs. 4.1-4.5, part of the me
     curvature_level,
     curve_kappa,
     distance_level,
+    projected_sphere_levels,
 )
 from ..common.partition import MAX_LEVEL
 
@@ -65,26 +66,8 @@ def projected_edge_levels(a, b, view, projection, height, e_max, t_max=MAX_LEVEL
     if e_max <= 0:
         raise InvalidInputError("The target edge length in pixels must be positive")
     pa, pb = to_eye(a, view), to_eye(b, view)
-    m = (pa + pb) * 0.5
     diff = pa - pb
-    d = np.sqrt(_dot(diff, diff))
-    proj = np.asarray(projection, np.float64)
-
-    def ndc_y(x, y, z):
-        clip_y = proj[1, 0] * x + proj[1, 1] * y + proj[1, 2] * z + proj[1, 3]
-        clip_w = proj[3, 0] * x + proj[3, 1] * y + proj[3, 2] * z + proj[3, 3]
-        return clip_y, clip_w
-
-    y0, w0 = ndc_y(m[..., 0], m[..., 1], m[..., 2])
-    y1, w1 = ndc_y(m[..., 0], m[..., 1] + d, m[..., 2])
-    ahead = (w0 > 0) & (w1 > 0)
-    safe0, safe1 = np.where(ahead, w0, 1.0), np.where(ahead, w1, 1.0)
-    pixels = np.abs(y1 / safe1 - y0 / safe0) * (height * 0.5)
-    t = np.where(ahead, pixels / e_max, 1.0)
-    # Perspective: eye looks down -z. A sphere that crosses the eye plane is huge on screen.
-    crosses = m[..., 2] + 0.5 * d > 0
-    t = np.where(crosses & (m[..., 2] - 0.5 * d < 0), t_max, t)
-    return np.clip(t, 1.0, t_max)
+    return projected_sphere_levels((pa + pb) * 0.5, np.sqrt(_dot(diff, diff)), projection, height, e_max, t_max)
 
 
 def face_normals(corners):

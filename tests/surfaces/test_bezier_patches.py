@@ -63,13 +63,13 @@ def test_random_levels_stay_welded():
 def test_curvature_levels_are_highest_at_the_knob_and_the_base():
     patches, names = teapot_patches()
     edges = bp.patch_edges(patches)
-    el, inner = bp.patch_levels(patches, edges, bp.PatchLod(mode="CURVATURE"))
+    el, inner = bp.patch_levels(patches, edges, bp.PatchLod(metrics=("CURVATURE",)))
     by = {n: inner[names == n].max() for n in set(names)}
     top_two = sorted(by, key=by.get, reverse=True)[:2]
     assert set(top_two) == {"lid_top", "bottom"}, by
     assert el.min() >= 6 and el.max() <= 32 and inner.max() == 32
     # without the seed's cap for collapsed rows the base is an ordinary patch; the knob still folds
-    _, geometric = bp.patch_levels(patches, edges, bp.PatchLod(mode="CURVATURE", degenerate="ZERO"))
+    _, geometric = bp.patch_levels(patches, edges, bp.PatchLod(metrics=("CURVATURE",), degenerate="ZERO"))
     assert geometric[names == "lid_top"].max() > geometric[names != "lid_top"].max()
     assert geometric[names == "bottom"].max() < inner[names == "bottom"].max()
 
@@ -77,17 +77,39 @@ def test_curvature_levels_are_highest_at_the_knob_and_the_base():
 def test_distance_levels_high_near_low_far_and_welded_from_20_cameras():
     patches, _ = teapot_patches()
     edges = bp.patch_edges(patches)
-    lod = bp.PatchLod(mode="DISTANCE", max_level=24, near=2.0, far=30.0)
-    el, inner = bp.patch_levels(patches, edges, lod, eye=(0, -1.9, 1.5))  # inside the near distance: all high
+    lod = bp.PatchLod(metrics=("DISTANCE",), max_level=24, near=2.0, far=30.0)
+    el, inner = bp.patch_levels(patches, edges, lod, looking((0, -1.9, 1.5)))  # inside the near distance: all high
     assert el.min() >= 20 and inner.min() >= 20
-    el, inner = bp.patch_levels(patches, edges, lod, eye=(0, -300, 1.5))
+    el, inner = bp.patch_levels(patches, edges, lod, looking((0, -300, 1.5)))
     assert el.max() == 1 and inner.max() == 1
     rng = np.random.default_rng(4)
+    every = bp.PatchLod(metrics=bp.METRICS, near=2.0, far=30.0, edge_pixels=12.0)
     for _ in range(20):
         d = rng.normal(size=3)
-        eye = rng.uniform(3, 25) * d / np.linalg.norm(d)
-        el, inner = bp.patch_levels(patches, edges, bp.PatchLod(mode="BOTH", near=2.0, far=30.0), eye=eye)
+        el, inner = bp.patch_levels(patches, edges, every, looking(rng.uniform(3, 25) * d / np.linalg.norm(d)))
         check_mesh(patches, edges, el, inner, bp.tessellate_patches(patches, el, inner, edges))
+
+
+def looking(eye, target=(0.0, 0.0, 1.5), size=512):
+    return camera.Camera(camera.look_at_view(eye, target), camera.perspective(0.8, 1.0, 0.05, 1e4), size, size)
+
+
+def test_projected_edge_levels_follow_the_screen():
+    patches, _ = teapot_patches()
+    edges = bp.patch_edges(patches)
+    lod = bp.PatchLod(metrics=("EDGE_LENGTH",), max_level=64, edge_pixels=8.0)
+    near = bp.patch_levels(patches, edges, lod, looking((0, -8, 1.5)))
+    far = bp.patch_levels(patches, edges, lod, looking((0, -40, 1.5)))
+    small = bp.patch_levels(patches, edges, lod, looking((0, -8, 1.5), size=128))
+    assert near[0].sum() > 3 * far[0].sum() and near[0].sum() > 2 * small[0].sum()
+    # a side's level is its control polygon's projected length over Edge Pixels (never below 1)
+    c = edges.control
+    length = np.linalg.norm(np.diff(c, axis=1), axis=2).sum(axis=1)
+    cam = looking((0, -8, 1.5))
+    m = c.mean(axis=1) @ np.asarray(cam.view)[:3, :3].T + np.asarray(cam.view)[:3, 3]
+    focal = 0.5 * 512 * np.asarray(cam.projection)[1, 1]
+    approx = focal * length / -m[:, 2] / 8.0  # the sphere's projected diameter, to first order
+    assert np.allclose(near[0], np.clip(np.ceil(approx), 1, 64), atol=1.0)
 
 
 def test_both_sides_of_an_edge_get_one_level_and_bad_input_is_refused():
@@ -99,9 +121,8 @@ def test_both_sides_of_an_edge_get_one_level_and_bad_input_is_refused():
     assert collapsed.sum() == 2 and (count[collapsed] == 4).all()  # the lid's top, the bottom's centre
     assert (count[~collapsed] <= 2).all() and (count == 2).sum() > 30
     with pytest.raises(InvalidInputError):
-        bp.patch_levels(patches, edges, bp.PatchLod(mode="DISTANCE"))
+        bp.patch_levels(patches, edges, bp.PatchLod(metrics=("DISTANCE",)))
     with pytest.raises(InvalidInputError):
         bp.check_patches(np.full((1, 4, 4, 3), np.nan))
     with pytest.raises(InvalidInputError):
-        bp.PatchLod(mode="FAST")
-    assert camera  # the cameras of the distance test are plain eye points
+        bp.PatchLod(metrics=("FAST",))

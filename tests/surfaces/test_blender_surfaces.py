@@ -200,7 +200,7 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
     assert len(ob.data.splines) == 24
     read, skipped = addon_module("addon.bridge").read_surface_patches(ob.data)
     assert skipped == [] and np.allclose(read, patches.astype(np.float32))
-    assert bpy.ops.tessera.surface_tessellate(mode="CURVATURE") == {"FINISHED"}
+    assert bpy.ops.tessera.surface_tessellate(metrics={"CURVATURE"}) == {"FINISHED"}
     out = bpy.context.active_object
     edges = bp.patch_edges(read)
     el, inner = bp.patch_levels(read, edges, bp.PatchLod())
@@ -217,13 +217,14 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
     cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
     bpy.context.scene.collection.objects.link(cam)
     bpy.context.scene.camera = cam
-    counts = []
-    for y in (-3.0, -60.0):
-        cam.location = (0.0, y, 1.5)
-        bpy.context.view_layer.objects.active = ob
-        assert bpy.ops.tessera.surface_tessellate(mode="DISTANCE", near=2.0, far=50.0) == {"FINISHED"}
-        counts.append(len(bpy.context.active_object.data.polygons))
-    assert counts[0] > 4 * counts[1]
+    for metrics in ({"DISTANCE"}, {"EDGE_LENGTH"}):
+        counts = []
+        for y in (-3.0, -60.0):
+            cam.location, cam.rotation_euler = (0.0, y, 1.5), (1.5708, 0.0, 0.0)
+            bpy.context.view_layer.objects.active = ob
+            assert bpy.ops.tessera.surface_tessellate(metrics=metrics, near=2.0, far=50.0) == {"FINISHED"}
+            counts.append(len(bpy.context.active_object.data.polygons))
+        assert counts[0] > 4 * counts[1], metrics
 
 
 def test_tessellate_surface_refuses_what_is_not_bicubic_bezier(clean_scene, bpy_module):
