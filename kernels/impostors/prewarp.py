@@ -178,3 +178,26 @@ def zbuffer_splat(displacement, frame, eye):
     source = np.full(w * h, -1, np.int64)
     source[dst[first]] = src[first]
     return Splat(source.reshape(h, w))
+
+
+def _fill_rows(source):
+    """Each hole (-1) of each row takes the source of the nearest painted texel in its row (ties: the left one);
+    rows with nothing painted stay as they are."""
+    h, w = source.shape
+    idx = np.broadcast_to(np.arange(w), (h, w))
+    painted = source >= 0
+    left = np.maximum.accumulate(np.where(painted, idx, -1), axis=1)
+    right = np.minimum.accumulate(np.where(painted, idx, w)[:, ::-1], axis=1)[:, ::-1]
+    use_left = (left >= 0) & ((right >= w) | (idx - left <= right - idx))
+    pick = np.where(use_left, left, right)
+    ok = (pick >= 0) & (pick < w)
+    filled = np.take_along_axis(source, np.clip(pick, 0, w - 1), axis=1)
+    return np.where(painted, source, np.where(ok, filled, -1))
+
+
+def fill_holes(splat):
+    """Two 1-D passes (the seed leaves the method open, errata 9; §B.4 suggests 1-D passes): holes take the nearest
+    painted texel of their row, then what is left the nearest of its column. A new `Splat` (holes only where the
+    image was empty)."""
+    rows = _fill_rows(splat.source)
+    return Splat(_fill_rows(rows.T).T)

@@ -96,3 +96,21 @@ def test_the_offset_map_addresses_the_source():
     assert np.array_equal(out[filled], colours[iv[filled], iu[filled]])  # a dependent lookup, as the GPU does
     assert np.isnan(offs[~filled]).all() and (out[~filled] == 0).all()
     assert 0.0 <= splat.hole_fraction < 0.5
+
+
+def test_no_holes_left_for_a_smooth_height_field_under_moderate_view_changes():
+    w = h = 64
+    y, x = np.mgrid[0:h, 0:w] / w
+    d = 0.15 * (1 + np.sin(4 * x) * np.cos(3 * y))
+    frame = pw.ReliefFrame(np.array([-3.2, -3.2, 0.0]), np.array([0.1, 0, 0]), np.array([0, 0.1, 0]),
+                           np.array([0, 0, 1.0]))
+    fractions = []
+    for angle in np.radians([0, 10, 20, 30]):
+        eye = np.array([8 * np.sin(angle), 0.0, 8 * np.cos(angle)])
+        raw = pw.forward_splat(d, frame, eye)
+        fractions.append(raw.hole_fraction)
+        filled = pw.fill_holes(raw)
+        assert filled.hole_fraction == 0.0
+        painted = raw.source >= 0
+        assert np.array_equal(filled.source[painted], raw.source[painted])  # painted texels are kept
+    assert fractions[-1] > fractions[0]  # the raw holes grow with the view change; filled, there are none
