@@ -6,7 +6,7 @@ field's line-integral-convolution image (digest 001 §5.5.4)."""
 import bpy
 import numpy as np
 
-from ..addon import bridge
+from ..addon import bridge, curve_bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.gpu_context import ensure_gpu_context
 from ..addon.guarded import check_numbers, guarded
@@ -159,17 +159,17 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
                                    ob.matrix_world)
         out, skipped, counts = [], 0, []
-        for sp in bridge.read_splines(ob.data):
+        for sp in curve_bridge.read_splines(ob.data):
             if sp.kind == "BEZIER" and len(sp.co) >= 2:
                 for a in adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic,
                                          settings, camera):
-                    out.append(bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
+                    out.append(curve_bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
                                                    sp.material_index))
                 counts.append(a.counts)
             elif sp.kind == "POLY":
                 offset = np.asarray(settings.offset, np.float64)
                 for k in range(settings.copies):
-                    out.append(bridge.SplineArrays("POLY", sp.co + offset * k / settings.copies, None, None,
+                    out.append(curve_bridge.SplineArrays("POLY", sp.co + offset * k / settings.copies, None, None,
                                                    sp.radius, sp.tilt, sp.cyclic, sp.material_index))
             else:
                 skipped += 1
@@ -177,7 +177,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
             raise InvalidInputError(f"Curve {ob.name!r} has no Bézier or poly spline to sample"
                                     + (f" ({skipped} NURBS spline(s): convert them to Bézier first)" if skipped
                                        else ""))
-        data = tx.track(bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
+        data = tx.track(curve_bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
         for mat in ob.data.materials:
             data.materials.append(mat)
         new = tx.new_object(f"{ob.name}.adaptive", data)
@@ -280,7 +280,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
     @guarded
     def execute(self, context, tx):
         ob = context.active_object
-        patches, skipped = bridge.read_surface_patches(ob.data)
+        patches, skipped = curve_bridge.read_surface_patches(ob.data)
         if len(patches) == 0:
             raise InvalidInputError(f"Surface {ob.name!r} has no bicubic Bézier patch"
                                     + (": " + "; ".join(skipped) if skipped else ""))

@@ -6,7 +6,7 @@ from ...kernels.common.bezier_curves import CurveSampling, adaptive_spline
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.tubes.edge_chains import chains_from_edges
 from ...kernels.tubes.polylines import Polylines
-from .. import bridge
+from .. import bridge, curve_bridge
 
 SOURCE_TYPES = {"CURVE", "CURVES", "MESH"}
 
@@ -17,9 +17,9 @@ def read_lines(ob, settings):
     if ob.type == "CURVE" and settings.curve_sampling == "CURVATURE":
         lines = _curvature_lines(ob, settings)
     elif ob.type == "CURVE":
-        lines, notes = bridge.read_curve_object(ob, settings.radius)  # point radius x Radius, like a bevel
+        lines, notes = curve_bridge.read_curve_object(ob, settings.radius)  # point radius x Radius, like a bevel
     elif ob.type == "CURVES":
-        lines = bridge.read_hair_curves(ob.data, settings.radius)  # the 'radius' attribute where present
+        lines = curve_bridge.read_hair_curves(ob.data, settings.radius)  # the 'radius' attribute where present
     elif ob.type == "MESH":
         positions, edges = bridge.read_wire_mesh(ob.data)
         lines, vertex_ids = chains_from_edges(positions, edges)
@@ -42,7 +42,7 @@ def _curvature_lines(ob, settings):
     they are), radius (x Radius, like a bevel) and tilt along each segment."""
     sampling = CurveSampling(mode="CURVATURE", max_segments=settings.max_segments)
     points, radius, tilt, counts, cyclic, materials = [], [], [], [], [], []
-    for sp in bridge.read_splines(ob.data):
+    for sp in curve_bridge.read_splines(ob.data):
         if sp.kind == "BEZIER" and len(sp.co) >= 2:
             [a] = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic, sampling)
             pts, rad, til = a.points, a.radius, a.tilt

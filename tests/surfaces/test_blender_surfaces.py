@@ -198,7 +198,7 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
     patches, names = addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
     ob = surface_object(bpy, patches)
     assert len(ob.data.splines) == 24
-    read, skipped = addon_module("addon.bridge").read_surface_patches(ob.data)
+    read, skipped = addon_module("addon.curve_bridge").read_surface_patches(ob.data)
     assert skipped == [] and np.allclose(read, patches.astype(np.float32))
     assert bpy.ops.tessera.surface_tessellate(metrics={"CURVATURE"}) == {"FINISHED"}
     out = bpy.context.active_object

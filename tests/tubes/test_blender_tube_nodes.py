@@ -56,7 +56,7 @@ def evaluated(bpy, ob):
 
 
 def kernel_tubes(addon_module, ob, radius, **settings):
-    bridge = addon_module("addon.bridge")
+    bridge = addon_module("addon.curve_bridge")
     builder = addon_module("kernels.tubes.builder")
     lines, _ = bridge.read_curve_object(ob, radius)
     return lines, builder.build_tubes(lines, builder.TubeSettings(**settings), backend="numpy")
@@ -115,7 +115,7 @@ def test_pixel_clamp_keeps_one_pixel_for_the_active_camera(clean_scene, bpy_modu
         "Pixel Clamp": True, "Field of View": cam.data.angle_x, "Image Width": 400})
     pos, me = evaluated(bpy, ob)
     camera = cameras.object_camera(cameras.scene_camera(bpy.context), ob.matrix_world)
-    lines, _ = addon_module("addon.bridge").read_curve_object(ob, 0.001)
+    lines, _ = addon_module("addon.curve_bridge").read_curve_object(ob, 0.001)
     builder = addon_module("kernels.tubes.builder")
     mesh = builder.build_tubes(lines, builder.TubeSettings(sides=6, aa_clamp=True), camera=camera, backend="numpy")
     radius = np.linalg.norm(pos.reshape(-1, 6, 3) - lines.points[:, None, :], axis=2).mean(axis=1)

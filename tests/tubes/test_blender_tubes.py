@@ -113,7 +113,7 @@ def test_poll_explains_itself(clean_scene, bpy_module):
 
 def test_poly_bezier_and_nurbs_splines_in_one_curve(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
-    bridge = addon_module("addon.bridge")
+    bridge = addon_module("addon.curve_bridge")
     cu = bpy.data.curves.new("Mixed", "CURVE")
     cu.dimensions = "3D"
     poly = cu.splines.new("POLY")
