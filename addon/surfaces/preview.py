@@ -1,8 +1,9 @@
 """Live one-point surfaces in the 3D viewport: objects with ``tessera.surface.is_surface`` (empties made by *Add ›
 Tessera › Parametric Surface* with Output Live) are drawn on the GPU, one instance of the quad-domain pattern per
 control point (the object's origin, or the vertices of its Control Points mesh), the formula evaluated in the
-vertex shader. The control points are uploaded once (again when the object, its control mesh or its settings
-change); with Factor From Camera each instance's factor follows the view. Nothing is drawn in background mode."""
+vertex shader. The control points are uploaded once, and again when either object moves, the control mesh is edited
+or a setting changes; with Factor From Camera each instance's factor follows the view. Nothing is drawn in
+background mode."""
 
 import bpy
 import numpy as np
@@ -13,13 +14,25 @@ from .settings import TOPIC, surface_from
 from .sources import control_points, instance_factors
 
 
+def _placement(ob):
+    """What the control points in ``ob``'s space depend on besides the control mesh: both objects' transforms."""
+    src = ob.tessera.surface.instance_object
+    key = np.array(ob.matrix_world).tobytes()
+    return key + (np.array(src.matrix_world).tobytes() if src is not None else b"")
+
+
 def entry_for(ob, camera=None):
-    """The live surface's draw data for ``camera`` (its factors), or None when it cannot be built."""
+    """The live surface's draw data for ``camera`` (its factors), or None when it cannot be built. Rebuilt when the
+    control mesh is edited, a setting changes, or either object moves."""
     from ...gpu_shaders.surfaces.draw import SurfaceDrawData
 
     src = ob.tessera.surface.instance_object
+    placement = _placement(ob)
+    cached = PREVIEW.cache.get(ob)
+    if cached is not None and cached.source[1] != placement:
+        PREVIEW.cache.forget(ob)
     entry = PREVIEW.entry(ob, lambda: PreviewEntry(None, data_uid=src.data.session_uid if src else None,
-                                                   source=(control_points(ob),)))
+                                                   source=(control_points(ob), placement)))
     if entry is None:
         return None
     points = entry.source[0]

@@ -85,6 +85,12 @@ def test_a_live_surface_draws_what_bake_surface_makes(clean_scene, gpu_renderer,
                                      size=(200, 200), color=(1, 1, 1, 1), lit=False)
     a, b = cpu[..., 0] > 127, gpu[..., 0] > 127
     assert a.sum() > 1500 and np.mean(a == b) >= 0.998
+    # moving the control mesh moves the surfaces (the preview rebuilds its points)
+    before = entry.source[0].copy()
+    points_ob.location.x += 1.0
+    bpy.context.view_layer.update()
+    moved = preview.entry_for(live, camera.Camera(cam.view @ model, cam.projection, 200, 200))
+    assert np.allclose(moved.source[0] - before, [1.0, 0.0, 0.0], atol=1e-6)
     # factors from the camera: near instances finer than far ones
     live.tessera.surface.factor_mode = "CAMERA"
     far = preview.instance_factors(live, preview.control_points(live),
