@@ -110,13 +110,16 @@ def traversal_rank(width, height, frame, eye):
     return rank.reshape(height, width)
 
 
-def _destinations(width, height, frame, eye, displacement):
-    """Nearest destination texel of every source texel: (flat index (N,) int64, inside (N,) bool)."""
+def _destinations(width, height, frame, eye, displacement, present=None):
+    """Nearest destination texel of every source texel: (flat index (N,) int64, inside (N,) bool); texels outside
+    ``present`` (H, W) bool (where the object is not: its image's background) go nowhere."""
     k = prewarp_constants(frame, eye)
     v, u = np.mgrid[0:height, 0:width]
     ui, vi, valid = prewarp(u + 0.5, v + 0.5, displacement, k)  # texel centres
     iu, iv = np.floor(np.where(valid, ui, -1.0)), np.floor(np.where(valid, vi, -1.0))
     inside = valid & (iu >= 0) & (iu < width) & (iv >= 0) & (iv < height)
+    if present is not None:
+        inside &= np.asarray(present, bool)
     flat = np.where(inside, iv * width + iu, 0).astype(np.int64).ravel()
     return flat, inside.ravel()
 
@@ -149,12 +152,13 @@ class Splat:
         return out.reshape(img.shape)
 
 
-def forward_splat(displacement, frame, eye):
+def forward_splat(displacement, frame, eye, present=None):
     """Paint every source texel at its pre-warped position in the occlusion-compatible order (the last painted
-    wins): a `Splat`. displacement: (H, W) float orthogonal displacements, row 0 at v = 0."""
+    wins): a `Splat`. displacement: (H, W) float orthogonal displacements, row 0 at v = 0; present: (H, W) bool, the
+    texels where the object is (None: all)."""
     d = np.asarray(displacement, np.float64)
     h, w = d.shape
-    dest, inside = _destinations(w, h, frame, eye, d)
+    dest, inside = _destinations(w, h, frame, eye, d, present)
     rank = traversal_rank(w, h, frame, eye).ravel()
     best = np.full(w * h, -1, np.int64)
     np.maximum.at(best, dest[inside], rank[inside])
@@ -164,11 +168,11 @@ def forward_splat(displacement, frame, eye):
     return Splat(source.reshape(h, w))
 
 
-def zbuffer_splat(displacement, frame, eye):
+def zbuffer_splat(displacement, frame, eye, present=None):
     """The oracle: the same splats, each destination keeping the texel nearest to ``eye`` (a depth buffer)."""
     d = np.asarray(displacement, np.float64)
     h, w = d.shape
-    dest, inside = _destinations(w, h, frame, eye, d)
+    dest, inside = _destinations(w, h, frame, eye, d, present)
     v, u = np.mgrid[0:h, 0:w]
     dist = np.linalg.norm(frame.point(u + 0.5, v + 0.5, d) - np.asarray(eye, np.float64), axis=-1).ravel()
     order = np.lexsort((dist[inside], dest[inside]))  # per destination, nearest first
@@ -180,9 +184,10 @@ def zbuffer_splat(displacement, frame, eye):
     return Splat(source.reshape(h, w))
 
 
-def _fill_rows(source):
+def _fill_rows(source, max_gap=None):
     """Each hole (-1) of each row takes the source of the nearest painted texel in its row (ties: the left one);
-    rows with nothing painted stay as they are."""
+    with ``max_gap``, only holes in a run bounded by painted texels on both sides and at most that long (the
+    object's outside, reaching the border or wider, stays empty). Rows with nothing painted stay as they are."""
     h, w = source.shape
     idx = np.broadcast_to(np.arange(w), (h, w))
     painted = source >= 0
@@ -191,13 +196,16 @@ def _fill_rows(source):
     use_left = (left >= 0) & ((right >= w) | (idx - left <= right - idx))
     pick = np.where(use_left, left, right)
     ok = (pick >= 0) & (pick < w)
+    if max_gap is not None:
+        ok &= (left >= 0) & (right < w) & (right - left - 1 <= max_gap)
     filled = np.take_along_axis(source, np.clip(pick, 0, w - 1), axis=1)
     return np.where(painted, source, np.where(ok, filled, -1))
 
 
-def fill_holes(splat):
+def fill_holes(splat, max_gap=None):
     """Two 1-D passes (the seed leaves the method open, errata 9; §B.4 suggests 1-D passes): holes take the nearest
-    painted texel of their row, then what is left the nearest of its column. A new `Splat` (holes only where the
-    image was empty)."""
-    rows = _fill_rows(splat.source)
-    return Splat(_fill_rows(rows.T).T)
+    painted texel of their row, then what is left the nearest of its column. ``max_gap`` (texels): fill only runs of
+    holes enclosed on both sides and at most that long, so an object's outline stays where it is (None: every hole
+    of a row or column with something painted). A new `Splat`."""
+    rows = _fill_rows(splat.source, max_gap)
+    return Splat(_fill_rows(rows.T, max_gap).T)

@@ -1,0 +1,85 @@
+"""A nailboard on the GPU (seed 003 §B.4.1, digest §B.11 items 4 and 5): the board is one quad on its plane; the
+fragment shader reads the offset map (the CPU pre-warp, `kernels.impostors.prewarp.forward_splat`) at its texel,
+fetches the source texel's colour (a dependent lookup, nearest) and writes the depth of that texel's relief point,
+so the board composites per texel with the rest of the scene (it intersects and occludes as the object would)."""
+
+import numpy as np
+
+from .. import loader
+
+
+def _describe():
+    import gpu
+
+    iface = gpu.types.GPUStageInterfaceInfo("tessera_board_iface")
+    iface.smooth("VEC2", "texel")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.push_constant("MAT4", "view_projection")
+    info.push_constant("VEC3", "origin")
+    info.push_constant("VEC3", "axis_a")
+    info.push_constant("VEC3", "axis_b")
+    info.push_constant("VEC3", "normal_f")
+    info.push_constant("VEC3", "light_dir")
+    info.push_constant("INT", "lit")
+    info.sampler(0, "FLOAT_2D", "offsets")
+    info.sampler(1, "FLOAT_2D", "colours")
+    info.sampler(2, "FLOAT_2D", "displacement")
+    info.sampler(3, "FLOAT_2D", "normals")
+    info.vertex_in(0, "VEC2", "corner")
+    info.vertex_out(iface)
+    info.fragment_out(0, "VEC4", "frag_color")
+    if hasattr(info, "depth_write"):  # 4.5+ declares it; 4.2's OpenGL takes gl_FragDepth as it is
+        info.depth_write("ANY")
+    info.vertex_source(loader.source("impostors/board_vert.glsl"))
+    info.fragment_source(loader.source("impostors/board_frag.glsl"))
+    return info
+
+
+def _texture(values, fmt):
+    import gpu
+
+    v = np.ascontiguousarray(values, np.float32)
+    h, w = v.shape[:2]
+    return gpu.types.GPUTexture((w, h), format=fmt, data=gpu.types.Buffer("FLOAT", v.size, v.ravel()))
+
+
+class BoardDrawData:
+    """GPU resources of one nailboard: frame (`kernels.impostors.prewarp.ReliefFrame`); colours (H, W, 4),
+    displacement (H, W) and normals (H, W, 3) of its source images; splat: the `Splat` of the current pre-warp."""
+
+    def __init__(self, frame, colours, displacement, splat, normals=None):
+        h, w = np.asarray(displacement).shape
+        self.frame, self.size = frame, (w, h)
+        self.colours = _texture(colours, "RGBA32F")
+        self.displacement = _texture(displacement, "R32F")
+        n = np.zeros((h, w, 4), np.float32)
+        if normals is not None:
+            n[..., :3] = normals
+        self.normals = _texture(n, "RGBA32F")
+        self.set_splat(splat)
+
+    def set_splat(self, splat):
+        """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel."""
+        self.offsets = _texture(splat.offsets, "RG32F")
+
+    def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
+        """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major."""
+        from gpu_extras.batch import batch_for_shader
+
+        shader = loader.shader("nailboard", _describe)
+        w, h = self.size
+        corners = np.array([[0, 0], [w, 0], [w, h], [0, h]], np.float32)
+        batch = batch_for_shader(shader, "TRIS", {"corner": corners}, indices=np.array([[0, 1, 2], [0, 2, 3]],
+                                                                                        np.int32))
+        shader.bind()
+        shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
+        f = self.frame
+        for name, value in (("origin", f.origin), ("axis_a", f.a), ("axis_b", f.b), ("normal_f", f.f),
+                            ("light_dir", light_dir)):
+            shader.uniform_float(name, tuple(float(x) for x in value))
+        shader.uniform_int("lit", 1 if lit else 0)
+        shader.uniform_sampler("offsets", self.offsets)
+        shader.uniform_sampler("colours", self.colours)
+        shader.uniform_sampler("displacement", self.displacement)
+        shader.uniform_sampler("normals", self.normals)
+        batch.draw(shader)

@@ -1,0 +1,103 @@
+"""A nailboard on the GPU (tier: gpu): the dependent lookup through the offset map gives the CPU pre-warped image
+bit for bit, and per-texel depth makes a relief sphere intersect a GPU-drawn plane where the real sphere does."""
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.blender, pytest.mark.gpu]
+
+
+def test_nearest_lookup_is_the_cpu_prewarp_bit_for_bit(gpu_renderer, addon_module):
+    pw = addon_module("kernels.impostors.prewarp")
+    board = addon_module("gpu_shaders.impostors.draw")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    rng = np.random.default_rng(0)
+    w, h = 96, 64
+    d = rng.uniform(0, 3, (h, w))
+    colours = np.ones((h, w, 4), np.float32)
+    colours[..., :3] = rng.integers(0, 256, (h, w, 3)) / 255.0  # 8-bit exact, as the offscreen reads back
+    frame = pw.ReliefFrame(np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0]))
+    splat = pw.forward_splat(d, frame, np.array([30.0, 20.0, 40.0]))
+    assert 0 < splat.hole_fraction < 0.5
+    data = board.BoardDrawData(frame, colours, d, splat)
+    # one board texel on one pixel: x, y scaled onto clip space, z kept inside it
+    vp = np.array([[2 / w, 0, 0, -1], [0, 2 / h, 0, -1], [0, 0, -0.01, 0], [0, 0, 0, 1]], np.float64)
+    gpu = offscreen.render(lambda: data.draw(vp), size=(w, h), background=(0, 0, 0, 1))
+    cpu = np.round(splat.gather(colours) * 255).astype(np.uint8)
+    cpu[splat.source < 0] = (0, 0, 0, 255)
+    assert np.array_equal(gpu, cpu)
+
+
+def sphere_relief(n, radius):
+    """A hemisphere of ``radius`` over an n x n board of side 2 radius centred at the origin: displacement (n, n) and
+    present (n, n) bool (where the sphere is)."""
+    c = (np.arange(n) + 0.5) / n * 2 * radius - radius
+    x, y = np.meshgrid(c, c)
+    r2 = x * x + y * y
+    present = r2 < radius * radius
+    d = np.sqrt(np.maximum(radius * radius - r2, 0.0))
+    return d, present
+
+
+def test_a_relief_sphere_meets_a_gpu_plane_where_the_real_sphere_does(gpu_renderer, addon_module):
+    pw = addon_module("kernels.impostors.prewarp")
+    board = addon_module("gpu_shaders.impostors.draw")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    camera = addon_module("kernels.common.camera")
+    n, radius = 384, 1.0
+    d, present = sphere_relief(n, radius)
+    s = 2 * radius / n
+    frame = pw.ReliefFrame(np.array([-radius, -radius, 0.0]), np.array([s, 0, 0]), np.array([0, s, 0]),
+                           np.array([0, 0, 1.0]))
+    eye = np.array([0.4, -1.2, 6.0])
+    splat = pw.fill_holes(pw.forward_splat(d, frame, eye, present), max_gap=4)  # inside the outline only
+    red = np.zeros((n, n, 4), np.float32)
+    red[..., 0], red[..., 3] = 1.0, 1.0
+    data = board.BoardDrawData(frame, red, d, splat)
+    cam = camera.Camera(camera.look_at_view(eye, (0, 0, 0.3)), camera.perspective(0.55, 1.0, 0.5, 50.0), 200, 200)
+    vp = cam.projection @ cam.view
+    # a plane through the sphere: z = 0.6 y + 0.55, green, drawn as two triangles: it cuts the visible cap
+    quad = np.array([[-3, -3, 0.6 * -3 + 0.55], [3, -3, 0.6 * -3 + 0.55], [3, 3, 0.6 * 3 + 0.55],
+                     [-3, 3, 0.6 * 3 + 0.55]], np.float32)
+    quad_tris = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    # ground truth: a fine sphere mesh and the plane
+    uu, vv = np.meshgrid(np.linspace(0, np.pi, 200), np.linspace(0, 2 * np.pi, 400), indexing="ij")
+    sph = np.stack([np.sin(uu) * np.cos(vv), np.sin(uu) * np.sin(vv), np.cos(uu)], -1).reshape(-1, 3) * radius
+    i, j = np.meshgrid(np.arange(199), np.arange(399), indexing="ij")
+    a = (i * 400 + j).ravel()
+    sph_tris = np.concatenate([np.stack([a, a + 400, a + 401], 1), np.stack([a, a + 401, a + 1], 1)]).astype(np.int32)
+
+    def truth():
+        offscreen_draw(offscreen, sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1))
+        offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))
+
+    def boarded():
+        offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))
+        data.draw(vp)
+
+    want = offscreen.render(truth, size=(200, 200))
+    got = offscreen.render(boarded, size=(200, 200))
+    alone = offscreen.render(lambda: offscreen_draw(offscreen, sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1)),
+                             size=(200, 200))[..., 0] > 127
+    sphere_want, sphere_got = want[..., 0] > 127, got[..., 0] > 127
+    assert sphere_want.sum() > 2000 and (alone & ~sphere_want).sum() > 1000  # the plane hides part of the sphere
+    diff = sphere_want != sphere_got
+    # every pixel that differs lies within 1 px of the true picture's sphere boundary (silhouette or the intersection)
+    pad = np.pad(sphere_want, 1, mode="edge")
+    windows = np.stack([pad[1 + dy:201 + dy, 1 + dx:201 + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+    boundary = windows.any(axis=0) & ~windows.all(axis=0)
+    assert not (diff & ~boundary).any(), int((diff & ~boundary).sum())
+    assert diff.sum() < 0.05 * boundary.sum() + 40
+
+
+def offscreen_draw(offscreen, positions, triangles, vp, colour):
+    """Draw triangles into the bound framebuffer with the flat-mesh shader (unlit), depth-tested."""
+    from gpu_extras.batch import batch_for_shader
+
+    shader = offscreen.loader.shader("flat_mesh", offscreen._describe_flat_mesh)
+    corners = positions[triangles].reshape(-1, 3)
+    nor = np.zeros_like(corners)
+    nor[:, 2] = 1
+    batch = batch_for_shader(shader, "TRIS", {"pos": corners, "nor": nor})
+    offscreen.set_shading(shader, vp, colour, False)
+    batch.draw(shader)
