@@ -63,6 +63,34 @@ def read_pixels(path, what, pixel_type, n_channels=None):
     return np.asarray(data).reshape(spec.height, spec.width, n)[::-1], fmt
 
 
+def read_channels(path, what, suffixes):
+    """Named channels of a float image, across its parts (a multilayer EXR keeps each pass in a part of its own:
+    "ViewLayer.Depth.Z", ...): for each suffix, the first channel whose name ends with it, as (H, W) float32 with row
+    0 at the bottom. A `TesseraError` naming a missing one."""
+    oiio, inp = _open(path, what)
+    found = {}
+    try:
+        part = 0
+        while inp.seek_subimage(part, 0):
+            spec = inp.spec()
+            data = inp.read_image(part, 0, 0, spec.nchannels, "float")
+            if data is None:
+                raise TesseraError(f"Reading {path} failed: {_reason(oiio, inp, 'the file is damaged or truncated')}")
+            data = np.asarray(data).reshape(spec.height, spec.width, spec.nchannels)[::-1]
+            for k, name in enumerate(spec.channelnames):
+                found.setdefault(name, data[..., k])
+            part += 1
+    finally:
+        inp.close()
+    out = []
+    for suffix in suffixes:
+        name = next((n for n in found if n.endswith(suffix)), None)
+        if name is None:
+            raise TesseraError(f"{path} has no channel ending in {suffix!r} (it has {', '.join(found)})")
+        out.append(np.ascontiguousarray(found[name], np.float32))
+    return out
+
+
 def _reason(oiio, handle, fallback):
     """OpenImageIO's error text (the handle's, then the global one), or ``fallback`` when it gives none."""
     text = ""

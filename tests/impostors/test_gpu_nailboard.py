@@ -101,3 +101,45 @@ def offscreen_draw(offscreen, positions, triangles, vp, colour):
     batch = batch_for_shader(shader, "TRIS", {"pos": corners, "nor": nor})
     offscreen.set_shading(shader, vp, colour, False)
     batch.draw(shader)
+
+
+def test_a_board_from_the_cycles_worker_stands_in_for_the_object(clean_scene, gpu_renderer, bpy_module, addon_module):
+    """The whole chain: the worker renders a sphere's board with Cycles, the CPU pre-warps it for the eye, the GPU
+    draws it with per-texel depth next to a plane through the sphere; the picture is the sphere mesh's and the plane's
+    within 1 px of their outline and intersection."""
+    bpy = bpy_module
+    pw = addon_module("kernels.impostors.prewarp")
+    board = addon_module("gpu_shaders.impostors.draw")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    camera = addon_module("kernels.common.camera")
+    worker = addon_module("addon.impostors.worker")
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0)
+    ball = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    eye = np.array([0.6, -5.5, 2.5])
+    images = worker.request_board(ball, eye, res_screen=200, fov=0.55, samples=1).result(timeout=240)
+    frame = images.setup.frame
+    splat = pw.fill_holes(pw.forward_splat(images.displacement, frame, eye, images.present), max_gap=4)
+    red = np.zeros(images.colours.shape, np.float32)
+    red[..., 0], red[..., 3] = 1.0, 1.0
+    data = board.BoardDrawData(frame, red, images.displacement, splat, images.normals)
+    cam = camera.Camera(camera.look_at_view(eye, (0, 0, 0)), camera.perspective(0.55, 1.0, 0.5, 50.0), 200, 200)
+    vp = cam.projection @ cam.view
+    me = ball.data
+    pos = np.array([v.co for v in me.vertices], np.float32)
+    me.calc_loop_triangles()
+    tris = np.array([t.vertices[:] for t in me.loop_triangles], np.int32)
+    quad = np.array([[-3, -3, -0.8], [3, -3, -0.8], [3, 3, 1.6], [-3, 3, 1.6]], np.float32)  # z = 0.4 y + 0.4
+    quad_tris = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    want = offscreen.render(lambda: (offscreen_draw(offscreen, pos, tris, vp, (1, 0, 0, 1)),
+                                     offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))), size=(200, 200))
+    got = offscreen.render(lambda: (offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1)), data.draw(vp)),
+                           size=(200, 200))
+    alone = offscreen.render(lambda: offscreen_draw(offscreen, pos, tris, vp, (1, 0, 0, 1)), size=(200, 200))
+    sphere_want, sphere_got = want[..., 0] > 127, got[..., 0] > 127
+    assert sphere_want.sum() > 1500 and ((alone[..., 0] > 127) & ~sphere_want).sum() > 500
+    pad = np.pad(sphere_want, 1, mode="edge")
+    windows = np.stack([pad[1 + dy:201 + dy, 1 + dx:201 + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+    boundary = windows.any(axis=0) & ~windows.all(axis=0)
+    diff = sphere_want != sphere_got
+    assert not (diff & ~boundary).any(), int((diff & ~boundary).sum())

@@ -1,0 +1,41 @@
+"""The nailboard worker (tier: blender): a separate Blender process renders a sphere alone with Cycles through the
+board's orthographic camera; the depth pass gives the sphere's displacements over the board, the alpha where it is,
+and the viewport side did not wait for it."""
+
+import time
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+def test_the_worker_renders_a_sphere_board(clean_scene, bpy_module, addon_module, tmp_path):
+    bpy = bpy_module
+    worker = addon_module("addon.impostors.worker")
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0, location=(0.5, 0.2, 0.1))
+    ball = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    bpy.ops.mesh.primitive_cube_add(location=(4, 4, 4))  # another object: left out of the board
+    eye = np.array([0.5, -7.0, 2.0])
+    t = time.perf_counter()
+    job = worker.request_board(ball, eye, res_screen=400, fov=np.radians(40), samples=2)
+    started = time.perf_counter() - t
+    assert not job.done() or started < 5  # the request returns without rendering
+    board = job.result(timeout=240)
+    setup = board.setup
+    n = setup.resolution
+    assert board.colours.shape == (n, n, 4) and 40 <= n <= 400
+    # where the sphere is: a disc of its radius in the middle of the board
+    c = (np.arange(n) + 0.5) / n * setup.size - setup.size / 2
+    x, y = np.meshgrid(c, c)
+    disc = x * x + y * y < 0.97 ** 2
+    ring = x * x + y * y > 1.03 ** 2
+    assert board.present[disc].all() and not board.present[ring].any()
+    # the depth pass: the front of the sphere, d = size / 2 + sqrt(1 - x^2 - y^2) over the board's back plane
+    want = setup.size / 2 + np.sqrt(np.maximum(1 - x * x - y * y, 0))
+    inner = x * x + y * y < 0.9 ** 2
+    assert np.abs(board.displacement[inner] - want[inner]).max() < 0.02
+    # the normals face the eye's side
+    f = setup.frame.f
+    assert (board.normals[inner] @ f > 0.3).all()
