@@ -29,11 +29,13 @@ _modules = (
     "addon.subdivision.panel",
     "addon.node_panel",
     "addon.surfaces.panel",
+    "addon.impostors.panel",
     "addon.tubes.preview",
     "addon.terrain.preview",
     "addon.tessellation.preview",
     "addon.subdivision.preview",
     "addon.surfaces.preview",
+    "addon.impostors.preview",
     "addon.displacement.brush_cursor",
     "addon.displacement.brush_tool",
 )

@@ -1,7 +1,7 @@
 """The one ``tessera`` pointer on each ID type that Tessera stores settings on.
 
-- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain``, ``loop``, ``surface`` (each
-  capability's settings);
+- ``Object.tessera``: ``tessellate``, ``tubes``, ``displacement``, ``terrain``, ``loop``, ``surface``,
+  ``nailboard`` (each capability's settings);
 - ``Scene.tessera``: ``brush`` (the displacement brush shared by the tool and stroke replays);
 - ``Image.tessera``: ``serial`` (strokes applied to a map image, for undo).
 
@@ -12,6 +12,7 @@ roots, then the pointers, so the order is written here and nowhere else.
 import bpy
 
 from .displacement import settings as displacement_settings
+from .impostors import settings as nailboard_settings
 from .subdivision import settings as loop_settings
 from .surfaces import settings as surface_settings
 from .terrain import settings as terrain_settings
@@ -19,7 +20,7 @@ from .tessellation import settings as tessellation_settings
 from .tubes import settings as tube_settings
 
 _SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings, loop_settings,
-             surface_settings)
+             surface_settings, nailboard_settings)
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
@@ -29,6 +30,7 @@ class TESSERA_PG_object(bpy.types.PropertyGroup):
     terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
     loop: bpy.props.PointerProperty(type=loop_settings.TESSERA_PG_loop)
     surface: bpy.props.PointerProperty(type=surface_settings.TESSERA_PG_surface)
+    nailboard: bpy.props.PointerProperty(type=nailboard_settings.TESSERA_PG_nailboard)
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):

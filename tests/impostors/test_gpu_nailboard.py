@@ -143,3 +143,39 @@ def test_a_board_from_the_cycles_worker_stands_in_for_the_object(clean_scene, gp
     boundary = windows.any(axis=0) & ~windows.all(axis=0)
     diff = sphere_want != sphere_got
     assert not (diff & ~boundary).any(), int((diff & ~boundary).sum())
+
+
+def test_the_viewport_draws_a_live_nailboard_without_waiting(clean_scene, gpu_renderer, bpy_module, addon_module):
+    """The viewport side: the first frame asks for a board (queued for a timer, nothing drawn, nothing waited for);
+    once the worker is done the next frame draws the object from it, pre-warped for that frame's eye."""
+    import time
+    from types import SimpleNamespace
+
+    bpy = bpy_module
+    preview = addon_module("addon.impostors.preview")
+    offscreen = addon_module("gpu_shaders.offscreen")
+    camera = addon_module("kernels.common.camera")
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0)
+    ball = bpy.context.active_object
+    mat = bpy.data.materials.new("Red")
+    addon_module("addon.compat").use_material_nodes(mat)
+    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (1, 0, 0, 1)
+    ball.data.materials.append(mat)
+    ball.tessera.nailboard.enabled = True
+    ball.tessera.nailboard.samples = 1
+    eye = np.array([0.5, -6.0, 2.0])
+    cam = camera.Camera(camera.look_at_view(eye, (0, 0, 0)), camera.perspective(0.6, 1.0, 0.5, 50.0), 160, 160)
+    context = SimpleNamespace(visible_objects=[ball])
+    region = SimpleNamespace(height=160, width=160)
+    t = time.perf_counter()
+    first = offscreen.render(lambda: preview._draw(context, region, cam.view, cam.projection), size=(160, 160))
+    assert time.perf_counter() - t < 2.0 and first[..., :3].max() == 0  # asked, not waited for: nothing yet
+    assert len(preview._queue) == 1
+    preview._start_queued()  # what the timer does outside the draw callback
+    live = preview.MANAGER.boards[ball.session_uid]
+    live.pending.job.result(timeout=240)
+    second = offscreen.render(lambda: preview._draw(context, region, cam.view, cam.projection), size=(160, 160))
+    assert live.images is not None and live.pending is None
+    drawn = second[..., :3].max(axis=-1) > 10
+    assert drawn.sum() > 1000 and (second[..., 0][drawn] >= second[..., 2][drawn]).all()
+    preview.MANAGER.boards.clear()

@@ -1,0 +1,103 @@
+"""Live nailboards (seed 003 §B.5–B.6): which board an object is drawn from, and when a new one is asked for.
+
+`NailboardManager.update(ob, eye, ...)` is called by the viewport every frame and never waits:
+- a finished render is swapped in (double buffer: the old board is drawn until the new one is there);
+- a new board is asked for when there is none, at once when the object moved (its transform is part of the board),
+  and otherwise only when the board fails the validity tests for this eye (`kernels.impostors.validity`: approach,
+  parallax, resolution with tolerance K; a relief-mapped board's parallax counts at ``relief_factor``) and no render
+  is already running;
+- a request first looks in a cache of recent boards for one made near this viewpoint that is still valid there
+  (returning to a viewpoint costs no render), and asks for the eye predicted ``lead`` frames ahead from the eye's
+  velocity (the render is ready by the time the camera gets there).
+The renderer is `addon.impostors.worker.request_board` (a separate process); the manager only needs its job's
+``done()`` and ``result()``.
+"""
+
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...kernels.impostors.validity import Board, check
+
+
+@dataclass
+class LiveBoard:
+    """One object's state: images and board (what it is drawn from, or None), the transform they were made with,
+    the running job, the eyes of the last frames (for the velocity), and the GPU draw data (set by the viewport)."""
+
+    images: object = None
+    board: Board = None
+    matrix: bytes = b""
+    pending: object = None
+    pending_board: Board = None
+    eyes: list = field(default_factory=list)
+    draw: object = None
+
+
+class NailboardManager:
+    """Boards of every nailboard object, by ``session_uid``. request(ob, eye, res_screen, fov) -> a job."""
+
+    def __init__(self, request, k=1.0, relief_factor=0.25, lead=0, cache_size=8):
+        self.request, self.k, self.relief_factor, self.lead = request, float(k), float(relief_factor), int(lead)
+        self.boards, self.cache = {}, OrderedDict()
+        self.cache_size = int(cache_size)
+        self.regenerations = 0
+        self.cache_hits = 0
+        self.reasons = []  # the `Verdict` of each regeneration a validity test asked for
+
+    def _box(self, ob):
+        from mathutils import Vector
+
+        corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
+        return corners.min(axis=0), corners.max(axis=0)
+
+    def update(self, ob, eye, res_screen, fov):
+        """The `LiveBoard` to draw ``ob`` from at ``eye`` this frame (its ``images`` may still be None)."""
+        eye = np.asarray(eye, np.float64)
+        live = self.boards.setdefault(ob.session_uid, LiveBoard())
+        live.eyes = (live.eyes + [eye])[-3:]
+        matrix = np.array(ob.matrix_world).tobytes()
+        if live.pending is not None and live.pending.done():
+            live.images, live.board, live.draw = live.pending.result(), live.pending_board, None
+            self.cache[(ob.session_uid, live.matrix, live.board.eye.tobytes())] = (live.images, live.board)
+            while len(self.cache) > self.cache_size:
+                self.cache.popitem(last=False)
+            live.pending = None
+        moved = live.matrix != matrix
+        if moved:
+            if live.pending is not None:
+                live.pending.cancel()
+                live.pending = None
+            live.images, live.board, live.draw, live.matrix = None, None, None, matrix
+        verdict = None if live.board is None else check(live.board, eye, fov, res_screen, self.k, self.relief_factor)
+        stale = verdict is None or verdict.regenerate
+        if stale and live.pending is None:
+            if verdict is not None:
+                self.reasons.append(verdict)
+            hit = self._cached(ob, matrix, eye, res_screen, fov)
+            if hit is not None:
+                live.images, live.board, live.draw = hit[0], hit[1], None
+                self.cache_hits += 1
+            else:
+                self._ask(ob, live, eye, res_screen, fov)
+        return live
+
+    def _cached(self, ob, matrix, eye, res_screen, fov):
+        for key in reversed(self.cache):
+            if key[:2] != (ob.session_uid, matrix):
+                continue
+            images, board = self.cache[key]
+            if not check(board, eye, fov, res_screen, self.k, self.relief_factor).regenerate:
+                return images, board
+        return None
+
+    def _ask(self, ob, live, eye, res_screen, fov):
+        target = eye
+        if self.lead and len(live.eyes) >= 2:  # velocity prediction, `lead` frames ahead
+            target = eye + self.lead * (live.eyes[-1] - live.eyes[-2])
+        lo, hi = self._box(ob)
+        job = self.request(ob, target, res_screen, fov)
+        live.pending = job
+        live.pending_board = Board(np.asarray(target, np.float64), lo, hi, job.setup.resolution)
+        self.regenerations += 1

@@ -1,0 +1,103 @@
+"""Live nailboards in the 3D viewport: objects with ``tessera.nailboard.enabled`` are drawn from their current
+board (`live.NailboardManager`), pre-warped for the eye every frame on the CPU (8 bytes a texel uploaded) and drawn
+by the GPU with per-texel depth. The draw callback never waits: a board is asked for through a timer (a draw
+callback may not save files or start processes), rendered by the worker process, and swapped in when done. Nothing
+is drawn in background mode."""
+
+import bpy
+import numpy as np
+
+from ...kernels.impostors.board import board_setup
+from ...kernels.impostors.prewarp import fill_holes, forward_splat
+from ..viewport import Preview, tag_view3d_redraw
+from . import worker
+from .live import NailboardManager
+from .settings import TOPIC
+
+_queue = []
+HOLE_GAP = 4  # texels: gaps a pre-warp may open inside an object's outline
+
+
+class DeferredJob:
+    """A board asked for from a draw callback: started by a timer, then the worker's `BoardJob`."""
+
+    def __init__(self, ob, eye, res_screen, fov, samples):
+        from mathutils import Vector
+
+        corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
+        self.setup = board_setup(corners.min(axis=0), corners.max(axis=0), eye, res_screen, fov)
+        self.args, self.name, self.job = (eye, res_screen, fov, samples), ob.name, None
+        _queue.append(self)
+        if not bpy.app.timers.is_registered(_start_queued):
+            bpy.app.timers.register(_start_queued, first_interval=0.0)
+
+    def done(self):
+        return self.job is not None and self.job.done()
+
+    def result(self):
+        return self.job.result()
+
+    def cancel(self):
+        if self.job is not None:
+            self.job.cancel()
+        elif self in _queue:
+            _queue.remove(self)
+
+
+def _start_queued():
+    while _queue:
+        job = _queue.pop(0)
+        ob = bpy.data.objects.get(job.name)
+        if ob is not None:
+            eye, res, fov, samples = job.args
+            job.job = worker.request_board(ob, eye, res, fov, samples=samples)
+    return None
+
+
+def _poll_jobs():
+    """Redraw while a board is being rendered, so it is swapped in when done."""
+    busy = any(live.pending is not None for live in MANAGER.boards.values())
+    if busy:
+        tag_view3d_redraw()
+        return 0.25
+    return None
+
+
+def _request(ob, eye, res_screen, fov):
+    job = DeferredJob(ob, eye, res_screen, fov, ob.tessera.nailboard.samples)
+    if not bpy.app.timers.is_registered(_poll_jobs):
+        bpy.app.timers.register(_poll_jobs, first_interval=0.25)
+    return job
+
+
+MANAGER = NailboardManager(_request)
+
+
+def _draw(context, region, view, proj):
+    from ...gpu_shaders.impostors.draw import BoardDrawData
+
+    eye = np.linalg.inv(view)[:3, 3]
+    fov = 2.0 * np.arctan(1.0 / proj[1, 1])
+    for ob in context.visible_objects:
+        s = ob.tessera.nailboard
+        if not s.enabled or ob.type != "MESH":
+            continue
+        MANAGER.k, MANAGER.relief_factor, MANAGER.lead = s.tolerance, 0.25 if s.relief else 1.0, s.lead
+        live = MANAGER.update(ob, eye, region.height, fov)
+        images = live.images
+        if images is None:
+            continue
+        frame = images.setup.frame
+        # relief mapping: pre-warped for this eye; a plain sprite: for the eye it was made for
+        target = eye if s.relief else live.board.eye
+        splat = fill_holes(forward_splat(images.displacement, frame, target, images.present), HOLE_GAP)
+        if live.draw is None:
+            live.draw = BoardDrawData(frame, images.colours, images.displacement, splat, images.normals)
+        else:
+            live.draw.set_splat(splat)
+        live.draw.draw(proj @ view)
+
+
+PREVIEW = Preview(_draw, topic=TOPIC, on_settings=lambda ob: MANAGER.boards.pop(getattr(ob, "session_uid", None),
+                                                                                  None))
+register, unregister = PREVIEW.register, PREVIEW.unregister

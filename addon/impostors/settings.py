@@ -1,0 +1,31 @@
+"""Nailboard settings: ``Object.tessera.nailboard`` (sidebar › Tessera › Nailboard)."""
+
+import bpy
+
+from ..viewport import invalidator
+
+#: The invalidation topic of these settings (`addon.viewport`).
+TOPIC = "nailboard"
+_changed = invalidator(TOPIC)
+
+
+class TESSERA_PG_nailboard(bpy.types.PropertyGroup):
+    enabled: bpy.props.BoolProperty(
+        name="Nailboard", default=False, update=_changed,
+        description="Draw this object in the viewport from a board rendered by Cycles in a background process "
+                    "(colour, depth and normals), regenerated when the view makes it invalid; hide the object to see "
+                    "only the board")
+    relief: bpy.props.BoolProperty(name="Relief Mapping", default=True, update=_changed,
+                                   description="Pre-warp the board for the eye (parallax corrected, per-texel "
+                                               "depth); off: a plain sprite, regenerated sooner")
+    tolerance: bpy.props.FloatProperty(name="Tolerance K", default=1.5, min=0.1, max=100.0, update=_changed,
+                                       description="How many screen pixels a board texel or its error may grow to "
+                                                   "before the board is made again (seed eq. 9)")
+    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, update=_changed,
+                                   description="Cycles samples per board")
+    lead: bpy.props.IntProperty(name="Prediction", default=4, min=0, max=120, update=_changed,
+                                description="Ask for the board the camera will need this many frames ahead")
+
+
+classes = (TESSERA_PG_nailboard,)
+register, unregister = bpy.utils.register_classes_factory(classes)

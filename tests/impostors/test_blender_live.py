@@ -1,0 +1,89 @@
+"""When a live nailboard asks for a new board (seed 003 §B.6, digest §B.11 items 7, 10 and 11), on scripted camera
+paths (tier: blender): a static camera never; a dolly-in from the approach and resolution tests only; a strafe from
+parallax; an object move at once; a return to an earlier viewpoint from the cache; prediction asks ahead. The
+renderer here finishes at once (the real one, a separate process, is tested in test_blender_worker.py)."""
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+FOV, RES = np.radians(50), 800
+
+
+class InstantJob:
+    def __init__(self, setup):
+        self.setup = setup
+
+    def done(self):
+        return True
+
+    def result(self):
+        return self.setup
+
+    def cancel(self):
+        pass
+
+
+def manager(addon_module, **kw):
+    live = addon_module("addon.impostors.live")
+    board = addon_module("kernels.impostors.board")
+    asked = []
+
+    def request(ob, eye, res_screen, fov):
+        from mathutils import Vector
+
+        corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
+        asked.append(np.array(eye))
+        return InstantJob(board.board_setup(corners.min(0), corners.max(0), eye, res_screen, fov))
+
+    return live.NailboardManager(request, **kw), asked
+
+
+def run(m, ob, eyes):
+    for eye in eyes:
+        m.update(ob, eye, RES, FOV)
+
+
+def test_static_camera_then_dolly_then_strafe(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, _ = manager(addon_module)
+    run(m, ob, [np.array([0.0, -12.0, 0.0])] * 30)
+    assert m.regenerations == 1 and m.reasons == []  # the first board, then nothing
+    run(m, ob, [np.array([0.0, y, 0.0]) for y in np.linspace(-12, -4, 40)])  # dolly in
+    assert m.regenerations > 1
+    assert all(not r.parallax and (r.approach or r.resolution) for r in m.reasons)
+    before = m.regenerations
+    m.reasons.clear()
+    run(m, ob, [np.array([x, -4.0, 0.0]) for x in np.linspace(0, 3, 40)])  # strafe
+    assert m.regenerations > before and m.reasons[0].parallax
+
+
+def test_object_move_is_immediate_and_the_cache_serves_a_return(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, asked = manager(addon_module)
+    a, b = np.array([0.0, -12.0, 0.0]), np.array([9.0, -8.0, 0.0])
+    run(m, ob, [a, a, b, b])
+    assert m.regenerations == 2
+    run(m, ob, [a])  # back where the first board was made: from the cache, no render
+    assert m.regenerations == 2 and m.cache_hits == 1
+    ob.location.x += 0.5
+    bpy.context.view_layer.update()
+    run(m, ob, [a])
+    assert m.regenerations == 3  # moved: at once, even with the camera still
+
+
+def test_prediction_asks_for_the_eye_ahead(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, asked = manager(addon_module, lead=5)
+    eyes = [np.array([0.0, -12.0 + 0.2 * k, 0.0]) for k in range(3)]
+    run(m, ob, eyes[:1])
+    m.boards[ob.session_uid].board = None  # force a request on the next frame, with a velocity known
+    run(m, ob, eyes[1:2])
+    assert np.allclose(asked[-1], eyes[1] + 5 * (eyes[1] - eyes[0]))
