@@ -25,6 +25,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   curvature levels and distance levels for the camera, wireframe;
 - ``out/demo_lic.png``: line-integral-convolution textures of the ABC flow and a vortex
   (``tessera.vector_field_texture``);
+- ``out/demo_nailboard.png``: a Cycles-rendered Suzanne drawn by the GPU from its nailboard (rendered by the
+  background worker, pre-warped, per-texel depth) among GPU-drawn geometry: the floor cuts through it;
 - ``out/demo_gpu_preview.png``: the live preview's renderer, offscreen: adaptive PN Suzannes drawn from instanced
   refinement patterns, lit / with the output wireframe / displaced by a map sampled in the vertex shader;
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
@@ -354,6 +356,75 @@ def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
     return total
 
 
+def build_nailboard_picture(name="demo_nailboard.png", size=(1280, 620)):
+    """A glossy Suzanne rendered by Cycles in the nailboard worker (a separate process), drawn by the GPU from its
+    board, pre-warped for the eye, with per-texel depth: the GPU-drawn floor cuts through it and a GPU-drawn cube
+    stands in front of it. Returns (board texels a side, seconds the worker took)."""
+    mods = {n: __import__(f"bl_ext.tessera_demo.tessera.{n}", fromlist=["x"]) for n in (
+        "addon.gpu_context", "addon.impostors.worker", "kernels.impostors.prewarp", "kernels.common.camera",
+        "gpu_shaders.impostors.draw", "gpu_shaders.offscreen")}
+    mods["addon.gpu_context"].ensure_gpu_context()
+    clear_scene()
+    bpy.ops.mesh.primitive_monkey_add(location=(0.0, 0.0, 0.35))
+    monkey = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    mat = bpy.data.materials.new("Gloss")
+    _addon_module("addon.compat").use_material_nodes(mat)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.8, 0.12, 0.05, 1.0)
+    bsdf.inputs["Metallic"].default_value = 0.6
+    bsdf.inputs["Roughness"].default_value = 0.25
+    monkey.data.materials.append(mat)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.rotation_euler = (0.7, 0.2, 0.5)
+    sun.data.energy = 4.0
+    bpy.context.scene.collection.objects.link(sun)
+    eye = np.array([1.8, -5.2, 2.3])
+    t0 = time.perf_counter()
+    images = mods["addon.impostors.worker"].request_board(monkey, eye, res_screen=size[1], fov=0.75,
+                                                          samples=32).result(timeout=600)
+    seconds = time.perf_counter() - t0
+    pw = mods["kernels.impostors.prewarp"]
+    frame = images.setup.frame
+    splat = pw.fill_holes(pw.forward_splat(images.displacement, frame, eye, images.present), 4)
+    colours = images.colours.copy()
+    colours[..., :3] = np.clip(colours[..., :3], 0, 1) ** (1 / 2.2)  # linear render -> display
+    board = mods["gpu_shaders.impostors.draw"].BoardDrawData(frame, colours, images.displacement, splat)
+    camera = mods["kernels.common.camera"]
+    cam = camera.Camera(camera.look_at_view(eye, (0.0, 0.0, 0.2)), camera.perspective(0.75, size[0] / size[1],
+                                                                                      0.5, 60.0), *size)
+    vp = cam.projection @ cam.view
+    offscreen = mods["gpu_shaders.offscreen"]
+    floor = np.array([[-4, -4, 0.0], [4, -4, 0.0], [4, 4, 0.0], [-4, 4, 0.0]], np.float32)
+    floor_tris = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    cube = np.array([[x, y, z] for z in (0, 0.7) for y in (-1.9, -1.2) for x in (0.3, 1.0)], np.float32)
+    cube_tris = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
+                          [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], np.int32)
+    shader = offscreen.loader.shader("flat_mesh", offscreen._describe_flat_mesh)
+
+    def mesh(positions, tris, colour):
+        from gpu_extras.batch import batch_for_shader
+
+        corners = positions[tris].reshape(-1, 3)
+        n = np.cross(corners[1::3] - corners[0::3], corners[2::3] - corners[0::3])
+        n = np.repeat(n / np.linalg.norm(n, axis=1, keepdims=True), 3, axis=0).astype(np.float32)
+        offscreen.set_shading(shader, vp, colour, True)
+        batch_for_shader(shader, "TRIS", {"pos": corners, "nor": n}).draw(shader)
+
+    def draw():
+        mesh(floor, floor_tris, (0.55, 0.6, 0.65, 1.0))
+        mesh(cube, cube_tris, (0.3, 0.55, 0.8, 1.0))
+        board.draw(vp)
+
+    pixels = offscreen.render(draw, size, background=(0.9, 0.9, 0.92, 1.0))
+    image = bpy.data.images.new("demo_nailboard", size[0], size[1], alpha=True)
+    image.pixels.foreach_set((pixels.astype(np.float32) / 255.0).ravel())
+    image.filepath_raw = str(OUT / name)
+    image.file_format = "PNG"
+    image.save()
+    return images.setup.resolution, seconds
+
+
 def build_loop_scene():
     """Suzanne as Add > Monkey gives it, Loop level 2 of it, and a cube whose top edges are marked sharp at Loop
     level 3 (the crease stays a crisp curve); returns [(name, triangles, seconds)]."""
@@ -673,11 +744,13 @@ def main():
     print(f"demo: the teapot's body by Tessellate Surface, curvature / distance levels: {counts} triangles")
     seconds = build_lic_picture()
     print(f"demo: vector-field textures (ABC flow, vortex) in {seconds:.1f} s")
+    texels, seconds = build_nailboard_picture()
+    print(f"demo: a Cycles-rendered Suzanne as a {texels}² nailboard among GPU geometry (worker: {seconds:.1f} s)")
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
                  "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
-                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png", "demo_teapot.png"):
+                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png", "demo_teapot.png", "demo_nailboard.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")
