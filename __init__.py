@@ -19,6 +19,7 @@ _modules = (
     "operators.terrain",
     "operators.subdivision",
     "operators.surfaces",
+    "operators.impostors",
     "operators.node_groups",
     "addon.node_library",
     "addon.menus",

@@ -33,7 +33,7 @@ class BoardImages:
     present: np.ndarray
 
 
-def _command(blend, args):
+def worker_command(blend, args):
     """The worker's command line: the blender binary where there is one, else this Python with the bpy module."""
     binary = getattr(bpy.app, "binary_path", "")
     if binary and os.path.basename(binary).lower().startswith("blender") and os.path.isfile(binary):
@@ -41,7 +41,7 @@ def _command(blend, args):
     return [sys.executable, str(SCRIPT), "--", blend, *args]
 
 
-def _nice():
+def lower_priority():
     if hasattr(os, "nice"):
         os.nice(10)  # below the viewport's priority (seed: the CPU cluster's "low-priority thread")
 
@@ -93,9 +93,9 @@ def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL"):
     log = open(os.path.join(folder, "worker.log"), "wb")  # a file, not a pipe: a chatty worker never stalls
     kwargs = {"stdout": log, "stderr": subprocess.STDOUT}
     if os.name == "posix":
-        kwargs["preexec_fn"] = _nice
+        kwargs["preexec_fn"] = lower_priority
     try:
-        process = subprocess.Popen(_command(blend, args), **kwargs)
+        process = subprocess.Popen(worker_command(blend, args), **kwargs)
     finally:
         log.close()
     return BoardJob(setup, process, folder, out)

@@ -283,7 +283,7 @@ def test_every_numeric_setting_has_a_finite_range(clean_scene, bpy_module):
 
 def _setup_for(bpy, name, tmp_path):
     """Make the context ``tessera.<name>`` runs in; returns the keyword arguments it needs besides the NaN."""
-    if name in ("tessellate", "displacement_add", "bake_lighting_hce"):
+    if name in ("tessellate", "displacement_add", "bake_lighting_hce", "impostor_bake"):
         bpy.ops.mesh.primitive_monkey_add()
         return {}
     if name == "tubes":

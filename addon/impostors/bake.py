@@ -1,0 +1,178 @@
+"""Baked impostors (issue "Nailboards", item 4): an object rendered by Cycles from N x N directions of an octahedral
+(or hemi-octahedral) atlas (`kernels.impostors.octahedral`) into colour, normal and depth atlases, and a card that
+faces the camera whose material picks the view of the camera's direction: the impostor works in EEVEE and Cycles
+renders without the object. All views are rendered by one worker process, one after the other."""
+
+import json
+import os
+import subprocess
+import tempfile
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+from ...kernels.common.errors import TesseraError
+from ...kernels.common.image_io import read_channels
+from ...kernels.impostors.octahedral import view_directions
+from ..node_groups import Graph
+from .worker import lower_priority, worker_command
+
+
+@dataclass
+class Atlas:
+    """colour (S, S, 4) straight alpha, normal (S, S, 3), depth (S, S) in [0, 1] (0 at the front of the bounding
+    sphere, 1 at its back, 1 where empty), S = grid * tile; row 0 at v = 0; centre (3,), size (the bounding sphere's
+    diameter), grid, hemi."""
+
+    colour: np.ndarray
+    normal: np.ndarray
+    depth: np.ndarray
+    centre: np.ndarray
+    size: float
+    grid: int
+    hemi: bool
+
+
+def view_camera(direction, centre, size):
+    """Location, forward and up of the orthographic camera of a view (``direction`` from the object to it)."""
+    f = np.asarray(direction, np.float64)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(f[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    right = np.cross(helper, f)
+    right /= np.linalg.norm(right)
+    return centre + f * size, -f, np.cross(f, right)
+
+
+def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600):
+    """Render ``ob`` (world space) from every view of the atlas and assemble the atlases: an `Atlas`."""
+    from mathutils import Vector
+
+    corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
+    if not size > 0:
+        raise TesseraError(f"{ob.name!r} has no extent to bake")
+    folder = tempfile.mkdtemp(prefix="tessera-impostor-")
+    blend = os.path.join(folder, "scene.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
+    dirs = view_directions(grid, hemi)
+    views = []
+    for j in range(grid):
+        for i in range(grid):
+            loc, fwd, up = view_camera(dirs[j, i], centre, size)
+            views.append({"location": loc.tolist(), "forward": fwd.tolist(), "up": up.tolist(),
+                          "out": os.path.join(folder, f"view_{j}_{i}.exr")})
+    job = {"blend": blend, "object": ob.name, "resolution": int(tile), "samples": int(samples), "scale": size,
+           "clip": 2.0 * size, "views": views}
+    spec = os.path.join(folder, "views.json")
+    with open(spec, "w", encoding="utf-8") as f:
+        json.dump(job, f)
+    command = worker_command(blend, ["--views", spec])
+    command[command.index("--") + 1:] = ["--views", spec]  # the views file names the blend file itself
+    with open(os.path.join(folder, "worker.log"), "wb") as log:
+        kwargs = {"preexec_fn": lower_priority} if os.name == "posix" else {}
+        done = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, timeout=timeout, check=False, **kwargs)
+    if done.returncode != 0:
+        tail = open(os.path.join(folder, "worker.log"), encoding="utf-8", errors="replace").read()[-600:]
+        raise TesseraError(f"Baking the impostor failed (exit {done.returncode}): {tail}")
+    s = grid * tile
+    colour, normal, depth = np.zeros((s, s, 4), np.float32), np.zeros((s, s, 3), np.float32), np.ones((s, s))
+    for view in views:
+        j, i = (int(x) for x in os.path.basename(view["out"])[5:-4].split("_"))
+        r, g, b, a, z, nx, ny, nz = read_channels(view["out"], "impostor view", (
+            "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
+        rows, cols = slice(j * tile, (j + 1) * tile), slice(i * tile, (i + 1) * tile)
+        alpha = np.maximum(a, 1e-6)[..., None]
+        colour[rows, cols] = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1)
+        normal[rows, cols] = np.stack([nx, ny, nz], -1)
+        depth[rows, cols] = np.where(a > 0.5, np.clip(z / size - 0.5, 0, 1), 1.0)
+    return Atlas(colour, normal, depth, centre, size, int(grid), bool(hemi))
+
+
+def _image(name, pixels):
+    """A packed float image of ``pixels`` (H, W, C <= 4), the channels padded to RGBA."""
+    h, w, c = pixels.shape
+    rgba = np.ones((h, w, 4), np.float32)
+    rgba[..., :c] = pixels
+    image = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
+    image.pixels.foreach_set(rgba.ravel())
+    image.update()
+    image.pack()
+    return image
+
+
+def octahedral_uv(g, direction, hemi):
+    """Shader-node arithmetic of `kernels.impostors.octahedral.encode`: direction (a vector socket) -> (u, v)."""
+    x, y, z = g.split(direction)
+    total = g.math("ADD", g.math("ADD", g.math("ABSOLUTE", x), g.math("ABSOLUTE", y)), g.math("ABSOLUTE", z))
+    px, py = g.math("DIVIDE", x, total), g.math("DIVIDE", y, total)
+    if hemi:
+        u, v = g.math("ADD", px, py), g.math("SUBTRACT", px, py)
+    else:
+        fold = g.math("LESS_THAN", z, 0.0)
+        sx = g.math("SUBTRACT", g.math("MULTIPLY", g.math("GREATER_THAN", px, -1e-30), 2.0), 1.0)
+        sy = g.math("SUBTRACT", g.math("MULTIPLY", g.math("GREATER_THAN", py, -1e-30), 2.0), 1.0)
+        uf = g.math("MULTIPLY", g.math("SUBTRACT", 1.0, g.math("ABSOLUTE", py)), sx)
+        vf = g.math("MULTIPLY", g.math("SUBTRACT", 1.0, g.math("ABSOLUTE", px)), sy)
+        u = g.math("ADD", px, g.math("MULTIPLY", fold, g.math("SUBTRACT", uf, px)))
+        v = g.math("ADD", py, g.math("MULTIPLY", fold, g.math("SUBTRACT", vf, py)))
+    return g.math("ADD", g.math("MULTIPLY", u, 0.5), 0.5), g.math("ADD", g.math("MULTIPLY", v, 0.5), 0.5)
+
+
+def card_material(name, colour_image, grid, hemi):
+    """The card's material: the view direction (Incoming, world space) picks its atlas cell, the card's UVs the
+    texel inside it; the atlas's colour is emitted as it was rendered, its alpha mixes in transparency."""
+    mat = bpy.data.materials.new(name)
+    if mat.node_tree is None:
+        mat.use_nodes = True
+    tree = mat.node_tree
+    tree.nodes.clear()
+    g = Graph(tree)
+    incoming = g.node("ShaderNodeNewGeometry").outputs["Incoming"]
+    u, v = octahedral_uv(g, incoming, hemi)
+    n = float(grid)
+
+    def cell(t):
+        return g.math("MINIMUM", g.math("MAXIMUM", g.math("FLOOR", g.math("MULTIPLY", t, n)), 0.0), n - 1)
+
+    card = g.split(g.node("ShaderNodeTexCoord").outputs["UV"])
+    atlas = g.xyz(g.math("DIVIDE", g.math("ADD", cell(u), card[0]), n),
+                  g.math("DIVIDE", g.math("ADD", cell(v), card[1]), n), 0.0)
+    tex = g.node("ShaderNodeTexImage", [("Vector", atlas)], image=colour_image, interpolation="Closest",
+                 extension="EXTEND")
+    emit = g.node("ShaderNodeEmission", [("Color", tex.outputs["Color"]), ("Strength", 1.0)])
+    clear = g.node("ShaderNodeBsdfTransparent")
+    mix = g.node("ShaderNodeMixShader", [(0, tex.outputs["Alpha"]), (1, clear.outputs[0]), (2, emit.outputs[0])])
+    out = g.node("ShaderNodeOutputMaterial")
+    tree.links.new(mix.outputs[0], out.inputs["Surface"])
+    if hasattr(mat, "blend_method"):  # EEVEE (4.2 Legacy): let the alpha through
+        try:
+            mat.blend_method = "HASHED"
+        except (AttributeError, TypeError):
+            pass
+    return mat
+
+
+def make_card(name, atlas, images, scene_camera):
+    """A square card as big as the bounding sphere at its centre, facing ``scene_camera`` (Track To) when there is
+    one, with the atlas material: a new object (not linked)."""
+    half = atlas.size / 2
+    me = bpy.data.meshes.new(name)
+    me.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
+    uv = me.uv_layers.new(name="UVMap")
+    uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32))
+    me.materials.append(card_material(name, images["colour"], atlas.grid, atlas.hemi))
+    card = bpy.data.objects.new(name, me)
+    card.location = tuple(atlas.centre)
+    if scene_camera is not None:
+        track = card.constraints.new("TRACK_TO")
+        track.target, track.track_axis, track.up_axis = scene_camera, "TRACK_Z", "UP_Y"
+    return card
+
+
+def atlas_images(name, atlas):
+    return {"colour": _image(f"{name} colour", atlas.colour),
+            "normal": _image(f"{name} normal", atlas.normal * 0.5 + 0.5),
+            "depth": _image(f"{name} depth", atlas.depth[..., None])}
+
+

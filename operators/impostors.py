@@ -1,0 +1,57 @@
+"""``tessera.impostor_bake``: the active object baked into an octahedral impostor (colour, normal and depth atlases
+rendered by Cycles in a worker process) on a card that faces the camera, for EEVEE and Cycles renders."""
+
+import bpy
+
+from ..addon.guarded import guarded
+from ..addon.impostors.bake import atlas_images, bake_atlas, make_card
+from .selection import select_only
+
+
+class TESSERA_OT_impostor_bake(bpy.types.Operator):
+    """Bake the active object into an impostor: views from an octahedral set of directions rendered by Cycles into
+    atlases, on a card that faces the scene camera and shows the view of its direction"""
+
+    bl_idname = "tessera.impostor_bake"
+    bl_label = "Bake Impostor"
+    bl_options = {"REGISTER", "UNDO"}
+
+    grid: bpy.props.IntProperty(name="Views", default=8, min=1, max=32, description="Views a side of the atlas")
+    tile: bpy.props.IntProperty(name="View Size", default=128, min=8, max=2048, description="Pixels a view")
+    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, description="Cycles samples a view")
+    hemi: bpy.props.BoolProperty(name="Upper Hemisphere", default=False,
+                                 description="Views only from above (hemi-octahedral): finer for objects on the "
+                                             "ground")
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        if context.mode != "OBJECT" or ob is None or ob.type not in {"MESH", "CURVE", "SURFACE", "META", "FONT"}:
+            cls.poll_message_set("Select an object with geometry in Object Mode")
+            return False
+        return True
+
+    @guarded
+    def execute(self, context, tx):
+        ob = context.active_object
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            atlas = bake_atlas(ob, self.grid, self.tile, self.samples, self.hemi)
+        finally:
+            wm.progress_end()
+        name = f"{ob.name} impostor"
+        images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}
+        card = make_card(name, atlas, images, context.scene.camera)
+        tx.track(card.data)
+        tx.track(card.data.materials[0])
+        tx.track(card)
+        context.collection.objects.link(card)
+        select_only(context, [card])
+        note = "" if context.scene.camera else " (no scene camera: add a Track To constraint to the camera)"
+        self.report({"INFO"}, f"{name}: {self.grid}x{self.grid} views of {self.tile}px{note}")
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_impostor_bake,)
+register, unregister = bpy.utils.register_classes_factory(classes)

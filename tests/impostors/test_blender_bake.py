@@ -1,0 +1,67 @@
+"""Bake Impostor (tier: blender): a box rendered by Cycles from a 3 x 3 octahedral set of views into atlases, on a
+card facing the camera; rendered by Cycles from a view's direction, the card shows that view (its silhouette's area
+is the atlas tile's), for two views whose silhouettes differ."""
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+def coverage(alpha):
+    return float((alpha > 0.5).mean())
+
+
+def render_alpha(bpy, path, size=48):
+    import OpenImageIO as oiio
+
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples, scene.cycles.device = 1, "CPU"
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = True
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGBA"
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    inp = oiio.ImageInput.open(str(path))
+    px = np.asarray(inp.read_image(0, 0, 0, 4, "float")).reshape(size, size, 4)
+    inp.close()
+    return px[..., 3]
+
+
+def test_the_card_shows_the_view_of_its_direction(clean_scene, bpy_module, addon_module, tmp_path):
+    bpy = bpy_module
+    oc = addon_module("kernels.impostors.octahedral")
+    bake = addon_module("addon.impostors.bake")
+    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))  # long in x: its views differ
+    box = bpy.context.active_object
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    bpy.context.scene.camera = cam
+    bpy.context.view_layer.objects.active = box
+    assert bpy.ops.tessera.impostor_bake(grid=3, tile=32, samples=1) == {"FINISHED"}
+    card = bpy.context.active_object
+    assert card.name == "Cube impostor" and card.constraints[0].target == cam
+    colour = bpy.data.images["Cube impostor colour"]
+    assert tuple(colour.size) == (96, 96) and colour.packed_file is not None
+    px = np.empty(96 * 96 * 4, np.float32)
+    colour.pixels.foreach_get(px)
+    alpha = px.reshape(96, 96, 4)[..., 3]
+    tiles = {(i, j): coverage(alpha[j * 32:(j + 1) * 32, i * 32:(i + 1) * 32]) for i in range(3) for j in range(3)}
+    assert all(c > 0.02 for c in tiles.values())
+    (i1, j1), (i2, j2) = (1, 1), (2, 1)  # straight down z; and a view from +x, where the box is short
+    assert abs(tiles[(i1, j1)] - tiles[(i2, j2)]) > 0.05
+    box.hide_render = True
+    dirs = oc.view_directions(3)
+    size = float(np.linalg.norm(np.ptp(np.array([box.matrix_world @ __import__("mathutils").Vector(c)
+                                                  for c in box.bound_box]), axis=0)))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", size
+    for (i, j) in ((i1, j1), (i2, j2)):
+        loc, fwd, up = bake.view_camera(dirs[j, i], np.zeros(3), size)
+        cam.location = loc * 3
+        cam.rotation_euler = __import__("mathutils").Vector(fwd).to_track_quat("-Z", "Y").to_euler()
+        bpy.context.view_layer.update()
+        seen = coverage(render_alpha(bpy, tmp_path / f"card_{i}_{j}.png"))
+        assert seen == pytest.approx(tiles[(i, j)], abs=0.04), (i, j)
