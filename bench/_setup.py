@@ -44,3 +44,26 @@ def best_of(fn, repeat=5):
         result = fn()
         best = min(best, time.perf_counter() - t)
     return best, result
+
+
+def seconds(fn, repeat=3):
+    """Shortest of ``repeat`` timed calls of ``fn``, in seconds."""
+    return best_of(fn, repeat)[0]
+
+
+def offscreen_frame(box, width, height):
+    """A function ``frame(draw)`` that clears the `gpu.types.GPUOffScreen` ``box`` (``width`` x ``height``), calls
+    ``draw()`` with a depth test and reads one pixel back, so the timed frame includes the GPU's work."""
+    import gpu
+
+    def frame(draw):
+        with box.bind():
+            fb = gpu.state.active_framebuffer_get()
+            fb.clear(color=(0, 0, 0, 1), depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            draw()
+            fb.read_color(width // 2, height // 2, 1, 1, 4, 0, "UBYTE")
+            gpu.state.depth_test_set("NONE")
+
+    return frame

@@ -20,22 +20,12 @@ Run: .venv/bin/python bench/gpu_path.py [--full]
 import importlib
 import json
 import sys
-import time
 
 import numpy as np
-from _setup import enable_extension
+from _setup import enable_extension, offscreen_frame, seconds
 
 WIDTH = HEIGHT = 512
 LEVELS = (2, 6, 12, 24)
-
-
-def timed(fn, repeat=3):
-    best = float("inf")
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
 
 
 def measure(mod, base, level, vp, frame):
@@ -66,10 +56,10 @@ def measure(mod, base, level, vp, frame):
         frame(lambda: data.draw(vp))
 
     row = {"case": "frame", "output_triangles": len(out.triangles), "level": level,
-           "preview_draw_ms": 1e3 * timed(lambda: frame(lambda: data.draw(vp))),
-           "preview_relevel_ms": 1e3 * timed(relevel),
-           "mesh_draw_ms": 1e3 * timed(lambda: frame(lambda: draw_mesh(resident))),
-           "mesh_upload_draw_ms": 1e3 * timed(lambda: frame(lambda: draw_mesh(upload()))),
+           "preview_draw_ms": 1e3 * seconds(lambda: frame(lambda: data.draw(vp))),
+           "preview_relevel_ms": 1e3 * seconds(relevel),
+           "mesh_draw_ms": 1e3 * seconds(lambda: frame(lambda: draw_mesh(resident))),
+           "mesh_upload_draw_ms": 1e3 * seconds(lambda: frame(lambda: draw_mesh(upload()))),
            "preview_control_bytes": data.control_bytes, "preview_level_bytes": data.instance_bytes,
            "mesh_bytes": pos.nbytes + nor.nbytes + idx.nbytes}
     row["mesh_over_preview_bytes"] = row["mesh_bytes"] / (row["preview_control_bytes"] + row["preview_level_bytes"])
@@ -101,15 +91,7 @@ def main():
                       "base_triangles": len(base.triangles)}))
     levels = LEVELS if "--full" in sys.argv else LEVELS[:-1]
 
-    def frame(draw):
-        with fb_box.bind():
-            fb = gpu.state.active_framebuffer_get()
-            fb.clear(color=(0, 0, 0, 1), depth=1.0)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
-            draw()
-            fb.read_color(WIDTH // 2, HEIGHT // 2, 1, 1, 4, 0, "UBYTE")
-            gpu.state.depth_test_set("NONE")
+    frame = offscreen_frame(fb_box, WIDTH, HEIGHT)
 
     for level in levels:
         print(json.dumps(measure(mod, base, level, vp, frame)), flush=True)

@@ -27,24 +27,14 @@ Run: .venv/bin/python bench/surfaces.py [--full]   (--full: N up to 20,000; else
 import importlib
 import json
 import sys
-import time
 
 import numpy as np
-from _setup import enable_extension
+from _setup import enable_extension, offscreen_frame, seconds
 
 SIZE = 256
 FACTOR = 64
 COUNTS = (1, 10, 100, 500, 1000, 2500, 5000, 10000, 20000)
 MESH_LIMIT_BYTES = 1 << 30  # 1 GiB of positions at most for the uploaded-mesh path
-
-
-def timed(fn, repeat=3):
-    best = float("inf")
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
 
 
 def main():
@@ -67,15 +57,7 @@ def main():
     print(json.dumps({"bench": "surfaces", "case": "renderer", "renderer": renderer,
                       "backend": gpu.platform.backend_type_get(), "triangles_per_torus": 2 * FACTOR * FACTOR}))
 
-    def frame(fn):
-        with box.bind():
-            fb = gpu.state.active_framebuffer_get()
-            fb.clear(color=(0, 0, 0, 1), depth=1.0)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
-            fn()
-            fb.read_color(SIZE // 2, SIZE // 2, 1, 1, 4, 0, "UBYTE")
-            gpu.state.depth_test_set("NONE")
+    frame = offscreen_frame(box, SIZE, SIZE)
 
     run_teapot(bpy, mod)
     counts = COUNTS if "--full" in sys.argv else COUNTS[:6]
@@ -88,8 +70,8 @@ def main():
                "analytic_ratio": mesh_bytes / point_bytes}
         data = draw.SurfaceDrawData(torus, points, FACTOR)
         row["one_point_bytes"] = data.uploaded_bytes
-        row["one_point_draw_ms"] = 1e3 * timed(lambda data=data: frame(lambda: data.draw(vp, lit=False)))
-        row["one_point_upload_draw_ms"] = 1e3 * timed(lambda points=points: frame(
+        row["one_point_draw_ms"] = 1e3 * seconds(lambda data=data: frame(lambda: data.draw(vp, lit=False)))
+        row["one_point_upload_draw_ms"] = 1e3 * seconds(lambda points=points: frame(
             lambda: draw.SurfaceDrawData(torus, points, FACTOR).draw(vp, lit=False)), repeat=2)
         if mesh_bytes <= MESH_LIMIT_BYTES:
             def upload(points=points, n=n):
@@ -106,8 +88,8 @@ def main():
                 batch.draw(shader)
 
             row["mesh_bytes"] = pos_bytes
-            row["mesh_draw_ms"] = 1e3 * timed(lambda resident=resident: frame(lambda: draw_mesh(resident)))
-            row["mesh_upload_draw_ms"] = 1e3 * timed(lambda: frame(lambda: draw_mesh(upload()[0])), repeat=2)
+            row["mesh_draw_ms"] = 1e3 * seconds(lambda resident=resident: frame(lambda: draw_mesh(resident)))
+            row["mesh_upload_draw_ms"] = 1e3 * seconds(lambda: frame(lambda: draw_mesh(upload()[0])), repeat=2)
             row["mesh_over_one_point_bytes"] = pos_bytes / data.uploaded_bytes
             row["mesh_over_one_point_draw"] = row["mesh_draw_ms"] / row["one_point_draw_ms"]
             row["mesh_upload_over_one_point_upload"] = row["mesh_upload_draw_ms"] / row["one_point_upload_draw_ms"]
@@ -116,26 +98,9 @@ def main():
     box.free()
 
 
-def teapot_surface(bpy, nets):
-    """A SURFACE object holding ``nets`` (P, 4, 4, 3) as 4 x 4 endpoint-knot NURBS splines (Bézier patches)."""
-    made = []
-    for net in nets:
-        bpy.ops.surface.primitive_nurbs_surface_surface_add()
-        spline = bpy.context.active_object.data.splines[0]
-        spline.points.foreach_set("co", np.c_[net.transpose(1, 0, 2).reshape(16, 3), np.ones(16)].ravel())
-        spline.use_endpoint_u = spline.use_endpoint_v = True
-        made.append(bpy.context.active_object)
-    for ob in made:
-        ob.location = (0.0, 0.0, 0.0)
-        ob.select_set(True)
-    bpy.context.view_layer.objects.active = made[0]
-    bpy.ops.object.join()
-    return bpy.context.active_object
-
-
 def run_teapot(bpy, mod):
     nets, _ = mod("kernels.surfaces.revolved_teapot").teapot_patches()
-    surface = teapot_surface(bpy, nets)
+    surface = mod("addon.curve_bridge").write_surface_patches(nets)
 
     def ours():
         bpy.context.view_layer.objects.active = surface
@@ -169,7 +134,7 @@ def run_teapot(bpy, mod):
     surface.data.resolution_u = surface.data.resolution_v = res
 
     n_blender = blenders()
-    t_ours, t_blender = timed(ours, 5), timed(blenders, 5)
+    t_ours, t_blender = seconds(ours, 5), seconds(blenders, 5)
     print(json.dumps({"bench": "surfaces", "case": "teapot_tessellate_surface", "patches": len(nets),
                       "triangles": n_ours, "seconds": round(t_ours, 4),
                       "baseline": f"Blender's surface to mesh (resolution {res}), copied into a new object",

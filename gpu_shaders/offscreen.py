@@ -47,13 +47,11 @@ def _describe_flat_mesh():
     return info
 
 
-def render_triangles(positions, triangles, view_projection, size=(256, 256), color=(0.8, 0.8, 0.8, 1.0),
-                     background=(0.0, 0.0, 0.0, 1.0), lit=True, normals=None):
-    """Draw triangles offscreen and return the image.
+def triangle_batch(positions, triangles, normals=None):
+    """The flat-mesh shader and a batch of unshared corners: ``(shader, batch)``.
 
-    positions: (V, 3) float32 world space; triangles: (T, 3) int32; view_projection: (4, 4) row-major
-    matrix; size: (width, height); normals: None (flat shading), (V, 3) per vertex or (T, 3, 3) per corner.
-    Returns (height, width, 4) uint8, row 0 at the bottom. Needs a GPU context.
+    positions: (V, 3) float32 world space; triangles: (T, 3) int32; normals: None (flat shading), (V, 3) per
+    vertex or (T, 3, 3) per corner. Needs a GPU context.
     """
     from gpu_extras.batch import batch_for_shader
 
@@ -67,7 +65,22 @@ def render_triangles(positions, triangles, view_projection, size=(256, 256), col
         normals = np.asarray(normals, np.float32)
         nor = np.ascontiguousarray((normals if normals.ndim == 3 else normals[tris]).reshape(-1, 3))
     shader = loader.shader("flat_mesh", _describe_flat_mesh)
-    batch = batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
+    return shader, batch_for_shader(shader, "TRIS", {"pos": corners.reshape(-1, 3), "nor": nor})
+
+
+def draw_triangles(positions, triangles, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, normals=None):
+    """Draw triangles (as `triangle_batch` takes them) with the flat-mesh shader into the bound framebuffer, depth
+    state as the caller set it; view_projection: (4, 4) row-major. Needs a GPU context."""
+    shader, batch = triangle_batch(positions, triangles, normals)
+    set_shading(shader, view_projection, color, lit)
+    batch.draw(shader)
+
+
+def render_triangles(positions, triangles, view_projection, size=(256, 256), color=(0.8, 0.8, 0.8, 1.0),
+                     background=(0.0, 0.0, 0.0, 1.0), lit=True, normals=None):
+    """Draw triangles offscreen (as `draw_triangles` does) and return the image: (height, width, 4) uint8, row 0
+    at the bottom. Needs a GPU context."""
+    shader, batch = triangle_batch(positions, triangles, normals)
 
     def draw():
         set_shading(shader, view_projection, color, lit)

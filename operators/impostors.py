@@ -5,7 +5,7 @@ import bpy
 
 from ..addon.guarded import guarded
 from ..addon.impostors.bake import atlas_images, bake_atlas, make_card
-from .selection import select_only
+from .selection import object_poll, select_only
 
 
 class TESSERA_OT_impostor_bake(bpy.types.Operator):
@@ -25,11 +25,8 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if context.mode != "OBJECT" or ob is None or ob.type not in {"MESH", "CURVE", "SURFACE", "META", "FONT"}:
-            cls.poll_message_set("Select an object with geometry in Object Mode")
-            return False
-        return True
+        return object_poll(cls, context, {"MESH", "CURVE", "SURFACE", "META", "FONT"},
+                           "Select an object with geometry in Object Mode")
 
     @guarded
     def execute(self, context, tx):

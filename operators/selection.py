@@ -28,6 +28,16 @@ def mesh_poll(cls, context, verb):
     return True
 
 
+def object_poll(cls, context, types, message):
+    """Poll of an operator on the active object of one of ``types`` (object type names) in Object Mode; when not,
+    sets ``message`` as the reason."""
+    ob = context.active_object
+    if context.mode != "OBJECT" or ob is None or ob.type not in types:
+        cls.poll_message_set(message)
+        return False
+    return True
+
+
 def read_source(context, ob, output):
     """`bridge.read_mesh` of what the operator works on: the object with its modifiers evaluated for a new
     object, its own mesh data for ``output == "REPLACE"``. Returns ``(arrays, info, marks)`` (marks:
@@ -47,9 +57,10 @@ def read_source(context, ob, output):
 
 
 def place_mesh(context, tx, ob, mesh, output, suffix):
-    """Put ``mesh`` in the scene: swapped into ``ob`` (REPLACE; the old mesh removed if nothing else uses it,
-    undone on rollback) or as a new object ``<ob.name>.<suffix>`` in ``ob``'s collections with its transform and
-    object-linked materials, selected and active. Returns the object that holds it."""
+    """Put ``mesh`` (mesh or curve data, as ``ob``'s) in the scene: swapped into ``ob`` (REPLACE; the old mesh
+    removed if nothing else uses it, undone on rollback) or as a new object ``<ob.name>.<suffix>`` in ``ob``'s
+    collections with its transform and object-linked materials, selected and active. Returns the object that
+    holds it."""
     for material in ob.data.materials:
         mesh.materials.append(material)
     if output == "REPLACE":

@@ -33,7 +33,7 @@ from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
 from ..kernels.surfaces.domain_mesh import surface_mesh
-from .selection import select_only
+from .selection import object_poll, place_mesh, select_only
 
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
@@ -141,11 +141,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if context.mode != "OBJECT" or ob is None or ob.type != "CURVE":
-            cls.poll_message_set("Select a curve object in Object Mode")
-            return False
-        return True
+        return object_poll(cls, context, {"CURVE"}, "Select a curve object in Object Mode")
 
     def draw(self, context):
         draw_curve_options(self.layout, self)
@@ -178,12 +174,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
                                     + (f" ({skipped} NURBS spline(s): convert them to Bézier first)" if skipped
                                        else ""))
         data = tx.track(curve_bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
-        for mat in ob.data.materials:
-            data.materials.append(mat)
-        new = tx.new_object(f"{ob.name}.adaptive", data)
-        new.matrix_world = ob.matrix_world.copy()
-        context.collection.objects.link(new)
-        select_only(context, [new])
+        place_mesh(context, tx, ob, data, "NEW_OBJECT", "adaptive")
         seg = np.concatenate(counts) if counts else np.zeros(0, np.int64)
         words = (f"{len(seg):,} Bézier segments -> {int(seg.sum()):,} ({int(seg.min())}-{int(seg.max())} each)"
                  if len(seg) else "no Bézier segment")
@@ -268,11 +259,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
-        if context.mode != "OBJECT" or ob is None or ob.type != "SURFACE":
-            cls.poll_message_set("Select a surface object (NURBS surface patches) in Object Mode")
-            return False
-        return True
+        return object_poll(cls, context, {"SURFACE"}, "Select a surface object (NURBS surface patches) in Object Mode")
 
     def draw(self, context):
         draw_patch_options(self.layout, self)
@@ -295,12 +282,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
                             corner_attributes={"UVMap": mesh.corner_uv}, attribute_types={"UVMap": "FLOAT2"})
         data = tx.track(bridge.write_mesh(f"{ob.data.name}.tessellated", arrays))
         data.shade_smooth()
-        for mat in ob.data.materials:
-            data.materials.append(mat)
-        new = tx.new_object(f"{ob.name}.tessellated", data)
-        new.matrix_world = ob.matrix_world.copy()
-        context.collection.objects.link(new)
-        select_only(context, [new])
+        place_mesh(context, tx, ob, data, "NEW_OBJECT", "tessellated")
         note = f"; {len(skipped)} spline(s) left out: " + "; ".join(skipped) if skipped else ""
         self.report({"WARNING" if skipped else "INFO"},
                     f"{len(patches)} patches, sides {int(edge_levels.min())}-{int(edge_levels.max())} segments, "

@@ -400,20 +400,9 @@ def build_nailboard_picture(name="demo_nailboard.png", size=(1280, 620)):
     cube = np.array([[x, y, z] for z in (0, 0.7) for y in (-1.9, -1.2) for x in (0.3, 1.0)], np.float32)
     cube_tris = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
                           [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], np.int32)
-    shader = offscreen.loader.shader("flat_mesh", offscreen._describe_flat_mesh)
-
-    def mesh(positions, tris, colour):
-        from gpu_extras.batch import batch_for_shader
-
-        corners = positions[tris].reshape(-1, 3)
-        n = np.cross(corners[1::3] - corners[0::3], corners[2::3] - corners[0::3])
-        n = np.repeat(n / np.linalg.norm(n, axis=1, keepdims=True), 3, axis=0).astype(np.float32)
-        offscreen.set_shading(shader, vp, colour, True)
-        batch_for_shader(shader, "TRIS", {"pos": corners, "nor": n}).draw(shader)
-
     def draw():
-        mesh(floor, floor_tris, (0.55, 0.6, 0.65, 1.0))
-        mesh(cube, cube_tris, (0.3, 0.55, 0.8, 1.0))
+        offscreen.draw_triangles(floor, floor_tris, vp, (0.55, 0.6, 0.65, 1.0))
+        offscreen.draw_triangles(cube, cube_tris, vp, (0.3, 0.55, 0.8, 1.0))
         board.draw(vp)
 
     pixels = offscreen.render(draw, size, background=(0.9, 0.9, 0.92, 1.0))
@@ -627,19 +616,7 @@ def build_teapot_scene():
     clear_scene()
     clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
     nets, _ = _addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
-    made = []
-    for net in nets:
-        bpy.ops.surface.primitive_nurbs_surface_surface_add()
-        spline = bpy.context.active_object.data.splines[0]
-        spline.points.foreach_set("co", np.c_[net.transpose(1, 0, 2).reshape(16, 3), np.ones(16)].ravel())
-        spline.use_endpoint_u = spline.use_endpoint_v = True
-        made.append(bpy.context.active_object)
-    for ob in made:
-        ob.location = (0.0, 0.0, 0.0)
-        ob.select_set(True)
-    bpy.context.view_layer.objects.active = made[0]
-    bpy.ops.object.join()
-    surface = bpy.context.active_object
+    surface = _addon_module("addon.curve_bridge").write_surface_patches(nets)
     add_camera((0.0, -13.0, 5.5), (1.27, 0.0, 0.0), lens=35)
     counts = []
     for x, kw in ((-2.6, {"metrics": {"CURVATURE"}}), (2.6, {"metrics": {"DISTANCE"}, "near": 11.0, "far": 17.0,

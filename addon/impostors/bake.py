@@ -16,7 +16,7 @@ from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
 from ...kernels.impostors.octahedral import view_directions
 from ..node_groups import Graph
-from .worker import lower_priority, worker_command
+from .worker import lower_priority, worker_command, world_box
 
 
 @dataclass
@@ -45,10 +45,7 @@ def view_camera(direction, centre, size):
 
 def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600):
     """Render ``ob`` (world space) from every view of the atlas and assemble the atlases: an `Atlas`."""
-    from mathutils import Vector
-
-    corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
-    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    lo, hi = world_box(ob)
     centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
     if not size > 0:
         raise TesseraError(f"{ob.name!r} has no extent to bake")

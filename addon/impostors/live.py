@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...kernels.impostors.validity import Board, check
+from .worker import world_box
 
 
 @dataclass
@@ -45,12 +46,6 @@ class NailboardManager:
         self.regenerations = 0
         self.cache_hits = 0
         self.reasons = []  # the `Verdict` of each regeneration a validity test asked for
-
-    def _box(self, ob):
-        from mathutils import Vector
-
-        corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
-        return corners.min(axis=0), corners.max(axis=0)
 
     def update(self, ob, eye, res_screen, fov):
         """The `LiveBoard` to draw ``ob`` from at ``eye`` this frame (its ``images`` may still be None)."""
@@ -96,7 +91,7 @@ class NailboardManager:
         target = eye
         if self.lead and len(live.eyes) >= 2:  # velocity prediction, `lead` frames ahead
             target = eye + self.lead * (live.eyes[-1] - live.eyes[-2])
-        lo, hi = self._box(ob)
+        lo, hi = world_box(ob)
         job = self.request(ob, target, res_screen, fov)
         live.pending = job
         live.pending_board = Board(np.asarray(target, np.float64), lo, hi, job.setup.resolution)

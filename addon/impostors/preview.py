@@ -22,10 +22,7 @@ class DeferredJob:
     """A board asked for from a draw callback: started by a timer, then the worker's `BoardJob`."""
 
     def __init__(self, ob, eye, res_screen, fov, samples):
-        from mathutils import Vector
-
-        corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
-        self.setup = board_setup(corners.min(axis=0), corners.max(axis=0), eye, res_screen, fov)
+        self.setup = board_setup(*worker.world_box(ob), eye, res_screen, fov)
         self.args, self.name, self.job = (eye, res_screen, fov, samples), ob.name, None
         _queue.append(self)
         if not bpy.app.timers.is_registered(_start_queued):
@@ -50,7 +47,7 @@ def _start_queued():
         ob = bpy.data.objects.get(job.name)
         if ob is not None:
             eye, res, fov, samples = job.args
-            job.job = worker.request_board(ob, eye, res, fov, samples=samples)
+            job.job = worker.request_board(ob, eye, res, fov, samples=samples, setup=job.setup)
     return None
 
 

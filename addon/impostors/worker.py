@@ -76,13 +76,20 @@ class BoardJob:
             self.process.kill()
 
 
-def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL"):
-    """Start rendering ``ob``'s board for ``eye`` (world space; a camera of ``res_screen`` pixels and ``fov``
-    radians): a `BoardJob`, at once. The board is in world space (the object's bounding box in world space)."""
+def world_box(ob):
+    """The world-space axis-aligned box around ``ob``'s bounding box: ``(lo, hi)``, each (3,) float64."""
     from mathutils import Vector
 
-    corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box])
-    setup = board_setup(corners.min(axis=0), corners.max(axis=0), eye, res_screen, fov, rounding)
+    corners = np.array([ob.matrix_world @ Vector(c) for c in ob.bound_box], np.float64)
+    return corners.min(axis=0), corners.max(axis=0)
+
+
+def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=None):
+    """Start rendering ``ob``'s board for ``eye`` (world space; a camera of ``res_screen`` pixels and ``fov``
+    radians): a `BoardJob`, at once. The board is in world space (the object's bounding box in world space), or
+    ``setup`` (a `BoardSetup` already made for this object and eye) when given."""
+    if setup is None:
+        setup = board_setup(*world_box(ob), eye, res_screen, fov, rounding)
     folder = tempfile.mkdtemp(prefix="tessera-board-")
     blend = os.path.join(folder, "scene.blend")
     bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)

@@ -68,9 +68,13 @@ class BoardDrawData:
 
         shader = loader.shader("nailboard", _describe)
         w, h = self.size
-        corners = np.array([[0, 0], [w, 0], [w, h], [0, h]], np.float32)
-        batch = batch_for_shader(shader, "TRIS", {"corner": corners}, indices=np.array([[0, 1, 2], [0, 2, 3]],
-                                                                                        np.int32))
+
+        def build():
+            corners = np.array([[0, 0], [w, 0], [w, h], [0, h]], np.float32)
+            return batch_for_shader(shader, "TRIS", {"corner": corners},
+                                    indices=np.array([[0, 1, 2], [0, 2, 3]], np.int32))
+
+        batch = loader.batch(("nailboard", w, h), build)
         shader.bind()
         shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
         f = self.frame

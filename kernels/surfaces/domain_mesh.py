@@ -15,6 +15,7 @@ the UV map has its seams where the surface closes.
 and uploaded as one buffer; `upload_bytes` the memory accounting of Table 2.2.
 """
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -148,8 +149,10 @@ def upload_bytes(instances, factor):
     return instances * triangles * 3 * VERTEX_BYTES, instances * VERTEX_BYTES
 
 
+@functools.lru_cache(maxsize=64)
 def bounding_radius(surface, factor=32):
-    """Largest distance of the surface from its control point (sampled on the factor-F domain, +1% margin)."""
+    """Largest distance of the surface from its control point (sampled on the factor-F domain, +1% margin).
+    Cached per surface (surfaces are frozen, hashable dataclasses): a live preview asks every frame."""
     uv, _ = domain_pattern(factor)
     p = surface.point(uv[:, 0].astype(np.float64), uv[:, 1].astype(np.float64))
     return 1.01 * float(np.linalg.norm(p, axis=1).max())

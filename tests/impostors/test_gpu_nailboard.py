@@ -68,17 +68,17 @@ def test_a_relief_sphere_meets_a_gpu_plane_where_the_real_sphere_does(gpu_render
     sph_tris = np.concatenate([np.stack([a, a + 400, a + 401], 1), np.stack([a, a + 401, a + 1], 1)]).astype(np.int32)
 
     def truth():
-        offscreen_draw(offscreen, sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1))
-        offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))
+        offscreen.draw_triangles(sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1), False)
+        offscreen.draw_triangles(quad, quad_tris, vp, (0, 1, 0, 1), False)
 
     def boarded():
-        offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))
+        offscreen.draw_triangles(quad, quad_tris, vp, (0, 1, 0, 1), False)
         data.draw(vp)
 
     want = offscreen.render(truth, size=(200, 200))
     got = offscreen.render(boarded, size=(200, 200))
-    alone = offscreen.render(lambda: offscreen_draw(offscreen, sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1)),
-                             size=(200, 200))[..., 0] > 127
+    alone = offscreen.render(lambda: offscreen.draw_triangles(sph.astype(np.float32), sph_tris, vp, (1, 0, 0, 1),
+                                                              False), size=(200, 200))[..., 0] > 127
     sphere_want, sphere_got = want[..., 0] > 127, got[..., 0] > 127
     assert sphere_want.sum() > 2000 and (alone & ~sphere_want).sum() > 1000  # the plane hides part of the sphere
     diff = sphere_want != sphere_got
@@ -88,19 +88,6 @@ def test_a_relief_sphere_meets_a_gpu_plane_where_the_real_sphere_does(gpu_render
     boundary = windows.any(axis=0) & ~windows.all(axis=0)
     assert not (diff & ~boundary).any(), int((diff & ~boundary).sum())
     assert diff.sum() < 0.05 * boundary.sum() + 40
-
-
-def offscreen_draw(offscreen, positions, triangles, vp, colour):
-    """Draw triangles into the bound framebuffer with the flat-mesh shader (unlit), depth-tested."""
-    from gpu_extras.batch import batch_for_shader
-
-    shader = offscreen.loader.shader("flat_mesh", offscreen._describe_flat_mesh)
-    corners = positions[triangles].reshape(-1, 3)
-    nor = np.zeros_like(corners)
-    nor[:, 2] = 1
-    batch = batch_for_shader(shader, "TRIS", {"pos": corners, "nor": nor})
-    offscreen.set_shading(shader, vp, colour, False)
-    batch.draw(shader)
 
 
 def test_a_board_from_the_cycles_worker_stands_in_for_the_object(clean_scene, gpu_renderer, bpy_module, addon_module):
@@ -131,11 +118,12 @@ def test_a_board_from_the_cycles_worker_stands_in_for_the_object(clean_scene, gp
     tris = np.array([t.vertices[:] for t in me.loop_triangles], np.int32)
     quad = np.array([[-3, -3, -0.8], [3, -3, -0.8], [3, 3, 1.6], [-3, 3, 1.6]], np.float32)  # z = 0.4 y + 0.4
     quad_tris = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
-    want = offscreen.render(lambda: (offscreen_draw(offscreen, pos, tris, vp, (1, 0, 0, 1)),
-                                     offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1))), size=(200, 200))
-    got = offscreen.render(lambda: (offscreen_draw(offscreen, quad, quad_tris, vp, (0, 1, 0, 1)), data.draw(vp)),
+    want = offscreen.render(lambda: (offscreen.draw_triangles(pos, tris, vp, (1, 0, 0, 1), False),
+                                     offscreen.draw_triangles(quad, quad_tris, vp, (0, 1, 0, 1), False)),
+                            size=(200, 200))
+    got = offscreen.render(lambda: (offscreen.draw_triangles(quad, quad_tris, vp, (0, 1, 0, 1), False), data.draw(vp)),
                            size=(200, 200))
-    alone = offscreen.render(lambda: offscreen_draw(offscreen, pos, tris, vp, (1, 0, 0, 1)), size=(200, 200))
+    alone = offscreen.render(lambda: offscreen.draw_triangles(pos, tris, vp, (1, 0, 0, 1), False), size=(200, 200))
     sphere_want, sphere_got = want[..., 0] > 127, got[..., 0] > 127
     assert sphere_want.sum() > 1500 and ((alone[..., 0] > 127) & ~sphere_want).sum() > 500
     pad = np.pad(sphere_want, 1, mode="edge")

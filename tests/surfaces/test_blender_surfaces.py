@@ -171,32 +171,11 @@ def test_vector_field_from_a_grid_mesh(clean_scene, bpy_module):
         bpy.ops.tessera.vector_field_texture(field="MESH", attribute="wind", backend="CPU")
 
 
-def surface_object(bpy, patches):
-    """A SURFACE object with one 4 x 4 NURBS spline (endpoint knots: a Bézier patch) per control net."""
-    obs = []
-    for net in patches:
-        bpy.ops.surface.primitive_nurbs_surface_surface_add()
-        ob = bpy.context.active_object
-        s = ob.data.splines[0]
-        co = np.c_[np.asarray(net, np.float64).transpose(1, 0, 2).reshape(16, 3), np.ones(16)]  # u fastest
-        s.points.foreach_set("co", co.astype(np.float32).ravel())
-        s.use_endpoint_u = s.use_endpoint_v = True
-        ob.location = (0.0, 0.0, 0.0)
-        obs.append(ob)
-    for ob in bpy.context.selected_objects:
-        ob.select_set(False)
-    for ob in obs:
-        ob.select_set(True)
-    bpy.context.view_layer.objects.active = obs[0]
-    bpy.ops.object.join()
-    return bpy.context.active_object
-
-
 def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
     bp = addon_module("kernels.surfaces.bezier_patches")
     patches, names = addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
-    ob = surface_object(bpy, patches)
+    ob = addon_module("addon.curve_bridge").write_surface_patches(patches)
     assert len(ob.data.splines) == 24
     read, skipped = addon_module("addon.curve_bridge").read_surface_patches(ob.data)
     assert skipped == [] and np.allclose(read, patches.astype(np.float32))
