@@ -208,7 +208,7 @@ def _add_geometry(mesh, positions, corner_verts, loop_starts):
     mesh.polygons.add(len(loop_starts))
     mesh.attributes["position"].data.foreach_set("vector", positions.ravel())
     mesh.attributes[".corner_vert"].data.foreach_set("value", corner_verts)
-    mesh.polygons.foreach_set("loop_start", loop_starts)
+    compat.set_face_offsets(mesh, loop_starts)
 
 
 @contextmanager
