@@ -10,6 +10,7 @@ import numpy as np
 
 from ..common.errors import TesseraError
 from ..common.opencl_runtime import get_runtime
+from ..common.rows import take_rows
 from .refine_templates import scatter_rows, stamp, triangle_starts
 
 #: Below this many output rows the numpy path is used even when OpenCL is available (launch overhead).
@@ -135,6 +136,10 @@ def _corner_values_by_triangle(ref, values):
     n_faces = len(ref.faces)
     flat = np.asarray(values).reshape(n_faces, 3, -1)
     tail = values.shape[2:]
+    if ref.arrays.corner_slots is not None:  # each face's vertex weighed once, then gathered to its corners
+        slot_face, slot_bary, triangle_slots = ref.arrays.corner_slots.get()
+        sums = _slot_sums(flat, slot_face, slot_bary)  # (N, C) float32, gathered a row at a time
+        return take_rows(sums, triangle_slots).reshape((ref.n_triangles, 3) + tail)
     out = np.empty((ref.n_triangles, 3, flat.shape[2]), dtype=np.float32)
     faces, bary = ref.triangle_face, ref.corner_bary
     step = max(1, GATHER_CHUNK // 3)
@@ -145,6 +150,17 @@ def _corner_values_by_triangle(ref, values):
         out[lo:hi] = _weighted_sum(((w[:, :, tap, None], src[:, None, tap, :]) for tap in range(3)),
                                    (hi - lo, 3, flat.shape[2]))
     return out.reshape((ref.n_triangles, 3) + tail)
+
+
+def _slot_sums(flat, slot_face, slot_bary):
+    """Each slot's weighted sum of its face's three corner values: flat (T, 3, C), slot_face (N,), slot_bary (N, 3)
+    -> (N, C) float32; the products and sums of `_corner_values_by_triangle`, per slot instead of per corner."""
+    out = np.empty((len(slot_face), flat.shape[2]), dtype=np.float32)
+    for lo in range(0, len(slot_face), GATHER_CHUNK):
+        hi = min(len(slot_face), lo + GATHER_CHUNK)
+        src, w = flat[slot_face[lo:hi]], slot_bary[lo:hi]  # (n, 3, C), (n, 3)
+        out[lo:hi] = _weighted_sum(((w[:, tap, None], src[:, tap, :]) for tap in range(3)), (hi - lo, flat.shape[2]))
+    return out
 
 
 def _slot_values(ref, cls, values):

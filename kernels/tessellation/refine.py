@@ -30,7 +30,8 @@ import numpy as np
 
 from ..common.topology import triangle_edges, validate_triangles
 from . import refine_templates
-from .refine_general import face_levels, interior_counts, refine_general
+from .refine_general import face_levels, interior_counts
+from .refine_split import refine_split
 
 
 def refinement_counts(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL"):
@@ -83,4 +84,4 @@ def refine(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL
     classes = refine_templates.pattern_classes(edge_f[face_edges], edge_n[face_edges], inner_f, inner_n, spacing)
     if refine_templates.worth_it(classes, len(tris)):
         return refine_templates.refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing)
-    return refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacing)
+    return refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing)

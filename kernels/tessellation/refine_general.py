@@ -85,11 +85,12 @@ def refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacing
             triangles=Lazy.of(vertex_id[tri_rv].astype(np.int32)),
             triangle_face=Lazy.of(vertex_face[tri_rv[:, 0]].astype(np.int32)),
             interior_face=Lazy.of(vertex_face[interior].astype(np.int32)),
-            interior_bary=Lazy.of(vertex_bary[interior]), corner_bary=Lazy.of(vertex_bary[tri_rv])),
+            interior_bary=Lazy.of(vertex_bary[interior]), corner_bary=Lazy(lambda: vertex_bary[tri_rv]),
+            corner_slots=Lazy.of((vertex_face, vertex_bary, tri_rv))),
     )
 
 
-def _local_edge(position, outer_n):
+def local_edge(position, outer_n):
     """Which local edge a boundary-loop position lies on and its index along that edge.
 
     position: (k,) int in ``[0, n0 + n1 + n2)``; outer_n: (k, 3) int. Returns ``(edge, index)``, (k,) each.
@@ -113,47 +114,74 @@ def _ring_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t,
     k = ring_k[ring]
     ids = np.empty(len(ring), dtype=np.int64)
     bary = np.zeros((len(ring), 3), dtype=np.float64)
-
-    # Boundary loop: corners and edge points, seen from this face's orientation of each edge.
     o = np.flatnonzero(k == 0)
-    fo = face[o]
-    e, j = _local_edge(pos[o], outer_n[fo])
-    n_e = outer_n[fo, e]
-    is_corner = j == 0
-    edge = face_edges[fo, e]
-    flip = flipped[fo, e]
-    canonical = np.where(flip, n_e - j, j)
-    point = np.where(is_corner, 0, edge_first[edge] + canonical - 1)
-    ids[o] = np.where(is_corner, tris[fo, e], point)
-    # An edge point weighs the edge's canonical ends (1 - t, t) whichever way the face runs, so the two faces
-    # of an edge interpolate corner attributes with the same weights (bit-identical where they agree at the ends).
-    t = np.zeros(len(o))
-    t[~is_corner] = edge_point_t[point[~is_corner] - n_vertices]
-    w_lo, w_hi = 1.0 - t, t  # weights of the edge's lower and higher vertex
-    bary[o, e] = np.where(is_corner, 1.0, np.where(flip, w_hi, w_lo))
-    bary[o, (e + 1) % 3] = np.where(is_corner, 0.0, np.where(flip, w_lo, w_hi))
-
+    ids[o], bary[o] = boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t, n_vertices,
+                                        face[o], pos[o])
     # Interior rings: numbered consecutively after the edge points, in table order.
     q = np.flatnonzero(k >= 1)
     ids[q] = interior_first + np.arange(len(q))
-    fq, kq = face[q], k[q]
-    m = inner_n[fq]
-    side = m - 2 * kq
+    bary[q] = interior_bary(k[q], pos[q], inner_f[face[q]], inner_n[face[q]], spacing)
+    return ids, bary, face, k >= 1, ring_start
+
+
+def boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t, n_vertices, face, pos):
+    """Output id and barycentrics of boundary-loop positions ``pos`` (k,) of faces ``face`` (k,): corners and edge
+    points, seen from each face's orientation of its edges. Returns ``(ids (k,) int64, bary (k, 3) float64)``."""
+    e, j = local_edge(pos, outer_n[face])
+    n_e = outer_n[face, e]
+    is_corner = j == 0
+    edge = face_edges[face, e]
+    flip = flipped[face, e]
+    canonical = np.where(flip, n_e - j, j)
+    point = np.where(is_corner, 0, edge_first[edge] + canonical - 1)
+    ids = np.where(is_corner, tris[face, e], point).astype(np.int64)
+    # An edge point weighs the edge's canonical ends (1 - t, t) whichever way the face runs, so the two faces
+    # of an edge interpolate corner attributes with the same weights (bit-identical where they agree at the ends).
+    t = np.zeros(len(face))
+    t[~is_corner] = edge_point_t[point[~is_corner] - n_vertices]
+    w_lo, w_hi = 1.0 - t, t  # weights of the edge's lower and higher vertex
+    bary = np.zeros((len(face), 3), dtype=np.float64)
+    rows = np.arange(len(face))
+    bary[rows, e] = np.where(is_corner, 1.0, np.where(flip, w_hi, w_lo))
+    bary[rows, (e + 1) % 3] = np.where(is_corner, 0.0, np.where(flip, w_lo, w_hi))
+    return ids, bary
+
+
+def interior_bary(k, pos, inner_f, inner_n, spacing):
+    """Barycentrics of interior-ring vertices: ring ``k`` >= 1 (q,), loop position ``pos`` (q,), of faces with
+    clamped inner level ``inner_f`` (q,) and inner segment count ``inner_n`` (q,). Returns (q, 3) float64."""
+    j = pos % np.maximum(inner_n - 2 * k, 1)
+    return ring_bary(k, pos, inner_n, point_params(inner_f, inner_n, k, spacing),
+                     point_params(inner_f, inner_n, k + j, spacing))
+
+
+def ring_bary(k, pos, inner_n, p_ring, p_point):
+    """`interior_bary` from the inner partition's parameters at the ring (``p_ring``: point ``k``) and at the vertex
+    (``p_point``: point ``k + j``, j its index along its side), (q,) each. Returns (q, 3) float64."""
+    side = inner_n - 2 * k
+    c, j = pos // np.maximum(side, 1), pos % np.maximum(side, 1)
+    own, b_next, off = side_weights(p_ring, p_point, j, side)
+    bary = np.empty((len(k), 3), dtype=np.float64)
+    for col in range(3):  # column c gets own, c + 1 b_next, c + 2 off
+        bary[:, col] = np.where(c == col, own, np.where((c + 1) % 3 == col, b_next, off))
+    return bary
+
+
+def side_weights(p_ring, p_point, j, side):
+    """The three barycentric weights of point ``j`` on a side of an interior ring, from that side's corner on
+    (``own``), toward the next corner (``b_next``) and of the third corner (``off``); the centre point (``side``
+    0) gets 1/3 each. All arguments of one shape; returns three float64 arrays of it."""
     safe_side = np.maximum(side, 1)
-    c, j = pos[q] // safe_side, pos[q] % safe_side
-    p_ring = point_params(inner_f[fq], m, kq, spacing)  # the ring's offset in the inner partition
-    p_point = point_params(inner_f[fq], m, kq + j, spacing)
     off = (2.0 / 3.0) * p_ring  # ring corner c is (1 - 2 off) e_c + off (e_{c+1} + e_{c+2})
     span = 1.0 - 2.0 * p_ring
     with np.errstate(divide="ignore", invalid="ignore"):
         phi = np.where(span > 0, (p_point - p_ring) / span, j / safe_side)
     b_next = off + phi * (1.0 - 3.0 * off)
-    rows = np.arange(len(q))
-    bary[q[rows], c] = 1.0 - b_next - off
-    bary[q[rows], (c + 1) % 3] = b_next
-    bary[q[rows], (c + 2) % 3] = off
-    bary[q[side == 0]] = 1.0 / 3.0
-    return ids, bary, face, k >= 1, ring_start
+    own = 1.0 - b_next - off
+    centre = side == 0
+    if np.any(centre):
+        own, b_next, off = (np.where(centre, 1.0 / 3.0, w) for w in (own, b_next, off))
+    return own, b_next, off
 
 
 def _segment_keys(ring_face, ring_k, outer_n, side, n_segments):
@@ -166,7 +194,7 @@ def _segment_keys(ring_face, ring_k, outer_n, side, n_segments):
     outer = ring_k[ring] == 0
     o = np.flatnonzero(outer)
     n_o = outer_n[ring_face[ring[o]]]
-    e, j = _local_edge(pos[o], n_o)
+    e, j = local_edge(pos[o], n_o)
     key[o] = e + (j + 0.5) / n_o[np.arange(len(o)), e]
     q = np.flatnonzero(~outer)
     s = side[ring[q]]

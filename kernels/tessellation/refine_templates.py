@@ -103,6 +103,20 @@ def _template_edges(pat):
     return cols, np.flatnonzero(~on_boundary)[first]
 
 
+def edge_segments(edges, edge_n, point_start, n_vertices):
+    """The output edges along the input edges: every segment of every input edge, in edge order and canonical
+    direction. Returns ``(seg_start (E,) int64 first segment of each input edge, ends (S, 2) int64 its output
+    vertices)``."""
+    seg_e, seg_k, seg_start = ragged(edge_n)
+    ends = edges.astype(np.int64)
+
+    def vertex_at(e, q):  # vertex at canonical position q along input edge e
+        inner = n_vertices + point_start[e] + q - 1
+        return np.where(q == 0, ends[e, 0], np.where(q == edge_n[e], ends[e, 1], inner))
+
+    return seg_start, np.stack([vertex_at(seg_e, seg_k), vertex_at(seg_e, seg_k + 1)], axis=1)
+
+
 def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_start, classes, triangles, tri_start):
     """Edges of the refined mesh and the edge leaving each output corner, from the class patterns.
 
@@ -110,20 +124,14 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
     int32, corner_edges (M, 3) int32)``: the segments of every input edge (in edge order, canonical direction)
     then each face's interior edges.
     """
-    seg_e, seg_k, seg_start = ragged(edge_n)
-    n_seg = len(seg_e)
-    ends = edges.astype(np.int64)
-
-    def vertex_at(e, q):  # vertex at canonical position q along input edge e
-        inner = n_vertices + point_start[e] + q - 1
-        return np.where(q == 0, ends[e, 0], np.where(q == edge_n[e], ends[e, 1], inner))
-
+    seg_start, seg_ends = edge_segments(edges, edge_n, point_start, n_vertices)
+    n_seg = len(seg_ends)
     face_interior = np.zeros(len(tris), np.int64)
     for cls, _, interior_at in classes:
         face_interior[cls.faces] = len(interior_at)
     interior_start = n_seg + np.cumsum(face_interior) - face_interior
     out_edges = np.empty((n_seg + int(face_interior.sum()), 2), np.int32)
-    out_edges[:n_seg, 0], out_edges[:n_seg, 1] = vertex_at(seg_e, seg_k), vertex_at(seg_e, seg_k + 1)
+    out_edges[:n_seg] = seg_ends
     corner_edges = np.empty(triangles.shape, np.int32)
     outer_n = edge_n[face_edges]
     for cls, cols, interior_at in classes:

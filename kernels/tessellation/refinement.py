@@ -42,7 +42,10 @@ class LazyArrays:
 
     triangles: (M, 3) int32; triangle_face: (M,) int32; interior_face: (Ni,) int32; interior_bary: (Ni, 3)
     float64; corner_bary: (M, 3, 3) float64; output_edges: ``(edges (K, 2), corner_edges (M, 3))`` int32, or
-    None when the construction does not know them (the general path: the mesh writer computes edges).
+    None when the construction does not know them (the general path: the mesh writer computes edges);
+    corner_slots: ``(slot_face (N,) int64, slot_bary (N, 3) float64, triangle_slots (M, 3) int64)`` where the
+    construction numbers each face's vertices once per face (the general path's ring vertices): ``corner_bary ==
+    slot_bary[triangle_slots]``, so a corner attribute can be weighed once per slot and gathered; else None.
     """
 
     triangles: Lazy
@@ -51,6 +54,7 @@ class LazyArrays:
     interior_bary: Lazy
     corner_bary: Lazy
     output_edges: Lazy | None = None
+    corner_slots: Lazy | None = None
 
 
 @dataclass(frozen=True)
