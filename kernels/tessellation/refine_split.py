@@ -14,11 +14,12 @@ Per face, in output order: the strip's boundary triangles (one per boundary segm
 of annulus 1 -> 2, the strip's ring-1 triangles (one per ring-1 segment), then the rest of the template.
 """
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..common.partition import point_params
+from ..common.partition import MAX_LEVEL, point_params
 from ..common.rows import put_rows, take_rows
 from ..common.topology import group_by_class, ragged
 from .refine_general import boundary_vertices, interior_counts, local_edge, refine_general, side_weights
@@ -57,8 +58,10 @@ class InteriorTemplate:
     column_source: np.ndarray
 
 
+@functools.lru_cache(maxsize=MAX_LEVEL + 1)
 def interior_template(m):
-    """The `InteriorTemplate` of inner segment count ``m`` (>= 1), from the general construction."""
+    """The `InteriorTemplate` of inner segment count ``m`` (>= 1), from the general construction; built once per
+    ``m`` and kept (its arrays are shared: never write to them)."""
     m = int(m)
     empty = np.zeros((0, 3), np.int64)
     if m == 1:  # the face itself, no interior
@@ -107,9 +110,12 @@ def interior_template(m):
     for col in range(3):  # column c takes own, c + 1 b_next, c + 2 off
         column_source[:, col] = q + n_side * ((col - c) % 3)
     column_source[side == 0] = q[side == 0][:, None]  # the centre: own, 1/3, in every column
-    return InteriorTemplate(m, k, ring_pos, lone.interior_bary, before, after,
-                            np.stack([uniq // n_points, uniq % n_points], axis=1), corner_edges[:len(before)],
-                            corner_edges[len(before):], ring1_edges, side_k, side_j, side_len, column_source)
+    arrays = [np.array(a) for a in (k, ring_pos, lone.interior_bary, before, after,
+                                    np.stack([uniq // n_points, uniq % n_points], axis=1), corner_edges[:len(before)],
+                                    corner_edges[len(before):], ring1_edges, side_k, side_j, side_len, column_source)]
+    for a in arrays:
+        a.flags.writeable = False  # cached and shared by every call
+    return InteriorTemplate(m, *arrays)
 
 
 def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
@@ -132,7 +138,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     n_strip_inner = np.where(m >= 3, 3 * side, 0)  # the strip's ring-1 triangles
     n_strip_outer = np.where(m >= 2, boundary, 1)  # its boundary triangles (m == 1: the face itself)
     values, inverse = np.unique(m, return_inverse=True)
-    templates = [interior_template(v) for v in values]
+    templates = [interior_template(int(v)) for v in values]
     groups = group_by_class(inverse.reshape(-1), len(values))
     n_before = np.array([len(t.before) for t in templates], np.int64)[inverse]
     n_after = np.array([len(t.after) for t in templates], np.int64)[inverse]
@@ -146,71 +152,89 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     b_ids, b_bary = boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t, n_vertices,
                                       b_face, b_pos)
     n_interior = int(n_int.sum())
-    slot_id = np.concatenate([b_ids, interior_first + np.arange(n_interior, dtype=np.int64)]).astype(np.int32)
-    slot_face = np.concatenate([b_face, np.repeat(np.arange(n_faces, dtype=np.int64), n_int)])
-    in_bary = np.empty((n_interior, 3))
-    if spacing == "EQUAL":
-        for tpl, faces in zip(templates, groups, strict=True):
-            if len(tpl.bary):
-                in_bary[(int_start[faces][:, None] + np.arange(len(tpl.bary))).ravel()] = np.tile(tpl.bary,
-                                                                                                   (len(faces), 1))
-    else:
-        # The inner partition's parameters once per face and point index; the weights once per point of one side
-        # of each ring, rotated onto the other two (the same bits per element as `interior_bary`).
-        index = np.arange(int(m.max()) + 1)
-        table = point_params(inner_f[:, None], m[:, None], np.minimum(index, m[:, None]), spacing)
-        for tpl, faces in zip(templates, groups, strict=True):
-            if not len(tpl.ring_k):
-                continue
-            params = table[faces]
-            weights = np.concatenate(side_weights(params[:, tpl.side_k], params[:, tpl.side_k + tpl.side_j],
-                                                  tpl.side_j, tpl.side_len), axis=1)  # (F, 3Q)
-            rows = (int_start[faces][:, None] + np.arange(len(tpl.ring_k))).ravel()
-            put_rows(in_bary, rows, np.take(weights, tpl.column_source.ravel(), axis=1).reshape(-1, 3))
-    slot_bary = np.concatenate([b_bary, in_bary])
+    index_type = np.int32 if n_b + n_interior + interior_first < 2**31 else np.int64
     interior_base = n_b + int_start  # slot of each face's first interior point
+    # Built on first use, so the threads that evaluate the surface build them side by side (see `tessellate`).
 
-    index_type = np.int32 if len(slot_id) < 2**31 else np.int64
-    tri_slots = np.empty((n_out, 3), index_type)
-    # Strip, boundary triangles: segment i (local edge e, index j of n) reaches ring-1 vertex `inner_pos`, the
-    # number of ring-1 segments whose midpoint comes before its midpoint: e * s, plus those q of side e with
-    # (2q + 1) n < (2j + 1) s.
-    sf = np.flatnonzero(m[b_face] >= 2)
-    f, i = b_face[sf], b_pos[sf]
-    e, j = local_edge(i, outer_n[f])
-    n = outer_n[f, e]
-    s = side[f]
-    inner_pos = e * s + ((2 * j + 1) * s + n - 1) // (2 * n)
-    a_rows = tri_start[f] + i
-    tri_slots[a_rows, 0] = b_start[f] + i
-    tri_slots[a_rows, 1] = b_start[f] + (i + 1) % boundary[f]
-    tri_slots[a_rows, 2] = interior_base[f] + inner_pos % ring1_loop[f]
-    a_walk = i + inner_pos
-    a = (f, e, j, n, a_rows, a_walk)
-    # Strip, ring-1 triangles: segment q of side c reaches boundary vertex `outer_pos`, the number of boundary
-    # segments whose midpoint comes at or before its midpoint.
-    c_face, jj, _ = ragged(n_strip_inner)
-    s = side[c_face]
-    c, q = jj // np.maximum(s, 1), jj % np.maximum(s, 1)
-    n_c = outer_n[c_face, c]
-    before_c = np.where(c >= 1, outer_n[c_face, 0], 0) + np.where(c >= 2, outer_n[c_face, 1], 0)
-    outer_pos = before_c + ((2 * q + 1) * n_c + s) // (2 * s)
-    c_rows = tri_start[c_face] + n_strip_outer[c_face] + n_before[c_face] + jj
-    tri_slots[c_rows, 0] = interior_base[c_face] + (jj + 1) % ring1_loop[c_face]
-    tri_slots[c_rows, 1] = interior_base[c_face] + jj
-    tri_slots[c_rows, 2] = b_start[c_face] + outer_pos % boundary[c_face]
-    c_walk = jj + outer_pos
-    # Unrefined faces (m == 1): the boundary loop's three corners.
-    lone = np.flatnonzero(m == 1)
-    tri_slots[tri_start[lone]] = b_start[lone][:, None] + np.arange(3)
-    # Interiors, stamped per inner segment count.
-    for tpl, faces in zip(templates, groups, strict=True):
-        for part, offset in ((tpl.before, n_strip_outer[faces]),
-                             (tpl.after, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
-            if len(part):
-                rows = (tri_start[faces] + offset)[:, None] + np.arange(len(part))
-                block = (interior_base[faces][:, None, None] + part).astype(index_type).reshape(-1, 3)
-                put_rows(tri_slots, rows.ravel(), block)
+    def slot_ids():  # output vertex of every slot
+        out = np.empty(n_b + n_interior, index_type)
+        out[:n_b] = b_ids
+        out[n_b:] = np.arange(interior_first, interior_first + n_interior, dtype=index_type)
+        return out
+
+    def slot_faces():
+        out = np.empty(n_b + n_interior, index_type)
+        out[:n_b] = b_face
+        out[n_b:] = np.repeat(np.arange(n_faces, dtype=index_type), n_int)
+        return out
+
+    def slot_barys():
+        slot_bary = np.empty((n_b + n_interior, 3))
+        slot_bary[:n_b] = b_bary
+        in_bary = slot_bary[n_b:]  # the interior points' rows, written in place
+        if spacing == "EQUAL":
+            for tpl, faces in zip(templates, groups, strict=True):
+                if len(tpl.bary):
+                    put_rows(in_bary, (int_start[faces][:, None] + np.arange(len(tpl.bary))).ravel(),
+                             np.tile(tpl.bary, (len(faces), 1)))
+        else:
+            # The inner partition's parameters once per face and point index; the weights once per point of one side
+            # of each ring, rotated onto the other two (the same bits per element as `interior_bary`).
+            index = np.arange(int(m.max()) + 1)
+            table = point_params(inner_f[:, None], m[:, None], np.minimum(index, m[:, None]), spacing)
+            for tpl, faces in zip(templates, groups, strict=True):
+                if not len(tpl.ring_k):
+                    continue
+                params = table[faces]
+                weights = np.concatenate(side_weights(params[:, tpl.side_k], params[:, tpl.side_k + tpl.side_j],
+                                                      tpl.side_j, tpl.side_len), axis=1)  # (F, 3Q)
+                rows = (int_start[faces][:, None] + np.arange(len(tpl.ring_k))).ravel()
+                put_rows(in_bary, rows, np.take(weights, tpl.column_source.ravel(), axis=1).reshape(-1, 3))
+        return slot_bary
+
+    def strip():  # slot of every output triangle corner, and the strip rows for the output edges
+        tri_slots = np.empty((n_out, 3), index_type)
+        # Strip, boundary triangles: segment i (local edge e, index j of n) reaches ring-1 vertex `inner_pos`, the
+        # number of ring-1 segments whose midpoint comes before its midpoint: e * s, plus those q of side e with
+        # (2q + 1) n < (2j + 1) s.
+        sf = np.flatnonzero(m[b_face] >= 2)
+        f, i = b_face[sf], b_pos[sf]
+        e, j = local_edge(i, outer_n[f])
+        n = outer_n[f, e]
+        s = side[f]
+        inner_pos = e * s + ((2 * j + 1) * s + n - 1) // (2 * n)
+        a_rows = tri_start[f] + i
+        tri_slots[a_rows, 0] = b_start[f] + i
+        tri_slots[a_rows, 1] = b_start[f] + (i + 1) % boundary[f]
+        tri_slots[a_rows, 2] = interior_base[f] + inner_pos % ring1_loop[f]
+        a_walk = i + inner_pos
+        # Strip, ring-1 triangles: segment q of side c reaches boundary vertex `outer_pos`, the number of boundary
+        # segments whose midpoint comes at or before its midpoint.
+        c_face, jj, _ = ragged(n_strip_inner)
+        s = side[c_face]
+        c, q = jj // np.maximum(s, 1), jj % np.maximum(s, 1)
+        n_c = outer_n[c_face, c]
+        before_c = np.where(c >= 1, outer_n[c_face, 0], 0) + np.where(c >= 2, outer_n[c_face, 1], 0)
+        outer_pos = before_c + ((2 * q + 1) * n_c + s) // (2 * s)
+        c_rows = tri_start[c_face] + n_strip_outer[c_face] + n_before[c_face] + jj
+        tri_slots[c_rows, 0] = interior_base[c_face] + (jj + 1) % ring1_loop[c_face]
+        tri_slots[c_rows, 1] = interior_base[c_face] + jj
+        tri_slots[c_rows, 2] = b_start[c_face] + outer_pos % boundary[c_face]
+        c_walk = jj + outer_pos
+        # Unrefined faces (m == 1): the boundary loop's three corners.
+        lone = np.flatnonzero(m == 1)
+        tri_slots[tri_start[lone]] = b_start[lone][:, None] + np.arange(3)
+        # Interiors, stamped per inner segment count.
+        for tpl, faces in zip(templates, groups, strict=True):
+            for part, offset in ((tpl.before, n_strip_outer[faces]),
+                                 (tpl.after, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
+                if len(part):
+                    rows = (tri_start[faces] + offset)[:, None] + np.arange(len(part))
+                    block = (interior_base[faces][:, None, None] + part).astype(index_type).reshape(-1, 3)
+                    put_rows(tri_slots, rows.ravel(), block)
+        return tri_slots, (f, e, j, n, a_rows, a_walk), (c_face, jj, c_rows, c_walk), lone
+
+    slot_bary, slots = Lazy(slot_barys), Lazy(strip)
 
     def output_edges():
         seg_start, seg_ends = edge_segments(edges, edge_n, point_start, n_vertices)
@@ -223,6 +247,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         out[:n_seg] = seg_ends
         corner = np.empty((n_out, 3), np.int32)
         triangles = ref.triangles
+        _, a, (c_face, jj, c_rows, c_walk), lone = slots.get()
         # The strip's spokes, numbered by walk position: a triangle's spoke is the one it starts from (its first
         # boundary and ring-1 vertex); the one it ends on is the next triangle's.
         f, e, j, n, rows, walk = a
@@ -260,11 +285,12 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
         interior_counts=n_int, n_triangles=n_out, face_edges=face_edges, flipped=flipped,
         arrays=LazyArrays(
-            triangles=Lazy(lambda: np.take(slot_id, tri_slots)),
+            triangles=Lazy(lambda: np.take(slot_ids(), slots.get()[0])),
             triangle_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts)),
             interior_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), n_int)),
-            interior_bary=Lazy.of(in_bary), corner_bary=Lazy(lambda: slot_bary[tri_slots]),
-            output_edges=Lazy(output_edges), corner_slots=Lazy.of((slot_face, slot_bary, tri_slots))),
+            interior_bary=Lazy(lambda: slot_bary.get()[n_b:]),
+            corner_bary=Lazy(lambda: slot_bary.get()[slots.get()[0]]), output_edges=Lazy(output_edges),
+            corner_slots=Lazy(lambda: (slot_faces(), slot_bary.get(), slots.get()[0]))),
     )
     return ref
 
