@@ -122,13 +122,16 @@ def test_exported_obj_has_the_tessellated_faces(clean_scene, bpy_module, tmp_pat
     assert faces == n
 
 
-@pytest.mark.parametrize("level", [1, 5])
-def test_written_edges_are_the_ones_blender_computes(clean_scene, bpy_module, level):
-    """The operator hands Blender the refinement's own edges (no edge computation): the mesh validates clean
-    and its edges and corner edges are those Blender derives from the faces alone."""
+@pytest.mark.parametrize("levels", [{"level": 1}, {"level": 5},
+                                    {"level_mode": "ADAPTIVE", "metrics": {"CURVATURE"}, "spacing": "FRACTIONAL_EVEN",
+                                     "max_level": 12.0}])
+def test_written_edges_are_the_ones_blender_computes(clean_scene, bpy_module, levels):
+    """The operator hands Blender the refinement's own edges (no edge computation), uniform (per pattern class)
+    and adaptive (per face): the mesh validates clean and its edges and corner edges are those Blender derives
+    from the faces alone."""
     bpy = bpy_module
     add_suzanne(bpy)
-    assert bpy.ops.tessera.tessellate(method="PN", level=level) == {"FINISHED"}
+    assert bpy.ops.tessera.tessellate(method="PN", **levels) == {"FINISHED"}
     me = bpy.context.active_object.data
     assert not me.validate(verbose=False)  # nothing to correct
 

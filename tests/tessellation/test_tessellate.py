@@ -177,3 +177,34 @@ def test_corner_values_agree_bit_for_bit_at_shared_vertices(monkeypatch, spacing
     assert one_value_per_vertex(ref.triangles, out)
     corners = ref.triangles < len(v)  # input vertices keep their value exactly
     assert np.array_equal(out[corners], uv[ref.triangles[corners]])
+
+
+@pytest.mark.parametrize("method", ["LINEAR", "PHONG", "PN"])
+@pytest.mark.parametrize("spacing", ["EQUAL", "FRACTIONAL_EVEN"])
+def test_per_face_levels_give_the_general_construction_bytes(method, spacing, monkeypatch):
+    """Faces whose levels all differ take the per-face path (strips and stamped interiors); the whole tessellation
+    (positions, triangles, normals, every attribute) has the same bytes as with the general construction it
+    replaced, split corner normals included."""
+    from tessera.kernels.tessellation import refine as refine_module
+    from tessera.kernels.tessellation import refine_templates
+    from tessera.kernels.tessellation.refine_general import refine_general
+
+    mesh, uv_maps, _, _ = mesh_with_attributes(4)
+    rng = np.random.default_rng(8)
+    mesh.corner_normals = rng.normal(size=(len(mesh.triangles), 3, 3)).astype(np.float32)  # split everywhere
+    levels = rng.uniform(1, 23, len(triangle_edges(mesh.triangles)[0]))
+    monkeypatch.setattr(refine_templates, "worth_it", lambda classes, n: False)
+    got = tessellate(mesh, levels, spacing=spacing, method=method, backend="numpy")
+    assert got.refinement.face_class is None and got.refinement.arrays.corner_slots is not None
+    monkeypatch.setattr(refine_module, "refine_split", refine_general)
+    want = tessellate(mesh, levels, spacing=spacing, method=method, backend="numpy")
+    assert not want.refinement.has_output_edges  # the general construction ran
+    a, b = got.mesh, want.mesh
+    for name in ("positions", "triangles", "point_normals", "corner_normals"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        assert x is None or (x.dtype == y.dtype and np.array_equal(x, y)), name
+    for group in ("point_attributes", "corner_attributes", "face_attributes"):
+        for key, x in getattr(a, group).items():
+            y = getattr(b, group)[key]
+            assert x.dtype == y.dtype and np.array_equal(x, y), key
