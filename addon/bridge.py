@@ -1,8 +1,9 @@
 """The only module where mesh data crosses between Blender and numpy.
 
 Reading uses Blender's loop triangles (quads and n-gons are triangulated the way Blender draws them)
-and typed ``foreach_get``; writing allocates elements once and fills attributes with typed
-``foreach_set`` (``from_pydata`` is about 10x slower). Arrays are float32 / int32, contiguous.
+and typed ``foreach_get``; writing allocates a new mesh's elements once and fills its arrays with
+`mesh_memory.write_items` (a bulk copy where the layout allows, else typed ``foreach_set``; ``from_pydata`` is
+about 10x slower). Arrays are float32 / int32, contiguous.
 """
 
 from contextlib import contextmanager
@@ -16,6 +17,7 @@ from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.tolerances import FLAT_FACE_NORMAL_ATOL
 from ..kernels.displacement.tangent_space import triangle_tangents
 from . import compat
+from .mesh_memory import set_face_offsets, write_items
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
 # the number of channels.
@@ -196,7 +198,7 @@ def _set_custom_normals(mesh, normals, domain="CORNER"):
     """Corner (L, 3) or point (V, 3) float32 normals as custom normals, with the fastest API this Blender has."""
     normals = np.ascontiguousarray(normals, dtype=np.float32)
     if compat.FLOAT_CUSTOM_NORMALS:
-        _new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", domain).data.foreach_set("vector", normals.ravel())
+        write_items(_new_attribute(mesh, "custom_normal", "FLOAT_VECTOR", domain).data, "vector", normals)
     else:
         compat.set_split_custom_normals(mesh, normals, domain)
 
@@ -206,9 +208,9 @@ def _add_geometry(mesh, positions, corner_verts, loop_starts):
     mesh.vertices.add(len(positions))
     mesh.loops.add(len(corner_verts))
     mesh.polygons.add(len(loop_starts))
-    mesh.attributes["position"].data.foreach_set("vector", positions.ravel())
-    mesh.attributes[".corner_vert"].data.foreach_set("value", corner_verts)
-    compat.set_face_offsets(mesh, loop_starts)
+    write_items(mesh.attributes["position"].data, "vector", positions)
+    write_items(mesh.attributes[".corner_vert"].data, "value", corner_verts)
+    set_face_offsets(mesh, loop_starts)
 
 
 @contextmanager
@@ -230,8 +232,8 @@ def _set_edges(mesh, edges):
         return
     edges, corner_edges = edges
     mesh.edges.add(len(edges))
-    mesh.attributes[".edge_verts"].data.foreach_set("value", np.ascontiguousarray(edges, np.int32).ravel())
-    mesh.attributes[".corner_edge"].data.foreach_set("value", np.ascontiguousarray(corner_edges, np.int32).ravel())
+    write_items(mesh.attributes[".edge_verts"].data, "value", np.ascontiguousarray(edges, np.int32))
+    write_items(mesh.attributes[".corner_edge"].data, "value", np.ascontiguousarray(corner_edges, np.int32).ravel())
 
 
 def write_mesh(name, arrays, info=None, edges=None):
@@ -259,7 +261,7 @@ def write_mesh(name, arrays, info=None, edges=None):
                 dtype = arrays.attribute_types.get(attr_name, "FLOAT")
                 prop, _, np_type = _FACE_TYPES[dtype]
                 attr = _new_attribute(mesh, attr_name, dtype, domain)
-                attr.data.foreach_set(prop, np.ascontiguousarray(values, dtype=np_type).ravel())
+                write_items(attr.data, prop, np.ascontiguousarray(values, dtype=np_type))
         if arrays.corner_normals is not None:
             _set_custom_normals(mesh, arrays.corner_normals.reshape(-1, 3))
         elif arrays.point_normals is not None:
@@ -306,13 +308,13 @@ def write_polygons(name, poly):
             first = poly.corner_normals[starts]
             flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < FLAT_FACE_NORMAL_ATOL, axis=1)
             sharp = np.logical_and.reduceat(flat, starts)
-            _new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", sharp)
+            write_items(_new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data, "value", sharp)
         if poly.corner_uvs is not None:
             uv = _new_attribute(mesh, "UVMap", "FLOAT2", "CORNER")
-            uv.data.foreach_set("vector", np.ascontiguousarray(poly.corner_uvs).ravel())
+            write_items(uv.data, "vector", np.ascontiguousarray(poly.corner_uvs, np.float32))
         if poly.face_material is not None and np.any(poly.face_material):
             mat = _new_attribute(mesh, "material_index", "INT", "FACE")
-            mat.data.foreach_set("value", np.ascontiguousarray(poly.face_material))
+            write_items(mat.data, "value", np.ascontiguousarray(poly.face_material, np.int32))
         mesh.update()
     return mesh
 

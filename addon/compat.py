@@ -18,17 +18,13 @@ ask for it, and the version is compared only where the difference cannot be seen
 - geometry-node modes (Set Curve Normal, Resample Curve, Merge by Distance, ...): a node property until 4.5, a
   menu input socket from 5.0 (`set_node_mode`); Curve to Mesh scales the profile by the curve radius by itself in
   4.2 and through its Scale input from 4.5 (builders link the radius where the node has that input);
-- face offsets: ``MeshPolygon.loop_start`` has a per-item setter, so ``foreach_set`` costs ~50 ns a face (the wall
-  of every large mesh written from Python); in every supported Blender a polygon's RNA pointer is its entry in
-  the mesh's int32 face-offset array, which `set_face_offsets` fills in one copy where a probe shows that layout
-  and a read-back confirms it (else ``foreach_set``).
+- the memory layout behind RNA items (face offsets, attribute values) is the same in all of them; `mesh_memory`
+  checks it at run time instead of assuming it.
 """
 
-import ctypes
 import math
 
 import bpy
-import numpy as np
 
 #: 5.0+ stores custom normals as a float vector attribute (what is written is what is read back).
 FLOAT_CUSTOM_NORMALS = bpy.app.version >= (5, 0, 0)
@@ -55,32 +51,6 @@ def set_split_custom_normals(mesh, normals, domain="CORNER"):
         mesh.normals_split_custom_set_from_vertices(normals)
     else:
         mesh.normals_split_custom_set(normals)
-
-
-#: Below this many faces ``foreach_set`` is as fast as the probe.
-BULK_OFFSETS_MIN_FACES = 256
-
-
-def set_face_offsets(mesh, starts):
-    """Write the first corner of every face: starts (F,) int32 ascending, F = ``len(mesh.polygons)``, the corners
-    already added. One copy into the face-offset array where each polygon's RNA pointer is its int32 entry (the
-    stride and span checked, the copy read back through RNA at the ends and in between); otherwise, or when the
-    read-back differs, ``foreach_set``. Returns True when the bulk copy was used."""
-    starts = np.ascontiguousarray(starts, dtype=np.int32)
-    polys = mesh.polygons
-    n = len(starts)
-    if n != len(polys):
-        raise ValueError(f"{n} face starts for {len(polys)} faces")
-    if n >= BULK_OFFSETS_MIN_FACES:
-        first, second, last = polys[0].as_pointer(), polys[1].as_pointer(), polys[n - 1].as_pointer()
-        if second - first == 4 and last - first == 4 * (n - 1):
-            ctypes.memmove(first, starts.ctypes.data, starts.nbytes)
-            probe = np.unique(np.linspace(0, n - 1, 17).astype(np.int64))
-            if all(polys[int(i)].loop_start == starts[i] for i in probe) and \
-                    polys[n - 1].loop_total == len(mesh.loops) - int(starts[-1]):
-                return True
-    polys.foreach_set("loop_start", starts)
-    return False
 
 
 def stroke_element(location, pressure=1.0, first=False, mouse=(0.0, 0.0)):

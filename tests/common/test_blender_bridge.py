@@ -58,10 +58,10 @@ def test_failed_write_leaves_no_mesh(clean_scene, bpy_module, bridge, addon_modu
 
 @pytest.mark.parametrize("sizes", ["triangles", "mixed"])
 def test_face_offsets_written_in_one_copy_equal_foreach_set(clean_scene, bpy_module, addon_module, sizes):
-    """`compat.set_face_offsets` takes the bulk copy on every supported Blender, and the mesh it leaves has the same
-    face starts and sizes as the per-face setter's, and validates clean."""
+    """`mesh_memory.set_face_offsets` takes the bulk copy on every supported Blender, and the mesh it leaves has the
+    same face starts and sizes as the per-face setter's, and validates clean."""
     bpy = bpy_module
-    compat = addon_module("addon.compat")
+    memory = addon_module("addon.mesh_memory")
     rng = np.random.default_rng(7)
     n_faces = 20000
     size = np.full(n_faces, 3) if sizes == "triangles" else rng.integers(3, 9, n_faces)
@@ -78,7 +78,7 @@ def test_face_offsets_written_in_one_copy_equal_foreach_set(clean_scene, bpy_mod
         me.attributes["position"].data.foreach_set("vector", positions.ravel())
         me.attributes[".corner_vert"].data.foreach_set("value", corner_verts)
         if bulk:
-            assert compat.set_face_offsets(me, starts)
+            assert memory.set_face_offsets(me, starts)
         else:
             me.polygons.foreach_set("loop_start", starts)
         me.update(calc_edges=True)
@@ -96,14 +96,92 @@ def test_face_offsets_written_in_one_copy_equal_foreach_set(clean_scene, bpy_mod
 
 def test_face_offsets_fall_back_below_the_bulk_size(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
-    compat = addon_module("addon.compat")
+    memory = addon_module("addon.mesh_memory")
     me = bpy.data.meshes.new("few")
     me.vertices.add(4)
     me.loops.add(6)
     me.polygons.add(2)
     me.attributes[".corner_vert"].data.foreach_set("value", np.array([0, 1, 2, 0, 2, 3], np.int32))
-    assert not compat.set_face_offsets(me, np.array([0, 3], np.int32))
+    assert not memory.set_face_offsets(me, np.array([0, 3], np.int32))
     me.update(calc_edges=True)
     assert [tuple(p.vertices) for p in me.polygons] == [(0, 1, 2), (0, 2, 3)]
     with pytest.raises(ValueError):
-        compat.set_face_offsets(me, np.array([0], np.int32))
+        memory.set_face_offsets(me, np.array([0], np.int32))
+
+
+
+@pytest.mark.parametrize(("data_type", "domain", "prop", "bulk"), [
+    ("FLOAT_VECTOR", "POINT", "vector", True), ("FLOAT2", "CORNER", "vector", True),
+    ("FLOAT_COLOR", "CORNER", "color", True), ("FLOAT", "FACE", "value", True), ("INT", "FACE", "value", True),
+    ("BOOLEAN", "FACE", "value", True), ("INT8", "POINT", "value", False), ("BYTE_COLOR", "POINT", "color", False)])
+def test_bulk_writes_equal_foreach_set(clean_scene, bpy_module, addon_module, data_type, domain, prop, bulk):
+    """`mesh_memory.write_items` copies straight into the attribute's memory where its items are one array of the
+    values' type (and leaves the same values as ``foreach_set``, read back both ways); types Blender stores
+    otherwise (8-bit integers and colours) go through ``foreach_set``."""
+    bpy = bpy_module
+    memory = addon_module("addon.mesh_memory")
+    n_faces = 20_000
+    width = {"FLOAT_VECTOR": 3, "FLOAT2": 2, "FLOAT_COLOR": 4, "BYTE_COLOR": 4}.get(data_type, 1)
+    got = []
+    for use_bulk in (True, False):
+        me = bpy.data.meshes.new("bulk")
+        me.vertices.add(3 * n_faces)
+        me.loops.add(3 * n_faces)
+        me.polygons.add(n_faces)
+        me.attributes[".corner_vert"].data.foreach_set("value", np.arange(3 * n_faces, dtype=np.int32))
+        memory.set_face_offsets(me, np.arange(0, 3 * n_faces, 3, dtype=np.int32))
+        attr = me.attributes.new("probe", data_type, domain)
+        n = len(attr.data)
+        rng = np.random.default_rng(3)  # the same values both ways
+        values = {"INT": rng.integers(-1000, 1000, n).astype(np.int32), "BOOLEAN": rng.random(n) < 0.5,
+                  "INT8": rng.integers(-100, 100, n).astype(np.int32)}.get(
+                      data_type, rng.random((n, width)).astype(np.float32).reshape(n, -1))
+        if use_bulk:
+            assert memory.write_items(attr.data, prop, values, min_bytes=0) == bulk
+        else:
+            attr.data.foreach_set(prop, values.ravel())
+        out = np.empty(values.size, values.dtype)
+        me.attributes["probe"].data.foreach_get(prop, out)
+        got.append(out)
+        bpy.data.meshes.remove(me)
+    assert np.array_equal(got[0], got[1])
+
+
+def test_bulk_written_mesh_equals_the_foreach_set_mesh(clean_scene, bpy_module, addon_module, monkeypatch):
+    """A tessellation written by the bridge (bulk copies) and the same arrays written with ``foreach_set`` give equal
+    meshes after ``update``: positions, corners, faces, edges, UVs, normals Blender derives, bounds."""
+    bpy = bpy_module
+    bridge = addon_module("addon.bridge")
+    tess = addon_module("kernels.tessellation.tessellate")
+    bpy.ops.mesh.primitive_monkey_add()
+    bpy.ops.mesh.uv_texture_add()
+    arrays, info = bridge.read_mesh(bpy.context.active_object.data)
+    result = tess.tessellate(arrays, tess.uniform_levels(arrays, 12), method="PN")
+    edges = result.refinement.output_edges()
+    bulk = bridge.write_mesh("bulk", result.mesh, info, edges=edges)
+    monkeypatch.setattr(bridge, "write_items",
+                        lambda c, prop, v, min_bytes=0: c.foreach_set(prop, np.ascontiguousarray(v).ravel()))
+    monkeypatch.setattr(bridge, "set_face_offsets", lambda me, s: me.polygons.foreach_set("loop_start", s))
+    plain = bridge.write_mesh("plain", result.mesh, info, edges=edges)
+
+    def arrays_of(me):
+        assert not me.validate(verbose=False)
+        out = {}
+        for name, collection, prop, dtype, width in (
+                ("co", me.vertices, "co", np.float32, 3), ("normal", me.vertices, "normal", np.float32, 3),
+                ("loop_start", me.polygons, "loop_start", np.int32, 1),
+                ("corner", me.loops, "vertex_index", np.int32, 1), ("edge", me.edges, "vertices", np.int32, 2),
+                ("corner_edge", me.loops, "edge_index", np.int32, 1),
+                ("uv", me.uv_layers.active.data, "uv", np.float32, 2),
+                ("corner_normal", me.corner_normals, "vector", np.float32, 3)):
+            a = np.empty(len(collection) * width, dtype)
+            collection.foreach_get(prop, a)
+            out[name] = a
+        return out
+
+    a, b = arrays_of(bulk), arrays_of(plain)
+    assert len(a["co"]) > 30000 * 3
+    for key in a:
+        assert np.array_equal(a[key], b[key]), key
+    ob_a, ob_b = bpy.data.objects.new("a", bulk), bpy.data.objects.new("b", plain)
+    assert [tuple(c) for c in ob_a.bound_box] == [tuple(c) for c in ob_b.bound_box]

@@ -1,0 +1,89 @@
+"""Large arrays written straight into the memory behind a new mesh's RNA collections.
+
+``foreach_set`` copies through RNA on the Python thread: item by item where the property has a setter (face offsets,
+~50 ns a face), otherwise as one copy that also pays the operating system's first touch of Blender's new pages. In
+every supported Blender an item's RNA pointer (``as_pointer``) is its address in one contiguous array (attribute
+values, face offsets), so `write_items` checks that layout (the stride and span of the item pointers), copies the
+array in row blocks on the worker threads (numpy releases the GIL while it copies) and reads a sample back through
+RNA; where the layout is not found, or the sample differs, it writes with ``foreach_set``. For data-blocks the caller
+has just created only: nothing else may share or cache those arrays.
+"""
+
+import ctypes
+
+import numpy as np
+
+from ..kernels.common import workers
+
+#: Arrays smaller than this go through ``foreach_set`` (the probe and the threads cost more than they save).
+BULK_MIN_BYTES = 1 << 20
+#: Face offsets go in bulk from 256 faces (their per-item setter makes ``foreach_set`` slow from the start).
+OFFSETS_MIN_BYTES = 1024
+#: Items read back through RNA after a bulk copy (spread over the array, the ends included).
+SAMPLES = 17
+
+
+def write_items(collection, prop, values, min_bytes=BULK_MIN_BYTES):
+    """``collection.foreach_set(prop, values)``, in bulk where the layout allows.
+
+    collection: an RNA collection of n items (``mesh.attributes[name].data``, ``mesh.polygons``); prop: the item
+    property that holds the values; values: (n,) or (n, k) array of the item's C type (float32, int32, bool);
+    min_bytes: smaller arrays go through ``foreach_set``. Returns True when the bulk copy was used.
+    """
+    values = np.ascontiguousarray(values)
+    n = len(collection)
+    if values.size == 0 or values.size % max(n, 1):
+        raise ValueError(f"{values.shape} values for {n} items of {prop!r}")
+    rows = values.reshape(n, -1)
+    if n >= 2 and values.nbytes >= min_bytes:
+        target = _item_array(collection, n, rows.dtype, rows.shape[1])
+        if target is not None:
+            _copy_blocks(target, rows)
+            del target  # never kept: the memory is Blender's
+            if _sample_matches(collection, prop, rows):
+                return True
+    collection.foreach_set(prop, values.ravel())
+    return False
+
+
+def _item_array(collection, n, dtype, width):
+    """A numpy view (n, width) of the memory behind ``collection`` when its items are one contiguous array of
+    ``width`` values of ``dtype`` each; else None."""
+    item = np.dtype(dtype).itemsize * width
+    first, second, last = (collection[i].as_pointer() for i in (0, 1, n - 1))
+    if first == 0 or second - first != item or last - first != item * (n - 1):
+        return None
+    memory = (ctypes.c_char * (item * n)).from_address(first)
+    return np.frombuffer(memory, dtype=dtype).reshape(n, width)
+
+
+def _copy_blocks(target, rows):
+    """``target[...] = rows`` in one block per worker thread."""
+    bounds = np.linspace(0, len(rows), workers.WORKERS + 1).astype(np.int64)
+    jobs = [workers.submit(np.copyto, target[lo:hi], rows[lo:hi]) for lo, hi in zip(bounds[:-1], bounds[1:],
+                                                                                        strict=True) if hi > lo]
+    for job in jobs:
+        job.result()
+
+
+def _sample_matches(collection, prop, rows):
+    for i in np.unique(np.linspace(0, len(rows) - 1, SAMPLES).astype(np.int64)):
+        got = getattr(collection[int(i)], prop)
+        if not np.array_equal(np.asarray(got, dtype=rows.dtype).reshape(-1), rows[i]):
+            return False
+    return True
+
+
+def set_face_offsets(mesh, starts):
+    """Write the first corner of every face: starts (F,) int32 ascending, F = ``len(mesh.polygons)``, the corners
+    already added (`write_items` on ``loop_start``, whose RNA setter costs ~50 ns a face; the last face's size is
+    checked too, which reads the array's closing entry). Returns True when the bulk copy was used."""
+    starts = np.ascontiguousarray(starts, dtype=np.int32)
+    polys = mesh.polygons
+    if len(starts) != len(polys):
+        raise ValueError(f"{len(starts)} face starts for {len(polys)} faces")
+    bulk = write_items(polys, "loop_start", starts, min_bytes=OFFSETS_MIN_BYTES)
+    if bulk and polys[len(polys) - 1].loop_total != len(mesh.loops) - int(starts[-1]):
+        polys.foreach_set("loop_start", starts)
+        return False
+    return bulk
