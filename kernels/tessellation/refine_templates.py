@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.partition import point_params
+from ..common.rows import put_rows
 from ..common.topology import group_by_class, ragged
 from .refine_general import interior_counts as count_interior
 from .refine_general import refine_general
@@ -148,10 +149,14 @@ def _output_edges(tris, n_vertices, edges, face_edges, flipped, edge_n, point_st
         ids = interior_start[faces][:, None] + np.arange(len(interior_at))
         slot_cols[:, start:] = ids
         if len(interior_at):  # an interior edge's ends: the corner it leaves and the next, in the output triangles
-            tri = tri_start[faces][:, None] + interior_at // 3
-            k = interior_at % 3
-            out_edges[ids.ravel(), 0] = triangles[tri, k].ravel()
-            out_edges[ids.ravel(), 1] = triangles[tri, (k + 1) % 3].ravel()
+            corner = (3 * tri_start[faces])[:, None] + (interior_at - interior_at % 3)  # first corner of its triangle
+            flat = triangles.reshape(-1)
+            ends = np.stack([np.take(flat, corner + interior_at % 3), np.take(flat, corner + (interior_at + 1) % 3)],
+                            axis=-1).astype(np.int32).reshape(-1, 2)
+            if cls.consecutive:  # the faces' interior edges are one run
+                out_edges[int(ids[0, 0]):int(ids[-1, -1]) + 1] = ends
+            else:
+                put_rows(out_edges, ids.ravel(), ends)
         scatter_rows(corner_edges, cls, tri_start, stamp(slot_cols, cols.ravel()).reshape(len(faces), -1, 3))
     return out_edges, corner_edges
 
