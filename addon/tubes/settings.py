@@ -91,7 +91,8 @@ def kernel_settings(s, aa_clamp=None):
     return TubeSettings(
         sides=s.sides, sides_mode=s.sides_mode, min_sides=s.min_sides, max_sides=max(s.min_sides, s.max_sides),
         edge_pixels=s.edge_pixels, refine=s.refine, refine_kind=s.refine_kind, select_angle=s.select_angle,
-        aa_clamp=s.aa_clamp if aa_clamp is None else aa_clamp, max_radius=s.max_radius, caps=s.caps, uvs=s.uvs)
+        aa_clamp=s.aa_clamp if aa_clamp is None else aa_clamp, max_radius=s.max_radius, caps=s.caps, uvs=s.uvs,
+        point_normals=False)  # Blender derives a written mesh's normals
 
 
 def draw_tube_settings(layout, s):

@@ -33,7 +33,9 @@ class TubeSettings:
     sides: ring vertices for FIXED; min_sides / max_sides bound CAMERA, which picks per tube
     ceil(π · projected diameter / edge_pixels); refine: Catmull-Rom subdivisions per segment (1 = off);
     select_angle: tolerance in radians for point selection (0 = keep all); aa_clamp: keep one pixel of radius
-    for the camera; max_radius: cap of that inflation (0 = none); caps: NONE / FLAT / ROUND; uvs: corner UVs.
+    for the camera; max_radius: cap of that inflation (0 = none); caps: NONE / FLAT / ROUND; uvs: corner UVs;
+    point_normals: write the exact radial point normals (a mesh writer that lets Blender derive its normals can
+    skip them: a sixth of the output bytes; FLAT caps compute them anyway for the body's corners).
     """
 
     sides: int = 8
@@ -48,6 +50,7 @@ class TubeSettings:
     max_radius: float = 0.0
     caps: str = "NONE"
     uvs: bool = True
+    point_normals: bool = True
 
     def validate(self, camera):
         if self.caps not in CAPS:
@@ -241,6 +244,8 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     if settings.caps == "FLAT":
         mesh.corner_normals[: layout.body_c] = mesh.point_normals[mesh.corner_verts[: layout.body_c]]
         mesh.point_normals = None
+    elif not settings.point_normals:
+        mesh.point_normals = None
     report(1.0)
     return mesh
 
@@ -307,7 +312,8 @@ class _Layout:
         mesh = PolygonMesh(
             positions=np.empty((v, 3), np.float32), face_sizes=np.empty(f, np.int32),
             corner_verts=np.empty(c, np.int32), edges=np.empty((e, 2), np.int32), corner_edges=np.empty(c, np.int32),
-            point_normals=np.empty((v, 3), np.float32), face_material=np.empty(f, np.int32),
+            point_normals=np.empty((v, 3), np.float32) if settings.point_normals or settings.caps == "FLAT" else None,
+            face_material=np.empty(f, np.int32),
         )
         if settings.caps == "FLAT":
             mesh.corner_normals = np.empty((c, 3), np.float32)
@@ -388,7 +394,8 @@ def _write_body_numpy(mesh, lines, frames, n, curves, run, cursor, u_ends):
 
     # vertices: radial directions (the normals), then centre + radius * radial
     cos_t, sin_t = (x.astype(np.float32) for x in _ring(n))
-    nrm_out = mesh.point_normals[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
+    nrm_out = (mesh.point_normals[v0:v0 + n_pts * n].reshape(n_pts, n, 3) if mesh.point_normals is not None
+               else np.empty((n_pts, n, 3), np.float32))  # the radial directions, kept only when asked for
     pos_out = mesh.positions[v0:v0 + n_pts * n].reshape(n_pts, n, 3)
     np.multiply(cos_t[None, :, None], frames.n[pick][:, None, :], out=nrm_out)
     np.multiply(sin_t[None, :, None], frames.b[pick][:, None, :], out=pos_out)
@@ -451,7 +458,8 @@ def _write_caps(mesh, caps, layout, settings):
     for piece in caps:
         nv, ne = len(piece.positions), len(piece.edges)
         mesh.positions[v:v + nv] = piece.positions
-        mesh.point_normals[v:v + nv] = piece.normals
+        if mesh.point_normals is not None:
+            mesh.point_normals[v:v + nv] = piece.normals
         mesh.edges[e:e + ne] = piece.edges
         v, e = v + nv, e + ne
         for k, faces in enumerate(piece.faces):

@@ -73,6 +73,7 @@ class TubeDevice:
                self._in(u1, np.float32), self._in(material, np.int32), self._in(ring, np.float32),
                np.int32(n), np.int32(n_pts), np.int32(len(run.seg)), np.int64(cursor.v), np.int64(cursor.e),
                np.int64(cursor.f), np.int64(cursor.c), np.int32(u_ends is not None),
+               np.int32(self.mesh.point_normals is not None),
                b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
                b["face_material"], b["corner_uvs"])
 

@@ -1,7 +1,7 @@
 // Tube body for one run of tubes with `n` sides, one work item per point (the numpy reference is
 // kernels.tubes._write_body: same vertex, edge, face and corner numbering).
 // centre, nrm, bin: (P, 3) float; radius: (P) float; seg: (P) int segment id or -1; nxt: (P) int next point;
-// u0, u1: (P) float UV u at the segment's ends (read when write_uv); ring: (n, 2) float cos, sin of the sides'
+// u0, u1: (P) float UV u at the segment's ends (read when write_uv); normals written only when write_normals; ring: (n, 2) float cos, sin of the sides'
 // angles (the numpy reference's float32 table, so both paths place vertices alike). Outputs are whole-mesh arrays written at
 // offsets v0 (vertices), e0 (edges), f0 (faces), c0 (corners); n_pts points and n_seg segments in this run.
 __kernel void tube_body(__global const float *centre, __global const float *nrm, __global const float *bin,
@@ -9,7 +9,7 @@ __kernel void tube_body(__global const float *centre, __global const float *nrm,
                         __global const float *u0, __global const float *u1, __global const int *material,
                         __global const float2 *ring,
                         const int n, const int n_pts, const int n_seg, const long v0, const long e0,
-                        const long f0, const long c0, const int write_uv,
+                        const long f0, const long c0, const int write_uv, const int write_normals,
                         __global float *positions, __global float *normals, __global int *edges,
                         __global int *corner_verts, __global int *corner_edges, __global int *face_sizes,
                         __global int *face_material, __global float *uvs)
@@ -24,7 +24,9 @@ __kernel void tube_body(__global const float *centre, __global const float *nrm,
   for (int j = 0; j < n; ++j) {
     const float2 cs = ring[j];
     const float3 radial = cs.x * N + cs.y * B;
-    vstore3(radial, vp + j, normals);
+    if (write_normals) {
+      vstore3(radial, vp + j, normals);
+    }
     vstore3(c + r * radial, vp + j, positions);
     const long er = e0 + (long)p * n + j;
     edges[2 * er] = (int)(vp + j);
