@@ -19,6 +19,10 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
     grid: bpy.props.IntProperty(name="Views", default=8, min=1, max=32, description="Views a side of the atlas")
     tile: bpy.props.IntProperty(name="View Size", default=128, min=8, max=2048, description="Pixels a view")
     samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, description="Cycles samples a view")
+    dilation: bpy.props.IntProperty(name="Dilation", default=4, min=0, max=64,
+                                    description="Texels each view's colours and normals spread into the empty texels "
+                                                "around it (alpha stays 0), so engines that filter the atlas show no "
+                                                "dark halo at the outline")
     hemi: bpy.props.BoolProperty(name="Upper Hemisphere", default=False,
                                  description="Views only from above (hemi-octahedral): finer for objects on the "
                                              "ground")
@@ -34,7 +38,7 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            atlas = bake_atlas(ob, self.grid, self.tile, self.samples, self.hemi)
+            atlas = bake_atlas(ob, self.grid, self.tile, self.samples, self.hemi, dilation=self.dilation)
         finally:
             wm.progress_end()
         name = f"{ob.name} impostor"

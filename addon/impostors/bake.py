@@ -14,6 +14,7 @@ import numpy as np
 
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
+from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
 from ..node_groups import Graph
 from .worker import lower_priority, worker_command, world_box
@@ -43,8 +44,9 @@ def view_camera(direction, centre, size):
     return centre + f * size, -f, np.cross(f, right)
 
 
-def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600):
-    """Render ``ob`` (world space) from every view of the atlas and assemble the atlases: an `Atlas`."""
+def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600, dilation=0):
+    """Render ``ob`` (world space) from every view of the atlas and assemble the atlases: an `Atlas`. dilation:
+    texels the colours and normals of each view spread into the empty texels around it (`dilate_views`)."""
     lo, hi = world_box(ob)
     centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
     if not size > 0:
@@ -83,6 +85,10 @@ def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600):
         colour[rows, cols] = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1)
         normal[rows, cols] = np.stack([nx, ny, nz], -1)
         depth[rows, cols] = np.where(a > 0.5, np.clip(z / size - 0.5, 0, 1), 1.0)
+    if dilation:
+        covered = colour[..., 3] > 0
+        colour[..., :3] = dilate_views(colour[..., :3], covered, grid, dilation)
+        normal = dilate_views(normal, covered, grid, dilation)
     return Atlas(colour, normal, depth, centre, size, int(grid), bool(hemi))
 
 

@@ -53,6 +53,14 @@ def test_the_card_shows_the_view_of_its_direction(clean_scene, bpy_module, addon
     assert all(c > 0.02 for c in tiles.values())
     (i1, j1), (i2, j2) = (1, 1), (2, 1)  # straight down z; and a view from +x, where the box is short
     assert abs(tiles[(i1, j1)] - tiles[(i2, j2)]) > 0.05
+    # Dilation (4 texels by default): the empty texels next to a view's outline carry colour, the far ones none
+    rgb = px.reshape(96, 96, 4)[..., :3]
+    yy, xx = np.mgrid[:32, :32]
+    for (i, j) in tiles:
+        a, c = alpha[j * 32:(j + 1) * 32, i * 32:(i + 1) * 32], rgb[j * 32:(j + 1) * 32, i * 32:(i + 1) * 32]
+        ys, xs = np.nonzero(a > 0)
+        d = np.min(np.abs(yy[..., None] - ys) + np.abs(xx[..., None] - xs), axis=-1)
+        assert np.all(c[(d >= 1) & (d <= 4)].sum(axis=-1) > 0) and np.all(c[d > 4] == 0), (i, j)
     box.hide_render = True
     dirs = oc.view_directions(3)
     size = float(np.linalg.norm(np.ptp(np.array([box.matrix_world @ __import__("mathutils").Vector(c)
