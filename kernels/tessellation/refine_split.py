@@ -91,8 +91,8 @@ def interior_template(m):
     uniq, inverse = np.unique(keys, return_inverse=True)
     corner_edges = inverse.reshape(local.shape).astype(np.int64)
     ring1 = np.arange(n_ring1)
-    ring1_keys = np.minimum(ring1, (ring1 + 1) % max(n_ring1, 1)) * n_points + np.maximum(ring1,
-                                                                                          (ring1 + 1) % max(n_ring1, 1))
+    ring1_next = (ring1 + 1) % max(n_ring1, 1)
+    ring1_keys = np.minimum(ring1, ring1_next) * n_points + np.maximum(ring1, ring1_next)
     ring1_edges = np.searchsorted(uniq, ring1_keys)
     if n_ring1 and not np.array_equal(uniq[ring1_edges], ring1_keys):
         raise AssertionError(f"a ring-1 segment of inner level {m} is no edge of the interior")
