@@ -10,11 +10,18 @@
   frame) while the worker renders another board, against the same with the worker idle (the seed: 171 vs 171 fps).
 - ``k``: for tolerance K = 1, 1.5, 2, 4 the frame at which the validity tests (`kernels.impostors.validity`) ask for
   a new board on the strafe, and the error measured there (R5).
-Run: .venv/bin/python bench/nailboards.py
+- ``r3_*``: the live manager (`addon.impostors.live.NailboardManager`) on a 10 s camera path at 60 frames/s (a
+  sweep back and forth around the object while the distance breathes), with a renderer that takes a fixed number of
+  frames per board, and the techniques switched on in turn: a new board whenever the eye moved (the baseline), the
+  validity metric (K = 1), the cache of recent boards (reuse), velocity prediction. Reported: renders asked for per
+  second, boards swapped in per second (the effective update rate), cache hits, and the share of frames drawn from a
+  board that is valid for that frame's eye (R3).
+Run: .venv/bin/python bench/nailboards.py (``--r3``: the R3 rows only)
 """
 
 import importlib
 import json
+import sys
 import time
 
 import numpy as np
@@ -22,6 +29,66 @@ from _setup import enable_extension
 
 SIZE = 200
 FRAMES = 40
+
+
+R3_FPS, R3_SECONDS, R3_LATENCY = 60, 10.0, 6  # frames a second, path length, frames a render takes
+
+
+class _TimedJob:
+    """A render that finishes after a fixed number of the manager's frames (what the worker's job offers)."""
+
+    clock = [0]
+
+    def __init__(self, setup, latency):
+        self.setup, self.ready = setup, self.clock[0] + latency
+
+    def done(self):
+        return self.clock[0] >= self.ready
+
+    def result(self):
+        return "images"
+
+    def cancel(self):
+        self.ready = float("inf")
+
+
+def r3_cases(mod, ob, fov):
+    """R3 on the live manager with a fixed-latency renderer (no Cycles: the counts depend on the path and the
+    tests, not on the render)."""
+    live, va, board = mod("addon.impostors.live"), mod("kernels.impostors.validity"), mod("kernels.impostors.board")
+    lo, hi = live.world_box(ob)
+
+    def request(ob, eye, res_screen, fov):
+        return _TimedJob(board.board_setup(lo, hi, eye, res_screen, fov), R3_LATENCY)
+
+    n = int(R3_FPS * R3_SECONDS)
+    t = np.arange(n) / R3_FPS
+    angle = 0.35 * np.sin(2 * np.pi * t / 6.0)  # back and forth over 40 degrees, period 6 s (at most 21 deg/s)
+    radius = 6.0 + 1.0 * np.sin(2 * np.pi * t / 9.0)
+    eyes = np.stack([radius * np.sin(angle), -radius * np.cos(angle), 0.25 * radius], axis=1)
+    configs = (("every_move", dict(k=1e-9, cache_size=0, lead=0)), ("metric", dict(k=1.0, cache_size=0, lead=0)),
+               ("metric_reuse", dict(k=1.0, cache_size=8, lead=0)),
+               ("metric_reuse_prediction", dict(k=1.0, cache_size=8, lead=R3_LATENCY)))
+    for name, cfg in configs:
+        manager = live.NailboardManager(request, relief_factor=0.25, **cfg)
+        _TimedJob.clock[0] = 0
+        swaps, valid, empty, last = 0, 0, 0, None
+        for frame, eye in enumerate(eyes):
+            _TimedJob.clock[0] = frame
+            state = manager.update(ob, eye, SIZE, fov)
+            if state.board is not None and state.board is not last:
+                swaps += 1
+            last = state.board
+            if state.board is None:
+                empty += 1
+            elif not va.check(state.board, eye, fov, SIZE, 1.0, 0.25).regenerate:
+                valid += 1
+        print(json.dumps({"bench": "nailboards", "case": f"r3_{name}", "frames": n, "fps": R3_FPS,
+                          "render_latency_frames": R3_LATENCY, "renders_per_second": round(manager.regenerations
+                                                                                           / R3_SECONDS, 2),
+                          "boards_swapped_in_per_second": round(swaps / R3_SECONDS, 2),
+                          "cache_hits": manager.cache_hits, "frames_valid_share": round(valid / n, 3),
+                          "frames_without_board": empty}), flush=True)
 
 
 def main():
@@ -38,6 +105,9 @@ def main():
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
     fov = 0.6
+    r3_cases(mod, ball, fov)
+    if "--r3" in sys.argv:
+        return
     o1 = np.array([0.0, -6.0, 1.5])
     images = worker.request_board(ball, o1, res_screen=SIZE, fov=fov, samples=1).result(timeout=600)
     frame = images.setup.frame
