@@ -32,8 +32,10 @@ def write_items(collection, prop, values, min_bytes=BULK_MIN_BYTES):
     """
     values = np.ascontiguousarray(values)
     n = len(collection)
-    if values.size == 0 or values.size % max(n, 1):
+    if (n == 0) != (values.size == 0) or values.size % max(n, 1):
         raise ValueError(f"{values.shape} values for {n} items of {prop!r}")
+    if n == 0:
+        return False
     rows = values.reshape(n, -1)
     if n >= 2 and values.nbytes >= min_bytes:
         target = _item_array(collection, n, rows.dtype, rows.shape[1])

@@ -185,3 +185,16 @@ def test_bulk_written_mesh_equals_the_foreach_set_mesh(clean_scene, bpy_module, 
         assert np.array_equal(a[key], b[key]), key
     ob_a, ob_b = bpy.data.objects.new("a", bulk), bpy.data.objects.new("b", plain)
     assert [tuple(c) for c in ob_a.bound_box] == [tuple(c) for c in ob_b.bound_box]
+
+
+def test_bulk_writes_of_nothing_and_of_the_wrong_size(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    memory = addon_module("addon.mesh_memory")
+    me = bpy.data.meshes.new("empty")
+    me.vertices.add(4)
+    faces = me.attributes.new("per_face", "FLOAT", "FACE")  # no faces: nothing to write, and no error
+    assert memory.write_items(faces.data, "value", np.zeros(0, np.float32)) is False
+    with pytest.raises(ValueError):
+        memory.write_items(me.attributes["position"].data, "vector", np.zeros((5, 3), np.float32))
+    with pytest.raises(ValueError):
+        memory.write_items(me.attributes["position"].data, "vector", np.zeros((0, 3), np.float32))
