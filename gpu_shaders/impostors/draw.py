@@ -6,6 +6,7 @@ so the board composites per texel with the rest of the scene (it intersects and 
 import numpy as np
 
 from .. import loader
+from ..textures import image_texture
 
 
 def _describe():
@@ -35,14 +36,6 @@ def _describe():
     return info
 
 
-def _texture(values, fmt):
-    import gpu
-
-    v = np.ascontiguousarray(values, np.float32)
-    h, w = v.shape[:2]
-    return gpu.types.GPUTexture((w, h), format=fmt, data=gpu.types.Buffer("FLOAT", v.size, v.ravel()))
-
-
 class BoardDrawData:
     """GPU resources of one nailboard: frame (`kernels.impostors.prewarp.ReliefFrame`); colours (H, W, 4),
     displacement (H, W) and normals (H, W, 3) of its source images; splat: the `Splat` of the current pre-warp."""
@@ -50,17 +43,17 @@ class BoardDrawData:
     def __init__(self, frame, colours, displacement, splat, normals=None):
         h, w = np.asarray(displacement).shape
         self.frame, self.size = frame, (w, h)
-        self.colours = _texture(colours, "RGBA32F")
-        self.displacement = _texture(displacement, "R32F")
+        self.colours = image_texture(colours, "RGBA32F")
+        self.displacement = image_texture(displacement, "R32F")
         n = np.zeros((h, w, 4), np.float32)
         if normals is not None:
             n[..., :3] = normals
-        self.normals = _texture(n, "RGBA32F")
+        self.normals = image_texture(n, "RGBA32F")
         self.set_splat(splat)
 
     def set_splat(self, splat):
         """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel."""
-        self.offsets = _texture(splat.offsets, "RG32F")
+        self.offsets = image_texture(splat.offsets, "RG32F")
 
     def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
         """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major."""

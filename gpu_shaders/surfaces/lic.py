@@ -7,7 +7,7 @@ import numpy as np
 
 from ...kernels.surfaces.vector_field import AnalyticField, GridField
 from .. import loader
-from ..textures import TEX_WIDTH, rgba_texture
+from ..textures import TEX_WIDTH, image_texture, rgba_texture
 
 FIELD_CODES = {"ABC": 0, "VORTEX": 1}
 
@@ -74,7 +74,7 @@ def _grid_texture(field):
         h, w = v.shape[:2]
         rgba = np.zeros((h, w, 4), np.float32)
         rgba[..., :2] = v
-        return gpu.types.GPUTexture((w, h), format="RGBA32F", data=gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel()))
+        return image_texture(rgba, "RGBA32F")
     return gpu.types.GPUTexture((2, 2), format="RGBA32F")
 
 

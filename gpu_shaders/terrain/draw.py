@@ -14,7 +14,7 @@ from ...kernels.terrain.analysis import tile_bounds
 from ...kernels.terrain.mesh import pattern, pattern_classes, pattern_codes
 from .. import loader
 from ..offscreen import set_shading, shaded_create_info
-from ..textures import TEX_WIDTH, rgba_texture
+from ..textures import TEX_WIDTH, image_texture, rgba_texture
 
 MAX_TEXTURE = 8192
 
@@ -45,14 +45,11 @@ class TerrainDrawData:
     """GPU resources of one terrain: the height texture, and per-class tile textures for the current view."""
 
     def __init__(self, hm, table):
-        import gpu
-
         self.hm, self.table = hm, table
         self.stride = max(1, -(-max(hm.width, hm.height) // MAX_TEXTURE))
         rows = np.arange(0, hm.height, self.stride)
         heights = np.ascontiguousarray(np.concatenate([hm.rows(int(r), int(r) + 1) for r in rows])[:, ::self.stride])
-        self.heights = gpu.types.GPUTexture((heights.shape[1], heights.shape[0]), format="R32F",
-                                            data=gpu.types.Buffer("FLOAT", heights.size, heights.ravel()))
+        self.heights = image_texture(heights, "R32F")
         self.height_bytes = heights.nbytes
         self.buckets, self.tile_bytes, self.fractional = {}, 0, False
         ntx, nty = table.counts

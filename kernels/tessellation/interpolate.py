@@ -130,9 +130,11 @@ def corner_values(ref, values, backend="auto"):
 
 
 def _corner_values_by_triangle(ref, values):
-    """`corner_values` on the general refinement, in numpy: each output corner weighs its face's three corner values
-    by its barycentrics, in blocks of output triangles. The same products and sums, in the same order, as
-    `gather_weighted_numpy` over the corners, without building the (3M, 3) gather index."""
+    """`corner_values` on a refinement built per face, in numpy: each output corner weighs its face's three corner
+    values by its barycentrics. The same products and sums, in the same order, as `gather_weighted_numpy` over the
+    corners, without building the (3M, 3) gather index. Where the refinement numbers its vertex slots (every
+    construction here does) each slot is weighed once and gathered to its corners; the per-corner blocks below
+    serve a refinement without slots and are the reference the tests hold the slot path to."""
     n_faces = len(ref.faces)
     flat = np.asarray(values).reshape(n_faces, 3, -1)
     tail = values.shape[2:]

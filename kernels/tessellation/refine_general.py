@@ -41,14 +41,21 @@ def face_levels(face_edges, n_edges, edge_levels, inner_levels, spacing):
     return edge_f, edge_n, inner_f, inner_n
 
 
+def edge_points(edge_f, edge_n, spacing):
+    """The points inside every mesh edge, in edge order and canonical direction: ``(point_edge (Ne,) int64 edge of
+    each point, point_start (E,) int64 each edge's first point, edge_point_t (Ne,) float64 parameter from the
+    edge's lower vertex)``."""
+    point_edge, point_local, point_start = ragged(edge_n - 1)
+    return point_edge, point_start, point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
+
+
 def refine_general(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     """The vectorised construction for any mix of levels (every face's rings and zipper at once)."""
     edge_f, edge_n, inner_f, inner_n = levels
     outer_n = edge_n[face_edges]  # (T, 3) segments of each local edge
 
     # Edge points, once per edge, in canonical direction: edge e owns ids [edge_first[e], + n_e - 1).
-    point_edge, point_local, point_start = ragged(edge_n - 1)
-    edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
+    point_edge, point_start, edge_point_t = edge_points(edge_f, edge_n, spacing)
     edge_first = n_vertices + point_start
     interior_first = n_vertices + len(point_edge)
 

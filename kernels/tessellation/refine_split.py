@@ -22,7 +22,7 @@ import numpy as np
 from ..common.partition import MAX_LEVEL, point_params
 from ..common.rows import put_rows, take_rows
 from ..common.topology import group_by_class, ragged
-from .refine_general import boundary_vertices, interior_counts, local_edge, refine_general, side_weights
+from .refine_general import boundary_vertices, edge_points, interior_counts, local_edge, refine_general, side_weights
 from .refine_templates import edge_segments
 from .refinement import Lazy, LazyArrays, Refinement
 
@@ -124,8 +124,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     edge_f, edge_n, inner_f, inner_n = levels
     outer_n = edge_n[face_edges].astype(np.int64)  # (T, 3)
     n_faces = len(tris)
-    point_edge, point_local, point_start = ragged(edge_n - 1)
-    edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
+    point_edge, point_start, edge_point_t = edge_points(edge_f, edge_n, spacing)
     edge_first = n_vertices + point_start
     interior_first = n_vertices + len(point_edge)
 

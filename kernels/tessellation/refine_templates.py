@@ -13,11 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..common.partition import point_params
 from ..common.rows import put_rows
 from ..common.topology import group_by_class, ragged
+from .refine_general import edge_points, refine_general
 from .refine_general import interior_counts as count_interior
-from .refine_general import refine_general
 from .refinement import Lazy, LazyArrays, Refinement
 
 #: Use the class path when there are at most this many classes, or at least this many faces per class.
@@ -244,8 +243,7 @@ def refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classe
     first, inverse = classes
     outer_n = edge_n[face_edges]
     outer_f = edge_f[face_edges]
-    point_edge, point_local, point_start = ragged(edge_n - 1)
-    edge_point_t = point_params(edge_f[point_edge], edge_n[point_edge], point_local + 1, spacing)
+    point_edge, point_start, edge_point_t = edge_points(edge_f, edge_n, spacing)
     interior_counts = count_interior(inner_n)
     interior_start = np.cumsum(interior_counts) - interior_counts
     interior_first = n_vertices + len(point_edge)

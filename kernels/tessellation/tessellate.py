@@ -262,6 +262,7 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
         ref = refine(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
         report(0.4)
         attributes = workers.submit(_attributes, ref, mesh, backend)
+        edges = _output_edges_job(ref)
         out = MeshArrays(positions=point_values(ref, mesh.positions, backend), triangles=ref.triangles,
                          attribute_types=dict(mesh.attribute_types))
         if mesh.corner_normals is not None:
@@ -284,9 +285,7 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
             out_positions, points = surface(ref, inputs)
         normals = workers.submit(_shading_normals, ref, method, options, *shading, points)
         triangles = workers.submit(lambda: ref.triangles)
-        # The per-face path's output edges (a few long array passes) overlap the surface work; the class path's
-        # (a Python loop per class) measured slower on a worker than after it, so the writer builds those.
-        edges = workers.submit(ref.output_edges) if ref.has_output_edges and not ref.classes else None
+        edges = _output_edges_job(ref)
         if surface is None and method == "PN":
             out_positions = workers.submit(_pn_positions, ref, positions, vertex_normals).result()
         elif surface is None:
@@ -298,11 +297,18 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
         out.point_normals, out.corner_normals = normals.result()
     report(0.8)
     out.point_attributes, out.corner_attributes, out.face_attributes = attributes.result()
-    if method != "LINEAR" and edges is not None:
+    if edges is not None:
         edges.result()
     report(1.0)
     result.mesh, result.refinement = out, ref
     return result
+
+
+def _output_edges_job(ref):
+    """The per-face path's output edges on a worker (a few long array passes, beside the surface work), or None:
+    the class path's (a Python loop per class) measured slower on a worker than after it, so the writer builds
+    those, and the general path has none."""
+    return workers.submit(ref.output_edges) if ref.has_output_edges and not ref.classes else None
 
 
 def _attributes(ref, mesh, backend):
