@@ -16,8 +16,9 @@ from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.tolerances import FLAT_FACE_NORMAL_ATOL
 from ..kernels.displacement.tangent_space import triangle_tangents
+from ..kernels.tubes.builder import MeshSizes, allocate_arrays
 from . import compat
-from .mesh_memory import set_face_offsets, write_items
+from .mesh_memory import face_offsets_match, face_offsets_view, item_view, sample_matches, set_face_offsets, write_items
 
 # Blender attribute data types whose values are floats we can interpolate, with the element field and
 # the number of channels.
@@ -287,6 +288,118 @@ def _restore_active(mesh, info):
 # ---- polygon meshes (tubes), wire meshes, point attributes (curves: curve_bridge) --------------------------
 
 
+# The `PolygonMesh` arrays a new mesh keeps as one array each: field -> (attribute, item property, dtype, width).
+_POLYGON_ARRAYS = {
+    "positions": ("position", "vector", np.float32, 3),
+    "corner_verts": (".corner_vert", "value", np.int32, 1),
+    "edges": (".edge_verts", "value", np.int32, 2),
+    "corner_edges": (".corner_edge", "value", np.int32, 1),
+    "corner_uvs": ("UVMap", "vector", np.float32, 2),
+    "face_material": ("material_index", "value", np.int32, 1),
+}
+
+
+class PolygonWriter:
+    """A new `bpy.types.Mesh` made from a `kernels.tubes.builder.PolygonMesh`.
+
+    `allocate` is an allocator for `build_tubes`: it adds the new mesh's elements and hands the kernel the mesh's own
+    arrays (positions, face offsets, corners, edges, UVs, materials) wherever each is one array in memory
+    (`mesh_memory.item_view`), so the output is written once, straight into Blender's memory, instead of built and
+    then copied. `finish` writes the rest (sharp faces, any array not handed out), reads a sample of what was written
+    in place back through RNA, and returns the mesh. ``track(mesh)`` is called with the new mesh as soon as it exists
+    (a `guarded.Transaction` removes it if anything fails later); `write_polygons` is the one-shot form.
+    """
+
+    def __init__(self, name, track=None):
+        self.name = name
+        self.mesh = None
+        self._track = track or (lambda block: block)
+        self._in_place = []
+
+    def allocate(self, sizes, settings):
+        """``builder.allocate_arrays(sizes, settings)`` with the new mesh's arrays in place of new ones."""
+        poly = allocate_arrays(sizes, settings)
+        data = self._new_mesh(sizes, settings.uvs)
+        for name, (_, _, dtype, width) in _POLYGON_ARRAYS.items():
+            wanted = getattr(poly, name)
+            view = item_view(data[name], dtype, width) if wanted is not None and data[name] is not None else None
+            if view is not None:
+                setattr(poly, name, view.reshape(wanted.shape))
+                self._in_place.append(name)
+        offsets = face_offsets_view(self.mesh)
+        if offsets is not None:
+            poly.face_offsets = offsets
+            self._in_place.append("face_offsets")
+        return poly
+
+    def finish(self, poly):
+        """Write what ``poly`` holds outside the mesh and return the mesh. The arrays that were the mesh's own memory
+        are set to None in ``poly`` (they belong to Blender from here on)."""
+        if self.mesh is None:
+            self._new_mesh(polygon_sizes(poly), poly.corner_uvs is not None)
+        mesh = self.mesh
+        data = self._data()
+        sharp = None if poly.corner_normals is None else _sharp_faces(poly)
+        for name, (_, prop, dtype, _) in _POLYGON_ARRAYS.items():
+            values = getattr(poly, name)
+            if values is None or data[name] is None:
+                continue
+            if name not in self._in_place:
+                write_items(data[name], prop, np.ascontiguousarray(values, dtype))
+            elif not sample_matches(data[name], prop, values.reshape(len(data[name]), -1)):
+                data[name].foreach_set(prop, np.array(values).ravel())  # never seen: the slow way
+        if "face_offsets" not in self._in_place or not face_offsets_match(mesh, poly.face_offsets):
+            set_face_offsets(mesh, np.array(poly.face_offsets[:-1]))
+        if poly.edges is None:
+            mesh.update(calc_edges=True)
+        if sharp is not None:
+            write_items(_new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data, "value", sharp)
+        for name in self._in_place:
+            setattr(poly, name, None)
+        self._in_place.clear()
+        mesh.update()
+        return mesh
+
+    def _new_mesh(self, sizes, uvs):
+        if sizes.faces == 0 or sizes.vertices == 0:
+            raise EmptyResultError(f"Nothing to write for {self.name!r}: the result has no faces")
+        mesh = self.mesh = self._track(bpy.data.meshes.new(self.name))
+        mesh.vertices.add(sizes.vertices)
+        mesh.loops.add(sizes.corners)
+        mesh.polygons.add(sizes.faces)
+        mesh.edges.add(sizes.edges)
+        if uvs:
+            _new_attribute(mesh, "UVMap", "FLOAT2", "CORNER")
+        if sizes.materials:
+            _new_attribute(mesh, "material_index", "INT", "FACE")
+        return self._data()
+
+    def _data(self):
+        """The item collections of the arrays in `_POLYGON_ARRAYS` (None for those the mesh lacks)."""
+        attrs = self.mesh.attributes
+        return {name: (attrs[attr].data if attr in attrs else None)
+                for name, (attr, _, _, _) in _POLYGON_ARRAYS.items()}
+
+
+def _sharp_faces(poly):
+    """(F,) bool: the faces whose corner normals all equal their first (flat, so Blender's sharp-face shading is
+    theirs)."""
+    offsets = np.asarray(poly.face_offsets)
+    starts, sizes = offsets[:-1], np.diff(offsets)
+    corner_face = np.repeat(np.arange(len(starts)), sizes)
+    first = poly.corner_normals[starts]
+    flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < FLAT_FACE_NORMAL_ATOL, axis=1)
+    return np.logical_and.reduceat(flat, starts)
+
+
+def polygon_sizes(poly):
+    """The `MeshSizes` of a `PolygonMesh` (no edges when it has none: Blender computes them; materials when any face
+    has one other than 0)."""
+    materials = poly.face_material is not None and bool(np.any(poly.face_material))
+    return MeshSizes(vertices=len(poly.positions), faces=len(poly.face_offsets) - 1, corners=len(poly.corner_verts),
+                     edges=0 if poly.edges is None else len(poly.edges), materials=materials)
+
+
 def write_polygons(name, poly):
     """Create a `bpy.types.Mesh` from a `kernels.tubes.builder.PolygonMesh` and return it.
 
@@ -294,29 +407,16 @@ def write_polygons(name, poly):
     smooth except where corner normals differ from the point normal field (FLAT caps: those faces are
     marked sharp, so Blender's own normals keep the rim crisp). UVs go to the map "UVMap", materials to
     ``material_index``. Removes the half-built mesh if anything fails. Raises `EmptyResultError` for a mesh
-    without faces (Blender's geometry writer needs at least one point).
+    without faces (Blender's geometry writer needs at least one point). The tube operator writes through a
+    `PolygonWriter` instead, whose allocator lets the kernel write into the mesh directly.
     """
-    n_f = len(poly.face_sizes)
-    if n_f == 0 or len(poly.positions) == 0:
-        raise EmptyResultError(f"Nothing to write for {name!r}: the result has no faces")
-    starts = poly.face_offsets[:-1]  # a cumulative sum: computed once
-    with _new_mesh(name) as mesh:
-        _add_geometry(mesh, np.ascontiguousarray(poly.positions), poly.corner_verts, starts)
-        _set_edges(mesh, None if poly.edges is None else (poly.edges, poly.corner_edges))
-        if poly.corner_normals is not None:
-            corner_face = np.repeat(np.arange(n_f), poly.face_sizes)
-            first = poly.corner_normals[starts]
-            flat = np.all(np.abs(poly.corner_normals - first[corner_face]) < FLAT_FACE_NORMAL_ATOL, axis=1)
-            sharp = np.logical_and.reduceat(flat, starts)
-            write_items(_new_attribute(mesh, "sharp_face", "BOOLEAN", "FACE").data, "value", sharp)
-        if poly.corner_uvs is not None:
-            uv = _new_attribute(mesh, "UVMap", "FLOAT2", "CORNER")
-            write_items(uv.data, "vector", np.ascontiguousarray(poly.corner_uvs, np.float32))
-        if poly.face_material is not None and np.any(poly.face_material):
-            mat = _new_attribute(mesh, "material_index", "INT", "FACE")
-            write_items(mat.data, "value", np.ascontiguousarray(poly.face_material, np.int32))
-        mesh.update()
-    return mesh
+    writer = PolygonWriter(name)
+    try:
+        return writer.finish(poly)
+    except Exception:
+        if writer.mesh is not None:
+            bpy.data.meshes.remove(writer.mesh)
+        raise
 
 
 def point_float_attribute(data, name, count):

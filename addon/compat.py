@@ -19,7 +19,8 @@ ask for it, and the version is compared only where the difference cannot be seen
   menu input socket from 5.0 (`set_node_mode`); Curve to Mesh scales the profile by the curve radius by itself in
   4.2 and through its Scale input from 4.5 (builders link the radius where the node has that input);
 - the memory layout behind RNA items (face offsets, attribute values) is the same in all of them; `mesh_memory`
-  checks it at run time instead of assuming it.
+  checks it at run time instead of assuming it. The face offsets are closed by the corner count in all of them
+  (`FACE_OFFSETS_CLOSED`).
 """
 
 import math
@@ -40,6 +41,10 @@ CUSTOM_NORMAL_STORAGE_ERROR = 0.0 if FLOAT_CUSTOM_NORMALS else math.sqrt(2.0 * 2
 #: corner domain in 4.5 and later (4.2: the face normal; 4.3 and 4.4 are not supported, so not
 #: checked). Nothing to ask Blender: the node is the same, only what it computes differs.
 NORMAL_NODE_CORNER_NORMALS = bpy.app.version >= (4, 5, 0)
+
+#: A mesh's face offsets are one array of F + 1 ints: each face's first corner, then the corner count (Blender
+#: 3.6 and later, so every supported one). A writer that fills them in place checks the last face's size afterwards.
+FACE_OFFSETS_CLOSED = bpy.app.version >= (3, 6, 0)
 
 UV_TANGENT_MESSAGE = "Tangent-space maps need Blender 5.0 or newer (its UV Tangent node)"
 

@@ -14,6 +14,7 @@ import ctypes
 import numpy as np
 
 from ..kernels.common import workers
+from . import compat
 
 #: Arrays smaller than this go through ``foreach_set`` (the probe and the threads cost more than they save).
 BULK_MIN_BYTES = 1 << 20
@@ -42,10 +43,19 @@ def write_items(collection, prop, values, min_bytes=BULK_MIN_BYTES):
         if target is not None:
             _copy_blocks(target, rows)
             del target  # never kept: the memory is Blender's
-            if _sample_matches(collection, prop, rows):
+            if sample_matches(collection, prop, rows):
                 return True
     collection.foreach_set(prop, values.ravel())
     return False
+
+
+def item_view(collection, dtype, width=1):
+    """A writable numpy view (n, width) of the memory behind ``collection``'s n items, or None where its items are
+    not one contiguous array of ``width`` values of ``dtype`` (or there are fewer than two items). For a
+    data-block the caller has just created, to be written before anything else touches it and dropped after:
+    the memory is Blender's (`sample_matches` checks what was written)."""
+    n = len(collection)
+    return _item_array(collection, n, np.dtype(dtype), width) if n >= 2 else None
 
 
 def _item_array(collection, n, dtype, width):
@@ -68,7 +78,8 @@ def _copy_blocks(target, rows):
         job.result()
 
 
-def _sample_matches(collection, prop, rows):
+def sample_matches(collection, prop, rows):
+    """Whether RNA reads back ``rows`` ((n, k) values) at `SAMPLES` items spread over ``collection``."""
     for i in np.unique(np.linspace(0, len(rows) - 1, SAMPLES).astype(np.int64)):
         got = getattr(collection[int(i)], prop)
         if not np.array_equal(np.asarray(got, dtype=rows.dtype).reshape(-1), rows[i]):
@@ -89,3 +100,24 @@ def set_face_offsets(mesh, starts):
         polys.foreach_set("loop_start", starts)
         return False
     return bulk
+
+
+
+def face_offsets_view(mesh):
+    """A writable (F + 1,) int32 view of a new mesh's face offsets (each face's first corner, then the corner count:
+    Blender's own layout, `compat.FACE_OFFSETS_CLOSED`), or None where they are not one array. Written in place, they
+    are checked with `face_offsets_match`."""
+    polys = mesh.polygons
+    if not compat.FACE_OFFSETS_CLOSED or item_view(polys, np.int32) is None:
+        return None
+    n = len(polys)
+    return np.frombuffer((ctypes.c_char * (4 * (n + 1))).from_address(polys[0].as_pointer()), dtype=np.int32)
+
+
+def face_offsets_match(mesh, offsets):
+    """Whether RNA reads ``offsets`` ((F + 1,) int32) back: the starts of `SAMPLES` faces and the last face's size."""
+    polys = mesh.polygons
+    last = len(polys) - 1
+    if polys[last].loop_total != int(offsets[-1]) - int(offsets[-2]):
+        return False
+    return sample_matches(polys, "loop_start", offsets[:-1].reshape(-1, 1))

@@ -57,19 +57,21 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
                     wm.progress_update(int(100 * (i + f) / len(sources)))
 
                 cam = object_camera(camera, ob.matrix_world) if camera is not None else None
+                # the kernel writes into the new mesh's own arrays (bridge.PolygonWriter.allocate)
+                writer = bridge.PolygonWriter(f"{ob.data.name}.tubes", track=tx.track)
                 try:
                     lines, notes = read_lines(ob, self)
                     self._check_budget(context, lines, settings)
-                    poly = build_tubes(lines, settings, cam, progress)
+                    poly = build_tubes(lines, settings, cam, progress, allocate=writer.allocate)
                 except EmptyResultError as err:  # this source has nothing to build; the others may
                     empty.append(f"{ob.name}: {err}")
                     continue
-                results.append((ob, poly, notes + poly.notes))
+                results.append((ob, writer.finish(poly), notes + poly.notes))
         finally:
             wm.progress_end()
         if not results:
             raise EmptyResultError(empty[0] if len(empty) == 1 else f"No tubes from {len(empty)} sources. {empty[0]}")
-        made = [self._place(tx, ob, poly) for ob, poly, _ in results]  # every source built before any is placed
+        made = [self._place(tx, ob, mesh) for ob, mesh, _ in results]  # every source built before any is placed
         for ob, _, notes in results:
             copy_tube_settings(self, ob.tessera.tubes)  # a batch script can re-run them
             for note in notes:
@@ -89,8 +91,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
                               f"over the memory budget of {budget / 2**20:,.0f} MiB. Use fewer sides, or raise "
                               "the budget in the Tessera preferences.")
 
-    def _place(self, tx, ob, poly):
-        mesh = tx.track(bridge.write_polygons(f"{ob.data.name}.tubes", poly))
+    def _place(self, tx, ob, mesh):
         for material in getattr(ob.data, "materials", ()):
             mesh.materials.append(material)
         new = tx.new_object(f"{ob.name}.tubes", mesh)

@@ -70,14 +70,15 @@ class TubeSettings:
 class PolygonMesh:
     """A polygon mesh as flat arrays.
 
-    positions: (V, 3) float32; face_sizes: (F,) int32; corner_verts: (L,) int32 (faces consecutive);
-    edges: (E, 2) int32 and corner_edges: (L,) int32 when known (the writer then skips edge computation);
-    point_normals: (V, 3) float32 or corner_normals: (L, 3) float32; corner_uvs: (L, 2) float32 or None;
-    face_material: (F,) int32.
+    positions: (V, 3) float32; face_offsets: (F + 1,) int32 first corner of every face, then L (faces consecutive,
+    the layout of Blender's own face offsets); corner_verts: (L,) int32; edges: (E, 2) int32 and corner_edges: (L,)
+    int32 when known (the writer then skips edge computation); point_normals: (V, 3) float32 or corner_normals:
+    (L, 3) float32; corner_uvs: (L, 2) float32 or None; face_material: (F,) int32, or None when every face has
+    material 0.
     """
 
     positions: np.ndarray
-    face_sizes: np.ndarray
+    face_offsets: np.ndarray
     corner_verts: np.ndarray
     edges: np.ndarray = None
     corner_edges: np.ndarray = None
@@ -88,12 +89,62 @@ class PolygonMesh:
     notes: list = field(default_factory=list)
 
     @property
-    def face_offsets(self):
-        """First corner of every face and the corner count: (F + 1,) int32 (corner ids fit, as corner_verts)."""
-        out = np.empty(len(self.face_sizes) + 1, np.int32)
-        out[0] = 0
-        np.cumsum(self.face_sizes, dtype=np.int32, out=out[1:])
-        return out
+    def face_sizes(self):
+        """Corners of every face: (F,) int32."""
+        return np.diff(self.face_offsets)
+
+
+@dataclass(frozen=True)
+class MeshSizes:
+    """Element counts of a tube mesh (bodies and caps), and whether any face has a material index other than 0:
+    what an allocator of its `PolygonMesh` needs."""
+
+    vertices: int
+    faces: int
+    corners: int
+    edges: int
+    materials: bool = True
+
+
+def allocate_arrays(sizes, settings):
+    """A `PolygonMesh` of new numpy arrays for ``sizes`` (`MeshSizes`) and the arrays ``settings`` asks for.
+
+    The default allocator of `build_tubes`. Another allocator (a mesh writer handing out the memory of the mesh it
+    will become) returns the same shapes and dtypes, contiguous; any array may live elsewhere.
+    """
+    v, f, c, e = sizes.vertices, sizes.faces, sizes.corners, sizes.edges
+    mesh = PolygonMesh(
+        positions=np.empty((v, 3), np.float32), face_offsets=np.empty(f + 1, np.int32),
+        corner_verts=np.empty(c, np.int32), edges=np.empty((e, 2), np.int32), corner_edges=np.empty(c, np.int32),
+        point_normals=np.empty((v, 3), np.float32) if settings.point_normals or settings.caps == "FLAT" else None,
+        face_material=np.empty(f, np.int32) if sizes.materials else None,
+    )
+    if settings.caps == "FLAT":
+        mesh.corner_normals = np.empty((c, 3), np.float32)
+    if settings.uvs:
+        mesh.corner_uvs = np.empty((c, 2), np.float32)
+    return mesh
+
+
+def _check_allocation(mesh, sizes, settings):
+    """Raise ValueError unless ``mesh`` (from an allocator) has every array ``settings`` needs, shaped for
+    ``sizes``, of the right dtype and contiguous."""
+    v, f, c, e = sizes.vertices, sizes.faces, sizes.corners, sizes.edges
+    want = {"positions": ((v, 3), np.float32), "face_offsets": ((f + 1,), np.int32), "corner_verts": ((c,), np.int32),
+            "edges": ((e, 2), np.int32), "corner_edges": ((c,), np.int32)}
+    if sizes.materials:
+        want["face_material"] = ((f,), np.int32)
+    if settings.point_normals or settings.caps == "FLAT":
+        want["point_normals"] = ((v, 3), np.float32)
+    if settings.caps == "FLAT":
+        want["corner_normals"] = ((c, 3), np.float32)
+    if settings.uvs:
+        want["corner_uvs"] = ((c, 2), np.float32)
+    for name, (shape, dtype) in want.items():
+        a = getattr(mesh, name)
+        if a is None or a.shape != shape or a.dtype != dtype or not a.flags.c_contiguous or not a.flags.writeable:
+            raise ValueError(f"The allocator gave {name} as "
+                             f"{None if a is None else (a.shape, a.dtype)}; {shape} {np.dtype(dtype)} was needed")
 
 
 @dataclass
@@ -210,14 +261,16 @@ def prepare_lines(lines, settings):
     return lines
 
 
-def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, backend="auto"):
+def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, backend="auto", allocate=allocate_arrays):
     """Tube mesh around every curve of ``lines`` (`polylines.Polylines`). Returns a `PolygonMesh`.
 
     Layout: tubes sorted by side count (stable, so FIXED keeps the curve order), bodies first, then caps.
     Output arrays are allocated once at their final size and written in chunks of curves, so memory stays
     close to the output itself. ``backend``: "auto" (OpenCL when a device with doubles exists, else numpy),
     "numpy" or "opencl" (the same numbering; values equal within float32 rounding). Raises `EmptyResultError`
-    when no curve has two distinct points (nothing has a length to put a tube around).
+    when no curve has two distinct points (nothing has a length to put a tube around). ``allocate(sizes,
+    settings)``: where the output goes (`allocate_arrays`, or memory the caller owns, such as a new mesh's); called
+    once, after the input has been checked.
     """
     settings.validate(camera)
     runtime = runtime_for(backend)
@@ -229,7 +282,8 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     frames = _frames(lines, settings, camera, runtime)
     report(0.3)
     layout = _Layout(lines, frames.sides, settings)
-    mesh = layout.allocate(settings)
+    mesh = allocate(layout.sizes, settings)
+    _check_allocation(mesh, layout.sizes, settings)
     mesh.notes = list(lines.notes)
     caps = []
     cursor = Cursor(cap_v=layout.body_v, cap_e=layout.body_e)
@@ -241,6 +295,7 @@ def build_tubes(lines, settings=TubeSettings(), camera=None, progress=None, back
     if device is not None:
         device.finish()
     _write_caps(mesh, caps, layout, settings)
+    mesh.face_offsets[-1] = layout.sizes.corners
     if settings.caps == "FLAT":
         mesh.corner_normals[: layout.body_c] = mesh.point_normals[mesh.corner_verts[: layout.body_c]]
         mesh.point_normals = None
@@ -305,21 +360,8 @@ class _Layout:
                 ends = 2 * int(np.sum(open_ & (sides == n)))
                 dv, de, df, dc = cap_sizes(settings.caps, int(n))
                 cap_v, cap_e, cap_f, cap_c = cap_v + ends * dv, cap_e + ends * de, cap_f + ends * df, cap_c + ends * dc
-        self.totals = (self.body_v + cap_v, self.body_f + cap_f, self.body_c + cap_c, self.body_e + cap_e)
-
-    def allocate(self, settings):
-        v, f, c, e = self.totals
-        mesh = PolygonMesh(
-            positions=np.empty((v, 3), np.float32), face_sizes=np.empty(f, np.int32),
-            corner_verts=np.empty(c, np.int32), edges=np.empty((e, 2), np.int32), corner_edges=np.empty(c, np.int32),
-            point_normals=np.empty((v, 3), np.float32) if settings.point_normals or settings.caps == "FLAT" else None,
-            face_material=np.empty(f, np.int32),
-        )
-        if settings.caps == "FLAT":
-            mesh.corner_normals = np.empty((c, 3), np.float32)
-        if settings.uvs:
-            mesh.corner_uvs = np.empty((c, 2), np.float32)
-        return mesh
+        self.sizes = MeshSizes(vertices=self.body_v + cap_v, faces=self.body_f + cap_f, corners=self.body_c + cap_c,
+                               edges=self.body_e + cap_e, materials=bool(np.any(lines.material_index)))
 
     def units(self, max_points=1 << 19):
         """``(sides, curve ids)`` runs of equal side count with about ``max_points`` points each."""
@@ -420,8 +462,9 @@ def _write_body_numpy(mesh, lines, frames, n, curves, run, cursor, u_ends):
     along = (e0 + (n_pts + np.arange(n_seg)) * n)[:, None]
     ce[..., 0], ce[..., 1] = (e0 + seg * n)[:, None] + j, along + j1
     ce[..., 2], ce[..., 3] = (e0 + nxt * n)[:, None] + j, along + j
-    mesh.face_sizes[f0:f0 + n_seg * n] = 4
-    mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][run.curve_of_point[seg]], n)
+    mesh.face_offsets[f0:f0 + n_seg * n] = np.arange(c0, c0 + 4 * n_seg * n, 4, dtype=np.int64)
+    if mesh.face_material is not None:
+        mesh.face_material[f0:f0 + n_seg * n] = np.repeat(lines.material_index[curves][run.curve_of_point[seg]], n)
     if u_ends is not None:
         u0, u1 = u_ends
         v_lo, v_hi = (j / n).astype(np.float32), ((j + 1) / n).astype(np.float32)
@@ -464,8 +507,9 @@ def _write_caps(mesh, caps, layout, settings):
         v, e = v + nv, e + ne
         for k, faces in enumerate(piece.faces):
             nf, width = faces.shape
-            mesh.face_sizes[f:f + nf] = width
-            mesh.face_material[f:f + nf] = piece.materials[k]
+            mesh.face_offsets[f:f + nf] = np.arange(c, c + nf * width, width, dtype=np.int64)
+            if mesh.face_material is not None:
+                mesh.face_material[f:f + nf] = piece.materials[k]
             mesh.corner_verts[c:c + nf * width] = faces.ravel()
             mesh.corner_edges[c:c + nf * width] = piece.corner_edges[k].ravel()
             if settings.uvs:

@@ -29,7 +29,7 @@ def runtime_for(backend):
 class TubeDevice:
     """Writes tube bodies into ``mesh`` (a preallocated `builder.PolygonMesh`) with OpenCL."""
 
-    OUTPUTS = ("positions", "point_normals", "edges", "corner_verts", "corner_edges", "face_sizes", "face_material",
+    OUTPUTS = ("positions", "point_normals", "edges", "corner_verts", "corner_edges", "face_offsets", "face_material",
                "corner_uvs")
 
     def __init__(self, runtime, mesh):
@@ -73,8 +73,8 @@ class TubeDevice:
                self._in(u1, np.float32), self._in(material, np.int32), self._in(ring, np.float32),
                np.int32(n), np.int32(n_pts), np.int32(len(run.seg)), np.int64(cursor.v), np.int64(cursor.e),
                np.int64(cursor.f), np.int64(cursor.c), np.int32(u_ends is not None),
-               np.int32(self.mesh.point_normals is not None),
-               b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_sizes"],
+               np.int32(self.mesh.point_normals is not None), np.int32(self.mesh.face_material is not None),
+               b["positions"], b["point_normals"], b["edges"], b["corner_verts"], b["corner_edges"], b["face_offsets"],
                b["face_material"], b["corner_uvs"])
 
     def finish(self):

@@ -117,19 +117,20 @@ def test_an_unexpected_failure_is_reported_and_nothing_is_left(clean_scene, bpy_
     tubes_op = addon_module("operators.tubes")
     a = poly_curve(bpy, [(0, 0, 0), (1, 0, 0)], "A")
     b = poly_curve(bpy, [(0, 1, 0), (1, 1, 0)], "B")
-    real = tubes_op.bridge.write_polygons
+    real = tubes_op.bridge.PolygonWriter.finish
     calls = []
 
-    def flaky(name, poly):
-        calls.append(name)
+    def flaky(writer, poly):
+        calls.append(writer.name)
         if len(calls) == 2:
             raise ZeroDivisionError("simulated bug")
-        return real(name, poly)
+        return real(writer, poly)
 
-    monkeypatch.setattr(tubes_op.bridge, "write_polygons", flaky)
+    monkeypatch.setattr(tubes_op.bridge.PolygonWriter, "finish", flaky)
     select(bpy, a, b)
     refused(bpy, bpy.ops.tessera.tubes, ["Tessera failed", "simulated bug", "nothing was changed"])
     assert len(calls) == 2  # the first tube was written, then removed with everything else
+    assert not [m.name for m in bpy.data.meshes if m.name.endswith(".tubes")]  # both meshes, the failed one too
 
 
 def _height_image(bpy, size=33):
