@@ -153,7 +153,8 @@ class TubeFrames:
 
     Per point: t, n, b (P, 3) float32 unit tangent, normal and binormal (rotation-minimising); radius (P,) float32
     (after the anti-aliasing clamp when it is on); arc (P,) float64 arc length from the curve's start. Per curve:
-    total (C,) float64 length (a closed curve's includes its closing segment); sides (C,) int64.
+    total (C,) float64 length (a closed curve's includes its closing segment); sides (C,) int64. Arc and total
+    are 0 in chunks of open curves built without UVs (nothing reads them there).
     """
 
     t: np.ndarray
@@ -332,7 +333,10 @@ def _frames(lines, settings, camera, runtime=None):
         if settings.aa_clamp:
             radius = effective_radius(radius, pixel, np.repeat(sides, sub.counts), settings.max_radius)
         out.radius[p0:p1] = radius
-        arc, total = arc_lengths(sub)
+        if settings.uvs or np.any(sub.cyclic):
+            arc, total = arc_lengths(sub)
+        else:  # read only by UVs and by closed curves' seam twist
+            arc, total = np.zeros(len(sub.points)), np.zeros(sub.n_curves)
         out.arc[p0:p1], out.total[c0:c1] = arc, total
         if runtime is not None:
             rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out.t[p0:p1], out.n[p0:p1], out.b[p0:p1]])
