@@ -3,7 +3,6 @@
 faces the camera whose material picks the view of the camera's direction: the impostor works in EEVEE and Cycles
 renders without the object. All views are rendered by one worker process, one after the other."""
 
-import json
 import os
 import subprocess
 import tempfile
@@ -17,7 +16,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
 from ..node_groups import Graph
-from .worker import lower_priority, worker_command, world_box
+from .worker import start_worker, world_box, write_job
 
 
 @dataclass
@@ -52,8 +51,6 @@ def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600, dilat
     if not size > 0:
         raise TesseraError(f"{ob.name!r} has no extent to bake")
     folder = tempfile.mkdtemp(prefix="tessera-impostor-")
-    blend = os.path.join(folder, "scene.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
     dirs = view_directions(grid, hemi)
     views = []
     for j in range(grid):
@@ -61,19 +58,17 @@ def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600, dilat
             loc, fwd, up = view_camera(dirs[j, i], centre, size)
             views.append({"location": loc.tolist(), "forward": fwd.tolist(), "up": up.tolist(),
                           "out": os.path.join(folder, f"view_{j}_{i}.exr")})
-    job = {"blend": blend, "object": ob.name, "resolution": int(tile), "samples": int(samples), "scale": size,
-           "clip": 2.0 * size, "views": views}
-    spec = os.path.join(folder, "views.json")
-    with open(spec, "w", encoding="utf-8") as f:
-        json.dump(job, f)
-    command = worker_command(blend, ["--views", spec])
-    command[command.index("--") + 1:] = ["--views", spec]  # the views file names the blend file itself
-    with open(os.path.join(folder, "worker.log"), "wb") as log:
-        kwargs = {"preexec_fn": lower_priority} if os.name == "posix" else {}
-        done = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, timeout=timeout, check=False, **kwargs)
-    if done.returncode != 0:
+    process = start_worker(write_job(ob, folder, tile, samples, size, 2.0 * size, views),
+                           os.path.join(folder, "worker.log"))
+    try:
+        process.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+        raise TesseraError(f"Baking the impostor took longer than {timeout} s and was stopped") from None
+    if process.returncode != 0:
         tail = open(os.path.join(folder, "worker.log"), encoding="utf-8", errors="replace").read()[-600:]
-        raise TesseraError(f"Baking the impostor failed (exit {done.returncode}): {tail}")
+        raise TesseraError(f"Baking the impostor failed (exit {process.returncode}): {tail}")
     s = grid * tile
     colour, normal, depth = np.zeros((s, s, 4), np.float32), np.zeros((s, s, 3), np.float32), np.ones((s, s))
     for view in views:

@@ -52,9 +52,12 @@ def _start_queued():
 
 
 def _poll_jobs():
-    """Redraw while a board is being rendered, so it is swapped in when done."""
-    busy = any(live.pending is not None for live in MANAGER.boards.values())
-    if busy:
+    """Redraw while a board is being rendered, so it is swapped in when done; a finished render's images start being
+    read here (on a worker thread, `worker.BoardJob.done`), not in the draw callback."""
+    pending = [live.pending for live in MANAGER.boards.values() if live.pending is not None]
+    for job in pending:
+        job.done()
+    if pending:
         tag_view3d_redraw()
         return 0.25
     return None

@@ -1,9 +1,12 @@
 """The renderer side of nailboards (seed 003 §B.5): a board is rendered by a separate Blender process (niced where
-the OS allows), so the viewport never waits for it. `request_board` saves a copy of the file, starts the process on
-`worker_script.py` and returns at once a `BoardJob`; `BoardJob.done()` polls without blocking, `BoardJob.result()`
-reads the images (colour, displacement from the depth pass, normals, where the object is) once it is done.
+the OS allows), so the viewport never waits for it. `request_board` writes what the render needs (`write_job`: the
+object and what it depends on, the scene's lights and world, nothing else), starts the process on
+`worker_script.py` and returns at once a `BoardJob`; `BoardJob.done()` polls without blocking and, once the process
+has finished, reads its images on a worker thread (colour, displacement from the depth pass, normals, where the
+object is), so the main thread never reads a file either; `BoardJob.result()` hands them over.
 """
 
+import json
 import os
 import subprocess
 import sys
@@ -14,6 +17,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
+from ...kernels.common import workers
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
 from ...kernels.impostors.board import board_setup
@@ -33,17 +37,58 @@ class BoardImages:
     present: np.ndarray
 
 
-def worker_command(blend, args):
-    """The worker's command line: the blender binary where there is one, else this Python with the bpy module."""
+def worker_command(job_file):
+    """The worker's command line for a job file (`write_job`): the blender binary where there is one, else this
+    Python with the bpy module."""
     binary = getattr(bpy.app, "binary_path", "")
     if binary and os.path.basename(binary).lower().startswith("blender") and os.path.isfile(binary):
-        return [binary, "--background", "--factory-startup", blend, "--python", str(SCRIPT), "--", blend, *args]
-    return [sys.executable, str(SCRIPT), "--", blend, *args]
+        return [binary, "--background", "--factory-startup", "--python", str(SCRIPT), "--", str(job_file)]
+    return [sys.executable, str(SCRIPT), "--", str(job_file)]
 
 
-def lower_priority():
-    if hasattr(os, "nice"):
-        os.nice(10)  # below the viewport's priority (seed: the CPU cluster's "low-priority thread")
+def write_job(ob, folder, resolution, samples, scale, clip, views):
+    """Write a render job for the worker into ``folder`` and return the job file's path.
+
+    ``scene.blend`` holds ``ob`` with what it depends on (mesh, materials, images, the objects its modifiers use),
+    the lights of the scene that render and its world: only these (``bpy.data.libraries.write``, with absolute
+    paths), so the main thread's pause does not grow with the scene the way saving a copy of the file does.
+    ``job.json`` names them, with the world matrix of every object (the worker places them in a scene of their own,
+    unparented) and the views: dicts of ``location``, ``forward``, ``up`` (3 floats each) and ``out`` (an EXR path).
+    """
+    scene = bpy.context.scene
+    lights = [o for o in scene.objects if o.type == "LIGHT" and not o.hide_render and o is not ob]
+    blocks = {ob, *lights}
+    if scene.world is not None:
+        blocks.add(scene.world)
+    blend = os.path.join(folder, "scene.blend")
+    bpy.data.libraries.write(blend, blocks, path_remap="ABSOLUTE", fake_user=True)
+    job = {"blend": blend, "object": ob.name, "lights": [o.name for o in lights],
+           "world": None if scene.world is None else scene.world.name,
+           "matrices": {o.name: [list(row) for row in o.matrix_world] for o in (ob, *lights)},
+           "resolution": int(resolution), "samples": int(samples), "scale": float(scale), "clip": float(clip),
+           "views": views}
+    path = os.path.join(folder, "job.json")
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(job, f)
+    return path
+
+
+def start_worker(job_file, log_path):
+    """Start the worker on a job file (`write_job`), its output going to ``log_path`` (a file, not a pipe: a chatty
+    worker never stalls), below the viewport's priority (the seed's "low-priority thread": nice 10 on POSIX, below
+    normal on Windows). Returns the `subprocess.Popen`. The priority is lowered after the start rather than in the
+    child before it, so Python can spawn without copying this (large) process's page tables (no ``preexec_fn``)."""
+    kwargs = {}
+    if os.name == "nt":
+        kwargs["creationflags"] = subprocess.BELOW_NORMAL_PRIORITY_CLASS
+    with open(log_path, "wb") as log:
+        process = subprocess.Popen(worker_command(job_file), stdout=log, stderr=subprocess.STDOUT, **kwargs)
+    if hasattr(os, "setpriority"):
+        try:
+            os.setpriority(os.PRIO_PROCESS, process.pid, 10)
+        except OSError:  # it has finished already, or the system does not let us: it runs at normal priority
+            pass
+    return process
 
 
 class BoardJob:
@@ -51,15 +96,26 @@ class BoardJob:
 
     def __init__(self, setup, process, folder, out):
         self.setup, self.process, self.folder, self.out = setup, process, folder, out
+        self._images = None  # the reading of the images (a future), started once the process has finished
 
     def done(self):
-        return self.process.poll() is not None
+        """Whether the board is rendered and its images read (their reading starts, on a worker thread, at the first
+        call that finds the process finished)."""
+        if self._images is None and self.process.poll() is not None:
+            self._images = workers.submit(self._read)
+        return self._images is not None and self._images.done()
 
     def result(self, timeout=None):
+        """The `BoardImages`, waiting up to ``timeout`` seconds for the render (None: as long as it takes)."""
         try:
             self.process.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
             raise TesseraError("The board is still being rendered") from None
+        if self._images is None:
+            self._images = workers.submit(self._read)
+        return self._images.result()
+
+    def _read(self):
         if self.process.returncode != 0 or not os.path.isfile(self.out):
             tail = Path(self.folder, "worker.log").read_text(errors="replace")[-600:]
             raise TesseraError(f"Rendering the board failed (exit {self.process.returncode}): {tail}")
@@ -91,19 +147,9 @@ def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=No
     if setup is None:
         setup = board_setup(*world_box(ob), eye, res_screen, fov, rounding)
     folder = tempfile.mkdtemp(prefix="tessera-board-")
-    blend = os.path.join(folder, "scene.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
     out = os.path.join(folder, "board.exr")
-    args = [ob.name, out, str(setup.resolution), str(int(samples)),
-            *(repr(float(x)) for v in (setup.camera_location, setup.camera_forward, setup.camera_up) for x in v),
-            repr(float(setup.size)), repr(float(2 * setup.size))]
-    log = open(os.path.join(folder, "worker.log"), "wb")  # a file, not a pipe: a chatty worker never stalls
-    kwargs = {"stdout": log, "stderr": subprocess.STDOUT}
-    if os.name == "posix":
-        kwargs["preexec_fn"] = lower_priority
-    try:
-        process = subprocess.Popen(worker_command(blend, args), **kwargs)
-    finally:
-        log.close()
-    return BoardJob(setup, process, folder, out)
+    view = {"location": [float(x) for x in setup.camera_location], "forward": [float(x) for x in setup.camera_forward],
+            "up": [float(x) for x in setup.camera_up], "out": out}
+    job = write_job(ob, folder, setup.resolution, samples, setup.size, 2 * setup.size, [view])
+    return BoardJob(setup, start_worker(job, os.path.join(folder, "worker.log")), folder, out)
 

@@ -1,11 +1,11 @@
-"""Run by a separate Blender process (never imported by the add-on): render one object alone with Cycles through an
-orthographic camera into a multilayer EXR with its Combined, Depth and Normal passes.
+"""Run by a separate Blender process (never imported by the add-on): render one object alone with Cycles through
+orthographic cameras into multilayer EXRs with their Combined, Depth and Normal passes.
 
-Arguments after ``--``: blend file, object name, output path, resolution, samples, camera location (3), forward (3),
-up (3), orthographic scale, clip end; or ``--views FILE``, a JSON file with the blend file, object name, resolution,
-samples, scale, clip end and a list of views (location, forward, up, out), rendered one after the other (an impostor
-atlas). With the bpy module the blend file is opened here; with the blender binary it is opened on the command line
-and named again here.
+Argument after ``--``: a job file written by `worker.write_job` (JSON): the blend file holding the object, the
+lights and the world (and only what they depend on), their names, every object's world matrix, resolution,
+samples, orthographic scale, clip end and the views (location, forward, up, out), rendered one after the other (one
+for a live board, a grid of them for an impostor atlas). The objects are placed in a scene of their own at the
+matrices given, unparented and unconstrained, so the render sees them where the viewport does.
 """
 
 import json
@@ -15,18 +15,22 @@ import bpy
 from mathutils import Matrix, Vector
 
 
-def setup(blend, name, res, samples):
-    if bpy.data.filepath != blend:
-        bpy.ops.wm.open_mainfile(filepath=blend)
-    scene = bpy.context.scene
-    target = bpy.data.objects[name]
-    for ob in scene.objects:  # the object alone (lights stay: they light it)
-        if ob.type not in {"LIGHT"} and ob is not target:
-            ob.hide_render = True
+def setup(job):
+    if bpy.data.filepath != job["blend"]:
+        bpy.ops.wm.open_mainfile(filepath=job["blend"])
+    scene = bpy.data.scenes.new("tessera_board")
+    for name in (job["object"], *job["lights"]):
+        ob = bpy.data.objects[name]
+        scene.collection.objects.link(ob)
+        ob.parent = None
+        ob.constraints.clear()
+        ob.matrix_world = Matrix(job["matrices"][name])
+    if job["world"] is not None:
+        scene.world = bpy.data.worlds[job["world"]]
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
-    scene.cycles.samples = int(samples)
-    scene.render.resolution_x = scene.render.resolution_y = int(res)
+    scene.cycles.samples = int(job["samples"])
+    scene.render.resolution_x = scene.render.resolution_y = int(job["resolution"])
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = True
     layer = scene.view_layers[0]
@@ -50,23 +54,17 @@ def render_view(scene, loc, fwd, up, scale, clip, out):
         (right.x, up.x, -fwd.x, loc.x), (right.y, up.y, -fwd.y, loc.y), (right.z, up.z, -fwd.z, loc.z), (0, 0, 0, 1)))
     scene.camera = cam
     scene.render.filepath = out
-    bpy.ops.render.render(write_still=True)
+    bpy.ops.render.render(write_still=True, scene=scene.name)
     bpy.data.objects.remove(cam)
     bpy.data.cameras.remove(cam_data)
 
 
 def main(argv):
-    if argv[0] == "--views":
-        with open(argv[1], encoding="utf-8") as f:
-            job = json.load(f)
-        scene = setup(job["blend"], job["object"], job["resolution"], job["samples"])
-        for view in job["views"]:
-            render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"])
-        return
-    blend, name, out, res, samples = argv[:5]
-    nums = [float(x) for x in argv[5:]]
-    scene = setup(blend, name, res, samples)
-    render_view(scene, nums[0:3], nums[3:6], nums[6:9], nums[9], nums[10], out)
+    with open(argv[0], encoding="utf-8") as f:
+        job = json.load(f)
+    scene = setup(job)
+    for view in job["views"]:
+        render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"])
 
 
 main(sys.argv[sys.argv.index("--") + 1:])

@@ -2,6 +2,8 @@
 board's orthographic camera; the depth pass gives the sphere's displacements over the board, the alpha where it is,
 and the viewport side did not wait for it."""
 
+import os
+import threading
 import time
 
 import numpy as np
@@ -16,12 +18,25 @@ def test_the_worker_renders_a_sphere_board(clean_scene, bpy_module, addon_module
     bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0, location=(0.5, 0.2, 0.1))
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    bpy.ops.mesh.primitive_cube_add(location=(4, 4, 4))  # another object: left out of the board
+    holder = bpy.data.objects.new("Holder", None)  # a parent with a transform: the worker places the ball unparented
+    bpy.context.scene.collection.objects.link(holder)
+    holder.location = (3.0, -1.0, 2.0)
+    bpy.context.view_layer.update()
+    ball.parent = holder  # the ball's world centre is now (3.5, -0.8, 2.1), its local one still (0.5, 0.2, 0.1)
+    bpy.ops.mesh.primitive_cube_add(location=(4, 4, 4))  # another object: left out of the board and of its file
+    bpy.context.view_layer.update()
     eye = np.array([0.5, -7.0, 2.0])
     t = time.perf_counter()
     job = worker.request_board(ball, eye, res_screen=400, fov=np.radians(40), samples=2)
     started = time.perf_counter() - t
     assert not job.done() or started < 5  # the request returns without rendering
+    if hasattr(os, "getpriority") and job.process.poll() is None:  # below the viewport's priority
+        try:
+            assert os.getpriority(os.PRIO_PROCESS, job.process.pid) >= 10
+        except ProcessLookupError:  # it finished in between
+            pass
+    with bpy.data.libraries.load(os.path.join(job.folder, "scene.blend")) as (written, _):
+        assert ball.name in written.objects and "Cube" not in written.objects and not written.scenes
     board = job.result(timeout=240)
     setup = board.setup
     n = setup.resolution
@@ -39,3 +54,27 @@ def test_the_worker_renders_a_sphere_board(clean_scene, bpy_module, addon_module
     # the normals face the eye's side
     f = setup.frame.f
     assert (board.normals[inner] @ f > 0.3).all()
+
+
+def test_the_images_are_read_off_the_main_thread(clean_scene, bpy_module, addon_module, monkeypatch):
+    """Once the render has finished, `BoardJob.done()` has the images read on a worker thread: the viewport's draw
+    callback, which swaps the board in, never reads a file."""
+    bpy = bpy_module
+    worker = addon_module("addon.impostors.worker")
+    readers = []
+    real = worker.read_channels
+
+    def recording(*args):
+        readers.append(threading.current_thread() is threading.main_thread())
+        return real(*args)
+
+    monkeypatch.setattr(worker, "read_channels", recording)
+    bpy.ops.mesh.primitive_ico_sphere_add(radius=0.5)
+    ball = bpy.context.active_object
+    job = worker.request_board(ball, np.array([0.0, -5.0, 0.0]), res_screen=100, fov=np.radians(40), samples=1)
+    job.process.wait(timeout=240)
+    while not job.done():
+        time.sleep(0.01)
+    board = job.result()
+    assert readers == [False]
+    assert board.present.any()
