@@ -1,7 +1,8 @@
 """Live nailboards (seed 003 §B.5–B.6): which board an object is drawn from, and when a new one is asked for.
 
 `NailboardManager.update(ob, eye, ...)` is called by the viewport every frame and never waits:
-- a finished render is swapped in (double buffer: the old board is drawn until the new one is there);
+- a finished render is swapped in (double buffer: the old board is drawn until the new one is there); a job that
+  offers a quick preview of its board (``job.preview()``, progressive delivery) has the preview swapped in first;
 - a new board is asked for when there is none, at once when the object moved (its transform is part of the board),
   and otherwise only when the board fails the validity tests for this eye (`kernels.impostors.validity`: approach,
   parallax, resolution with tolerance K; a relief-mapped board's parallax counts at ``relief_factor``) and no render
@@ -34,6 +35,7 @@ class LiveBoard:
     pending_board: Board = None
     eyes: list = field(default_factory=list)
     draw: object = None
+    previewing: bool = False  # drawn from the pending job's preview until its full render is there
 
 
 class NailboardManager:
@@ -45,6 +47,7 @@ class NailboardManager:
         self.cache_size = int(cache_size)
         self.regenerations = 0
         self.cache_hits = 0
+        self.previews = 0  # previews swapped in before their full render
         self.reasons = []  # the `Verdict` of each regeneration a validity test asked for
 
     def update(self, ob, eye, res_screen, fov):
@@ -58,12 +61,17 @@ class NailboardManager:
             self.cache[(ob.session_uid, live.matrix, live.board.eye.tobytes())] = (live.images, live.board)
             while len(self.cache) > self.cache_size:
                 self.cache.popitem(last=False)
-            live.pending = None
+            live.pending, live.previewing = None, False
+        elif live.pending is not None and not live.previewing:
+            early = getattr(live.pending, "preview", lambda: None)()
+            if early is not None:
+                live.images, live.board, live.draw, live.previewing = early, live.pending_board, None, True
+                self.previews += 1
         moved = live.matrix != matrix
         if moved:
             if live.pending is not None:
                 live.pending.cancel()
-                live.pending = None
+                live.pending, live.previewing = None, False
             live.images, live.board, live.draw, live.matrix = None, None, None, matrix
         verdict = None if live.board is None else check(live.board, eye, fov, res_screen, self.k, self.relief_factor)
         stale = verdict is None or verdict.regenerate

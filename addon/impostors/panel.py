@@ -19,7 +19,7 @@ class TESSERA_PT_nailboard(Sidebar, bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         col = layout.column()
-        for name in ("relief", "tolerance", "samples", "lead"):
+        for name in ("relief", "tolerance", "samples", "progressive", "lead"):
             col.prop(s, name)
 
 

@@ -21,15 +21,18 @@ HOLE_GAP = 4  # texels: gaps a pre-warp may open inside an object's outline
 class DeferredJob:
     """A board asked for from a draw callback: started by a timer, then the worker's `BoardJob`."""
 
-    def __init__(self, ob, eye, res_screen, fov, samples):
+    def __init__(self, ob, eye, res_screen, fov, samples, progressive=True):
         self.setup = board_setup(*worker.world_box(ob), eye, res_screen, fov)
-        self.args, self.name, self.job = (eye, res_screen, fov, samples), ob.name, None
+        self.args, self.name, self.job = (eye, res_screen, fov, samples, progressive), ob.name, None
         _queue.append(self)
         if not bpy.app.timers.is_registered(_start_queued):
             bpy.app.timers.register(_start_queued, first_interval=0.0)
 
     def done(self):
         return self.job is not None and self.job.done()
+
+    def preview(self):
+        return None if self.job is None else self.job.preview()
 
     def result(self):
         return self.job.result()
@@ -46,8 +49,9 @@ def _start_queued():
         job = _queue.pop(0)
         ob = bpy.data.objects.get(job.name)
         if ob is not None:
-            eye, res, fov, samples = job.args
-            job.job = worker.request_board(ob, eye, res, fov, samples=samples, setup=job.setup)
+            eye, res, fov, samples, progressive = job.args
+            job.job = worker.request_board(ob, eye, res, fov, samples=samples, setup=job.setup,
+                                           progressive=progressive)
     return None
 
 
@@ -57,6 +61,7 @@ def _poll_jobs():
     pending = [live.pending for live in MANAGER.boards.values() if live.pending is not None]
     for job in pending:
         job.done()
+        job.preview()
     if pending:
         tag_view3d_redraw()
         return 0.25
@@ -64,7 +69,8 @@ def _poll_jobs():
 
 
 def _request(ob, eye, res_screen, fov):
-    job = DeferredJob(ob, eye, res_screen, fov, ob.tessera.nailboard.samples)
+    s = ob.tessera.nailboard
+    job = DeferredJob(ob, eye, res_screen, fov, s.samples, s.progressive)
     if not bpy.app.timers.is_registered(_poll_jobs):
         bpy.app.timers.register(_poll_jobs, first_interval=0.25)
     return job

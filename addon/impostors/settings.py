@@ -23,6 +23,10 @@ class TESSERA_PG_nailboard(bpy.types.PropertyGroup):
                                                    "before the board is made again (seed eq. 9)")
     samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, update=_changed,
                                    description="Cycles samples per board")
+    progressive: bpy.props.BoolProperty(
+        name="Preview First", default=True, update=_changed,
+        description="From 8 samples, render a quick board with a sixteenth of the samples first and draw it until "
+                    "the full render is there")
     lead: bpy.props.IntProperty(name="Prediction", default=4, min=0, max=120, update=_changed,
                                 description="Ask for the board the camera will need this many frames ahead")
 

@@ -53,8 +53,11 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
     the lights of the scene that render and its world: only these (``bpy.data.libraries.write``, with absolute
     paths), so the main thread's pause does not grow with the scene the way saving a copy of the file does.
     ``job.json`` names them, with the world matrix of every object (the worker places them in a scene of their own,
-    unparented) and the views: dicts of ``location``, ``forward``, ``up`` (3 floats each) and ``out`` (an EXR path).
+    unparented) and the views: dicts of ``location``, ``forward``, ``up`` (3 floats each) and ``out`` (an EXR path),
+    and optionally ``preview``: ``{"samples", "out"}``, a quicker render of the view written first.
     """
+    if ob.mode == "EDIT":  # what is being edited is not in the mesh until flushed (saving a file would flush it)
+        ob.update_from_editmode()
     scene = bpy.context.scene
     lights = [o for o in scene.objects if o.type == "LIGHT" and not o.hide_render and o is not ob]
     blocks = {ob, *lights}
@@ -92,11 +95,25 @@ def start_worker(job_file, log_path):
 
 
 class BoardJob:
-    """One board being rendered: ``done()`` never blocks; ``result()`` waits for it (or use it once done)."""
+    """One board being rendered: ``done()`` never blocks; ``result()`` waits for it (or use it once done);
+    ``preview()`` gives the quick first render of a progressive job, once there is one, without waiting."""
 
-    def __init__(self, setup, process, folder, out):
+    def __init__(self, setup, process, folder, out, preview_out=None):
         self.setup, self.process, self.folder, self.out = setup, process, folder, out
+        self.preview_out = preview_out
         self._images = None  # the reading of the images (a future), started once the process has finished
+        self._preview = None  # the reading of the preview's images, started once its file is there
+
+    def preview(self):
+        """The `BoardImages` of the preview render (few samples: the same board, noisier colours) once it has been
+        written and read (on a worker thread, like the final images), else None; never blocks."""
+        if self.preview_out is None:
+            return None
+        if self._preview is None and os.path.isfile(self.preview_out):  # moved into place whole by the worker
+            self._preview = workers.submit(self._read_images, self.preview_out)
+        if self._preview is None or not self._preview.done() or self._preview.exception() is not None:
+            return None
+        return self._preview.result()
 
     def done(self):
         """Whether the board is rendered and its images read (their reading starts, on a worker thread, at the first
@@ -119,7 +136,10 @@ class BoardJob:
         if self.process.returncode != 0 or not os.path.isfile(self.out):
             tail = Path(self.folder, "worker.log").read_text(errors="replace")[-600:]
             raise TesseraError(f"Rendering the board failed (exit {self.process.returncode}): {tail}")
-        r, g, b, a, z, nx, ny, nz = read_channels(self.out, "board render", (
+        return self._read_images(self.out)
+
+    def _read_images(self, path):
+        r, g, b, a, z, nx, ny, nz = read_channels(path, "board render", (
             "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
         present = a > 0.5
         alpha = np.maximum(a, 1e-6)[..., None]
@@ -140,16 +160,31 @@ def world_box(ob):
     return corners.min(axis=0), corners.max(axis=0)
 
 
-def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=None):
+#: A board rendered with at least this many samples is rendered first with `preview_samples` (progressive delivery).
+PROGRESSIVE_MIN_SAMPLES = 8
+
+
+def preview_samples(samples):
+    """Samples of the quick first render of a board of ``samples`` samples (a sixteenth, at least 1)."""
+    return max(1, int(samples) // 16)
+
+
+def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=None, progressive=True):
     """Start rendering ``ob``'s board for ``eye`` (world space; a camera of ``res_screen`` pixels and ``fov``
     radians): a `BoardJob`, at once. The board is in world space (the object's bounding box in world space), or
-    ``setup`` (a `BoardSetup` already made for this object and eye) when given."""
+    ``setup`` (a `BoardSetup` already made for this object and eye) when given. progressive: from
+    `PROGRESSIVE_MIN_SAMPLES` samples, the worker first renders the board with `preview_samples` and writes it
+    (`BoardJob.preview`), then renders it in full."""
     if setup is None:
         setup = board_setup(*world_box(ob), eye, res_screen, fov, rounding)
     folder = tempfile.mkdtemp(prefix="tessera-board-")
     out = os.path.join(folder, "board.exr")
     view = {"location": [float(x) for x in setup.camera_location], "forward": [float(x) for x in setup.camera_forward],
             "up": [float(x) for x in setup.camera_up], "out": out}
+    preview_out = None
+    if progressive and samples >= PROGRESSIVE_MIN_SAMPLES:
+        preview_out = os.path.join(folder, "preview.exr")
+        view["preview"] = {"samples": preview_samples(samples), "out": preview_out}
     job = write_job(ob, folder, setup.resolution, samples, setup.size, 2 * setup.size, [view])
-    return BoardJob(setup, start_worker(job, os.path.join(folder, "worker.log")), folder, out)
+    return BoardJob(setup, start_worker(job, os.path.join(folder, "worker.log")), folder, out, preview_out)
 

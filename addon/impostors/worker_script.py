@@ -4,11 +4,13 @@ orthographic cameras into multilayer EXRs with their Combined, Depth and Normal 
 Argument after ``--``: a job file written by `worker.write_job` (JSON): the blend file holding the object, the
 lights and the world (and only what they depend on), their names, every object's world matrix, resolution,
 samples, orthographic scale, clip end and the views (location, forward, up, out), rendered one after the other (one
-for a live board, a grid of them for an impostor atlas). The objects are placed in a scene of their own at the
+for a live board, a grid of them for an impostor atlas); a view may ask for a quick preview render first (progressive
+delivery: the viewport draws it until the full render is there). The objects are placed in a scene of their own at the
 matrices given, unparented and unconstrained, so the render sees them where the viewport does.
 """
 
 import json
+import os
 import sys
 
 import bpy
@@ -43,7 +45,9 @@ def setup(job):
     return scene
 
 
-def render_view(scene, loc, fwd, up, scale, clip, out):
+def render_view(scene, loc, fwd, up, scale, clip, out, preview=None):
+    """Render one view into ``out``; with ``preview`` (``{"samples", "out"}``) first a quicker render at those
+    samples, moved into place under its name only once written whole (the viewport may read it while this goes on)."""
     cam_data = bpy.data.cameras.new("tessera_board_camera")
     cam_data.type, cam_data.ortho_scale, cam_data.clip_start, cam_data.clip_end = "ORTHO", scale, 1e-4, clip
     cam = bpy.data.objects.new("tessera_board_camera", cam_data)
@@ -53,6 +57,14 @@ def render_view(scene, loc, fwd, up, scale, clip, out):
     cam.matrix_world = Matrix((
         (right.x, up.x, -fwd.x, loc.x), (right.y, up.y, -fwd.y, loc.y), (right.z, up.z, -fwd.z, loc.z), (0, 0, 0, 1)))
     scene.camera = cam
+    if preview is not None:
+        samples = scene.cycles.samples
+        scene.cycles.samples = int(preview["samples"])
+        part = preview["out"] + ".part.exr"
+        scene.render.filepath = part
+        bpy.ops.render.render(write_still=True, scene=scene.name)
+        os.replace(part, preview["out"])
+        scene.cycles.samples = samples
     scene.render.filepath = out
     bpy.ops.render.render(write_still=True, scene=scene.name)
     bpy.data.objects.remove(cam)
@@ -64,7 +76,8 @@ def main(argv):
         job = json.load(f)
     scene = setup(job)
     for view in job["views"]:
-        render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"])
+        render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"],
+                    view.get("preview"))
 
 
 main(sys.argv[sys.argv.index("--") + 1:])

@@ -87,3 +87,44 @@ def test_prediction_asks_for_the_eye_ahead(clean_scene, bpy_module, addon_module
     m.boards[ob.session_uid].board = None  # force a request on the next frame, with a velocity known
     run(m, ob, eyes[1:2])
     assert np.allclose(asked[-1], eyes[1] + 5 * (eyes[1] - eyes[0]))
+
+
+class ProgressiveJob(InstantJob):
+    """A render that offers its preview after ``preview_after`` polls and finishes after ``done_after``."""
+
+    def __init__(self, setup, preview_after=2, done_after=5):
+        super().__init__(setup)
+        self.polls, self.preview_after, self.done_after = 0, preview_after, done_after
+
+    def done(self):
+        self.polls += 1
+        return self.polls > self.done_after
+
+    def preview(self):
+        return ("preview", self.setup) if self.polls > self.preview_after else None
+
+
+def test_a_progressive_board_is_drawn_from_its_preview_until_the_full_render(clean_scene, bpy_module, addon_module):
+    """Progressive delivery: while a board renders, its preview (``job.preview()``) is drawn as soon as it is there,
+    with the pending board's viewpoint; the full render replaces it, and only the full render is cached."""
+    bpy = bpy_module
+    live_mod = addon_module("addon.impostors.live")
+    board = addon_module("kernels.impostors.board")
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    jobs = []
+
+    def request(ob, eye, res_screen, fov):
+        jobs.append(ProgressiveJob(board.board_setup(np.full(3, -1.0), np.full(3, 1.0), eye, res_screen, fov)))
+        return jobs[-1]
+
+    m = live_mod.NailboardManager(request)
+    eye = np.array([0.0, -12.0, 0.0])
+    drawn = [m.update(ob, eye, RES, FOV).images for _ in range(8)]
+    job = jobs[0]
+    assert len(jobs) == 1 and m.previews == 1
+    assert drawn[:2] == [None, None]  # nothing yet, then the preview, then the full render
+    assert ("preview", job.setup) in drawn and drawn[-1] is job.setup
+    first_preview, first_final = drawn.index(("preview", job.setup)), drawn.index(job.setup)
+    assert first_preview < first_final and all(d == ("preview", job.setup) for d in drawn[first_preview:first_final])
+    assert [images for images, _ in m.cache.values()] == [job.setup]

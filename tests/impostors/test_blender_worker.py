@@ -73,8 +73,33 @@ def test_the_images_are_read_off_the_main_thread(clean_scene, bpy_module, addon_
     ball = bpy.context.active_object
     job = worker.request_board(ball, np.array([0.0, -5.0, 0.0]), res_screen=100, fov=np.radians(40), samples=1)
     job.process.wait(timeout=240)
-    while not job.done():
+    deadline = time.monotonic() + 60
+    while not job.done() and time.monotonic() < deadline:
         time.sleep(0.01)
     board = job.result()
     assert readers == [False]
     assert board.present.any()
+
+
+def test_a_progressive_board_writes_its_preview_first(clean_scene, bpy_module, addon_module):
+    """From `PROGRESSIVE_MIN_SAMPLES` samples the worker renders a quick preview of the same board first: the same
+    outline and depth as the full render (only the colours are noisier)."""
+    bpy = bpy_module
+    worker = addon_module("addon.impostors.worker")
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.8)
+    ball = bpy.context.active_object
+    job = worker.request_board(ball, np.array([0.0, -5.0, 1.0]), res_screen=120, fov=np.radians(40),
+                               samples=worker.PROGRESSIVE_MIN_SAMPLES)
+    final = job.result(timeout=240)
+    deadline = time.monotonic() + 60
+    while job.preview() is None and time.monotonic() < deadline:  # read on a worker thread
+        time.sleep(0.01)
+    early = job.preview()
+    assert early is not None
+    assert early.setup is final.setup and early.colours.shape == final.colours.shape
+    inside = final.present & early.present
+    assert inside.sum() >= 0.97 * max(final.present.sum(), early.present.sum()) > 0
+    assert np.abs(early.displacement[inside] - final.displacement[inside]).max() < 0.02
+    few = worker.request_board(ball, np.array([0.0, -5.0, 1.0]), res_screen=120, fov=np.radians(40), samples=1)
+    few.result(timeout=240)
+    assert few.preview() is None  # one sample: nothing to preview
