@@ -10,6 +10,10 @@
 - a request first looks in a cache of recent boards for one made near this viewpoint that is still valid there
   (returning to a viewpoint costs no render), and asks for the eye predicted ``lead`` frames ahead from the eye's
   velocity (the render is ready by the time the camera gets there).
+- a board at least `RESAMPLE_AT` times finer than this eye needs (eq. 8: the camera moved away) is resampled down
+  to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given: every frame pre-warps all
+  the texels of the board drawn, so it then costs what a board made for this distance would; the full board stays in
+  the cache, and serves again if the camera comes back.
 The renderer is `addon.impostors.worker.request_board` (a separate process); the manager only needs its job's
 ``done()`` and ``result()``.
 """
@@ -19,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...kernels.impostors.validity import Board, check
+from ...kernels.impostors.validity import Board, check, sprite_resolution
 from .worker import world_box
 
 
@@ -38,11 +42,20 @@ class LiveBoard:
     previewing: bool = False  # drawn from the pending job's preview until its full render is there
 
 
-class NailboardManager:
-    """Boards of every nailboard object, by ``session_uid``. request(ob, eye, res_screen, fov) -> a job."""
+#: A board this many times finer than the eye needs is resampled ...
+RESAMPLE_AT = 4
+#: ... to this many times what it needs (the margin keeps it valid while the camera comes a little closer).
+RESAMPLE_TO = 2
 
-    def __init__(self, request, k=1.0, relief_factor=0.25, lead=0, cache_size=8):
+
+class NailboardManager:
+    """Boards of every nailboard object, by ``session_uid``. request(ob, eye, res_screen, fov) -> a job;
+    resample(images, resolution) -> the images at that resolution (`worker.resample_images`), or None: never."""
+
+    def __init__(self, request, k=1.0, relief_factor=0.25, lead=0, cache_size=8, resample=None):
         self.request, self.k, self.relief_factor, self.lead = request, float(k), float(relief_factor), int(lead)
+        self.resample = resample
+        self.resamples = 0  # boards resampled down instead of drawn at a resolution the eye does not need
         self.boards, self.cache = {}, OrderedDict()
         self.cache_size = int(cache_size)
         self.regenerations = 0
@@ -84,7 +97,22 @@ class NailboardManager:
                 self.cache_hits += 1
             else:
                 self._ask(ob, live, eye, res_screen, fov)
+        elif self.resample is not None and not live.previewing:
+            self._resample(live, eye, res_screen, fov)
         return live
+
+    def _resample(self, live, eye, res_screen, fov):
+        board = live.board
+        distance = float(np.linalg.norm(eye - board.centre))
+        size = float(np.linalg.norm(np.asarray(board.hi, np.float64) - np.asarray(board.lo, np.float64)))
+        if distance <= size / 2:
+            return
+        needed = sprite_resolution(res_screen, size, distance, fov)
+        if board.resolution >= RESAMPLE_AT * needed:
+            resolution = RESAMPLE_TO * needed
+            live.images, live.draw = self.resample(live.images, resolution), None
+            live.board = Board(board.eye, board.lo, board.hi, resolution)
+            self.resamples += 1
 
     def _cached(self, ob, matrix, eye, res_screen, fov):
         for key in reversed(self.cache):

@@ -76,7 +76,7 @@ def _request(ob, eye, res_screen, fov):
     return job
 
 
-MANAGER = NailboardManager(_request)
+MANAGER = NailboardManager(_request, resample=worker.resample_images)
 
 
 def _draw(context, region, view, proj):

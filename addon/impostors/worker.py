@@ -21,6 +21,7 @@ from ...kernels.common import workers
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
 from ...kernels.impostors.board import board_setup
+from ...kernels.impostors.resample import resample_board
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
 
@@ -150,6 +151,13 @@ class BoardJob:
     def cancel(self):
         if self.process.poll() is None:
             self.process.kill()
+
+
+def resample_images(images, resolution):
+    """`BoardImages` resampled to ``resolution`` texels a side (`kernels.impostors.resample.resample_board`)."""
+    setup, colours, displacement, normals, present = resample_board(
+        images.setup, images.colours, images.displacement, images.normals, images.present, resolution)
+    return BoardImages(setup, colours, displacement, normals, present)
 
 
 def world_box(ob):

@@ -128,3 +128,39 @@ def test_a_progressive_board_is_drawn_from_its_preview_until_the_full_render(cle
     first_preview, first_final = drawn.index(("preview", job.setup)), drawn.index(job.setup)
     assert first_preview < first_final and all(d == ("preview", job.setup) for d in drawn[first_preview:first_final])
     assert [images for images, _ in m.cache.values()] == [job.setup]
+
+
+def test_a_board_much_finer_than_needed_is_resampled_and_the_full_one_serves_again(clean_scene, bpy_module,
+                                                                                   addon_module):
+    """Zooming out (a wider field of view from the same eye) keeps a board valid but makes it far finer than eq. 8
+    asks for: it is resampled down (no render) to twice what the view needs; zooming back in, the resampled board is
+    too coarse and the full one returns from the cache (no render either)."""
+    bpy = bpy_module
+    live_mod = addon_module("addon.impostors.live")
+    validity = addon_module("kernels.impostors.validity")
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, asked = manager(addon_module)
+    resampled = []
+
+    def resample(images, resolution):
+        resampled.append(resolution)
+        return ("resampled", resolution)
+
+    m.resample = resample
+    eye, narrow, wide = np.array([0.0, -9.0, 2.0]), np.radians(20), np.radians(80)
+    m.update(ob, eye, RES, narrow)  # asks
+    full = m.update(ob, eye, RES, narrow)  # swaps the board in
+    full_res, full_images = full.board.resolution, full.images
+    for fov in np.linspace(narrow, wide, 30):
+        live = m.update(ob, eye, RES, fov)
+    assert m.regenerations == 1 and m.resamples >= 1, (m.reasons, m.resamples)
+    size = float(np.linalg.norm(live.board.hi - live.board.lo))
+    needed = validity.sprite_resolution(RES, size, float(np.linalg.norm(eye - live.board.centre)), wide)
+    assert live.board.resolution < live_mod.RESAMPLE_AT * needed <= full_res
+    assert live.images == ("resampled", live.board.resolution) == ("resampled", resampled[-1])
+    hits = m.cache_hits
+    for _ in range(3):  # zoomed back in: the resampled board is too coarse here
+        live = m.update(ob, eye, RES, narrow)
+    assert m.regenerations == 1 and m.cache_hits == hits + 1 and len(asked) == 1
+    assert live.board.resolution == full_res and live.images is full_images
