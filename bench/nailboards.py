@@ -10,6 +10,8 @@
   frame) while the worker renders another board, against the same with the worker idle (the seed: 171 vs 171 fps).
 - ``r1_request_pause``: the main thread's pause to ask for a board in a scene that also holds a 4M-triangle mesh,
   against saving a copy of the file (what the request did before it wrote only the object, its lights and world).
+- ``resampled_board_frame``: the per-frame CPU share (pre-warp + hole filling) of a 1024² sphere board against the
+  same board resampled to 256² (what the manager draws once the view needs a quarter of the texels).
 - ``k``: for tolerance K = 1, 1.5, 2, 4 the frame at which the validity tests (`kernels.impostors.validity`) ask for
   a new board on the strafe, and the error measured there (R5).
 - ``r3_*``: the live manager (`addon.impostors.live.NailboardManager`) on a 10 s camera path at 60 frames/s (a
@@ -27,7 +29,7 @@ import sys
 import time
 
 import numpy as np
-from _setup import enable_extension
+from _setup import enable_extension, seconds
 
 SIZE = 200
 FRAMES = 40
@@ -187,10 +189,39 @@ def main():
     idle, _ = draw_times(False)
     busy, running = draw_times(True)
     print(json.dumps(request_pause_case(bpy, worker, ball, o1, fov)), flush=True)
+    print(json.dumps(resample_case(mod)), flush=True)
     print(json.dumps({"bench": "nailboards", "case": "r1_draw_with_worker", "worker_running_throughout": running,
                       "busy_max_ms": round(1e3 * max(busy), 1), "busy_mean_ms": round(1e3 * np.mean(busy), 1),
                       "idle_max_ms": round(1e3 * max(idle), 1), "idle_mean_ms": round(1e3 * np.mean(idle), 1),
                       "mean_ratio": round(np.mean(busy) / np.mean(idle), 2)}), flush=True)
+
+
+def resample_case(mod, repeat=5):
+    """The per-frame CPU share of a live board (pre-warp + hole filling, `addon.impostors.preview`) for a sphere board
+    of 1024² texels, against the same board resampled to 256² (what the manager draws once the view needs a quarter of
+    the texels: zoomed out); and the one-off cost of that resampling."""
+    pw, board, resample = (mod(f"kernels.impostors.{m}") for m in ("prewarp", "board", "resample"))
+    n = 1024
+    setup = board.board_setup(np.full(3, -1.0), np.full(3, 1.0), np.array([0.0, -9.0, 0.0]), 8 * n, 0.5,
+                              max_resolution=n)
+    c = (np.arange(n) + 0.5) / n * setup.size - setup.size / 2
+    x, y = np.meshgrid(c, c)
+    present = x * x + y * y < 1.0
+    d = np.where(present, setup.size / 2 + np.sqrt(np.maximum(1 - x * x - y * y, 0.0)), 0.0)
+    normals = np.stack([x, y, np.sqrt(np.maximum(1 - x * x - y * y, 0.0))], -1).astype(np.float32)
+    colours = np.ones((n, n, 4), np.float32)
+    eye = np.array([0.8, -9.0, 0.5])
+
+    def frame_cost(s, disp, mask):
+        return seconds(lambda: pw.fill_holes(pw.forward_splat(disp, s.frame, eye, mask), 4), repeat)
+
+    t = time.perf_counter()
+    small = resample.resample_board(setup, colours, d, normals, present, n // 4)
+    once = time.perf_counter() - t
+    fine, coarse = frame_cost(setup, d, present), frame_cost(small[0], small[2], small[4])
+    return {"bench": "nailboards", "case": "resampled_board_frame", "texels": f"{n // 4}²",
+            "seconds": round(coarse, 4), "baseline": f"the board drawn at its {n}² texels", "baseline_seconds":
+            round(fine, 4), "ratio": round(fine / coarse, 1), "resample_once_seconds": round(once, 3)}
 
 
 def request_pause_case(bpy, worker, ball, eye, fov, repeat=3):

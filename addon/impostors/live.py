@@ -11,9 +11,9 @@
   (returning to a viewpoint costs no render), and asks for the eye predicted ``lead`` frames ahead from the eye's
   velocity (the render is ready by the time the camera gets there).
 - a board at least `RESAMPLE_AT` times finer than this eye needs (eq. 8: the camera moved away) is resampled down
-  to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given: every frame pre-warps all
-  the texels of the board drawn, so it then costs what a board made for this distance would; the full board stays in
-  the cache, and serves again if the camera comes back.
+  to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given (run on a worker thread and
+  swapped in when done): every frame pre-warps all the texels of the board drawn, so it then costs what a board made
+  for this view would; the full board stays in the cache, and serves again if the view comes back.
 The renderer is `addon.impostors.worker.request_board` (a separate process); the manager only needs its job's
 ``done()`` and ``result()``.
 """
@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...kernels.common import workers
 from ...kernels.impostors.validity import Board, check, sprite_resolution
 from .worker import world_box
 
@@ -40,6 +41,7 @@ class LiveBoard:
     eyes: list = field(default_factory=list)
     draw: object = None
     previewing: bool = False  # drawn from the pending job's preview until its full render is there
+    resampling: tuple = None  # (future of the resampled images, the images and Board it resamples, its resolution)
 
 
 #: A board this many times finer than the eye needs is resampled ...
@@ -102,6 +104,16 @@ class NailboardManager:
         return live
 
     def _resample(self, live, eye, res_screen, fov):
+        if live.resampling is not None:
+            future, source, board, resolution = live.resampling
+            if not future.done():
+                return
+            live.resampling = None
+            if future.exception() is None and live.images is source and live.board is board:  # nothing newer came
+                live.images, live.draw = future.result(), None
+                live.board = Board(board.eye, board.lo, board.hi, resolution)
+                self.resamples += 1
+            return
         board = live.board
         distance = float(np.linalg.norm(eye - board.centre))
         size = float(np.linalg.norm(np.asarray(board.hi, np.float64) - np.asarray(board.lo, np.float64)))
@@ -110,9 +122,7 @@ class NailboardManager:
         needed = sprite_resolution(res_screen, size, distance, fov)
         if board.resolution >= RESAMPLE_AT * needed:
             resolution = RESAMPLE_TO * needed
-            live.images, live.draw = self.resample(live.images, resolution), None
-            live.board = Board(board.eye, board.lo, board.hi, resolution)
-            self.resamples += 1
+            live.resampling = (workers.submit(self.resample, live.images, resolution), live.images, board, resolution)
 
     def _cached(self, ob, matrix, eye, res_screen, fov):
         for key in reversed(self.cache):

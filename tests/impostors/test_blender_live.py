@@ -3,6 +3,8 @@ paths (tier: blender): a static camera never; a dolly-in from the approach and r
 parallax; an object move at once; a return to an earlier viewpoint from the cache; prediction asks ahead. The
 renderer here finishes at once (the real one, a separate process, is tested in test_blender_worker.py)."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -154,6 +156,10 @@ def test_a_board_much_finer_than_needed_is_resampled_and_the_full_one_serves_aga
     full_res, full_images = full.board.resolution, full.images
     for fov in np.linspace(narrow, wide, 30):
         live = m.update(ob, eye, RES, fov)
+    deadline = time.monotonic() + 30
+    while m.resamples == 0 and time.monotonic() < deadline:  # resampled on a worker thread, swapped in when done
+        live = m.update(ob, eye, RES, wide)
+        time.sleep(0.01)
     assert m.regenerations == 1 and m.resamples >= 1, (m.reasons, m.resamples)
     size = float(np.linalg.norm(live.board.hi - live.board.lo))
     needed = validity.sprite_resolution(RES, size, float(np.linalg.norm(eye - live.board.centre)), wide)
