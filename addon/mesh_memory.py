@@ -5,8 +5,9 @@
 every supported Blender an item's RNA pointer (``as_pointer``) is its address in one contiguous array (attribute
 values, face offsets), so `write_items` checks that layout (the stride and span of the item pointers), copies the
 array in row blocks on the worker threads (numpy releases the GIL while it copies) and reads a sample back through
-RNA; where the layout is not found, or the sample differs, it writes with ``foreach_set``. For data-blocks the caller
-has just created only: nothing else may share or cache those arrays.
+RNA; where the layout is not found, or the sample differs, it writes with ``foreach_set``. `item_view` and
+`face_offsets_view` hand out that memory itself, for a kernel to write its output in place (`bridge.PolygonWriter`).
+For data-blocks the caller has just created only: nothing else may share or cache those arrays.
 """
 
 import ctypes
@@ -100,7 +101,6 @@ def set_face_offsets(mesh, starts):
         polys.foreach_set("loop_start", starts)
         return False
     return bulk
-
 
 
 def face_offsets_view(mesh):

@@ -10,8 +10,8 @@
 - a request first looks in a cache of recent boards for one made near this viewpoint that is still valid there
   (returning to a viewpoint costs no render), and asks for the eye predicted ``lead`` frames ahead from the eye's
   velocity (the render is ready by the time the camera gets there).
-- a board at least `RESAMPLE_AT` times finer than this eye needs (eq. 8: the camera moved away) is resampled down
-  to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given (run on a worker thread and
+- a board at least `RESAMPLE_AT` times finer than this view needs (eq. 8: zoomed out, a smaller viewport) is resampled
+  down to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given (on a worker thread,
   swapped in when done): every frame pre-warps all the texels of the board drawn, so it then costs what a board made
   for this view would; the full board stays in the cache, and serves again if the view comes back.
 The renderer is `addon.impostors.worker.request_board` (a separate process); the manager only needs its job's
@@ -42,6 +42,7 @@ class LiveBoard:
     draw: object = None
     previewing: bool = False  # drawn from the pending job's preview until its full render is there
     resampling: tuple = None  # (future of the resampled images, the images and Board it resamples, its resolution)
+    keep: Board = None  # a board whose resampling failed: drawn as it is
 
 
 #: A board this many times finer than the eye needs is resampled ...
@@ -109,12 +110,17 @@ class NailboardManager:
             if not future.done():
                 return
             live.resampling = None
-            if future.exception() is None and live.images is source and live.board is board:  # nothing newer came
+            if future.exception() is not None:
+                print(f"Tessera: resampling a nailboard failed, it is drawn as rendered: {future.exception()}")
+                live.keep = board
+            elif live.images is source and live.board is board:  # nothing newer came in the meantime
                 live.images, live.draw = future.result(), None
                 live.board = Board(board.eye, board.lo, board.hi, resolution)
                 self.resamples += 1
             return
         board = live.board
+        if board is live.keep:
+            return
         distance = float(np.linalg.norm(eye - board.centre))
         size = float(np.linalg.norm(np.asarray(board.hi, np.float64) - np.asarray(board.lo, np.float64)))
         if distance <= size / 2:

@@ -170,3 +170,30 @@ def test_a_board_much_finer_than_needed_is_resampled_and_the_full_one_serves_aga
         live = m.update(ob, eye, RES, narrow)
     assert m.regenerations == 1 and m.cache_hits == hits + 1 and len(asked) == 1
     assert live.board.resolution == full_res and live.images is full_images
+
+
+def test_a_failing_resample_leaves_the_board_as_rendered(clean_scene, bpy_module, addon_module):
+    """A resampling that fails is tried once for that board, which is then drawn as it was rendered."""
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, _ = manager(addon_module)
+    calls = []
+
+    def broken(images, resolution):
+        calls.append(resolution)
+        raise MemoryError("simulated")
+
+    m.resample = broken
+    eye, narrow, wide = np.array([0.0, -9.0, 2.0]), np.radians(20), np.radians(80)
+    m.update(ob, eye, RES, narrow)
+    full = m.update(ob, eye, RES, narrow)
+    images, resolution = full.images, full.board.resolution
+    deadline = time.monotonic() + 30
+    while full.keep is None and time.monotonic() < deadline:
+        m.update(ob, eye, RES, wide)
+        time.sleep(0.01)
+    for _ in range(5):
+        live = m.update(ob, eye, RES, wide)
+    assert len(calls) == 1 and m.resamples == 0 and m.regenerations == 1
+    assert live.images is images and live.board.resolution == resolution
