@@ -23,6 +23,10 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
                                     description="Texels each view's colours and normals spread into the empty texels "
                                                 "around it (alpha stays 0), so engines that filter the atlas show no "
                                                 "dark halo at the outline")
+    blend: bpy.props.BoolProperty(name="Blend Views", default=True,
+                                  description="Mix the four views around the view direction (bilinear over the "
+                                              "atlas grid), so the card changes smoothly as it turns; off: the "
+                                              "nearest view, switching at cell borders")
     hemi: bpy.props.BoolProperty(name="Upper Hemisphere", default=False,
                                  description="Views only from above (hemi-octahedral): finer for objects on the "
                                              "ground")
@@ -43,7 +47,7 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
             wm.progress_end()
         name = f"{ob.name} impostor"
         images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}
-        card = make_card(name, atlas, images, context.scene.camera)
+        card = make_card(name, atlas, images, context.scene.camera, self.blend)
         tx.track(card.data)
         tx.track(card.data.materials[0])
         tx.track(card)

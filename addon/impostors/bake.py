@@ -117,9 +117,12 @@ def octahedral_uv(g, direction, hemi):
     return g.math("ADD", g.math("MULTIPLY", u, 0.5), 0.5), g.math("ADD", g.math("MULTIPLY", v, 0.5), 0.5)
 
 
-def card_material(name, colour_image, grid, hemi):
+def card_material(name, colour_image, grid, hemi, blend=True):
     """The card's material: the view direction (Incoming, world space) picks its atlas cell, the card's UVs the
-    texel inside it; the atlas's colour is emitted as it was rendered, its alpha mixes in transparency."""
+    texel inside it; the atlas's colour is emitted as it was rendered, its alpha mixes in transparency. blend: the four
+    views around the direction are mixed with bilinear weights over the octahedral grid (premultiplied by their
+    alpha; a direction at a view's own centre shows that view alone), so the card changes smoothly as it turns; off:
+    the nearest view is shown (it switches at cell borders)."""
     mat = bpy.data.materials.new(name)
     if mat.node_tree is None:
         mat.use_nodes = True
@@ -129,18 +132,38 @@ def card_material(name, colour_image, grid, hemi):
     incoming = g.node("ShaderNodeNewGeometry").outputs["Incoming"]
     u, v = octahedral_uv(g, incoming, hemi)
     n = float(grid)
-
-    def cell(t):
-        return g.math("MINIMUM", g.math("MAXIMUM", g.math("FLOOR", g.math("MULTIPLY", t, n)), 0.0), n - 1)
-
     card = g.split(g.node("ShaderNodeTexCoord").outputs["UV"])
-    atlas = g.xyz(g.math("DIVIDE", g.math("ADD", cell(u), card[0]), n),
-                  g.math("DIVIDE", g.math("ADD", cell(v), card[1]), n), 0.0)
-    tex = g.node("ShaderNodeTexImage", [("Vector", atlas)], image=colour_image, interpolation="Closest",
-                 extension="EXTEND")
-    emit = g.node("ShaderNodeEmission", [("Color", tex.outputs["Color"]), ("Strength", 1.0)])
+
+    def clamp(cell):
+        return g.math("MINIMUM", g.math("MAXIMUM", cell, 0.0), n - 1)
+
+    def view(cu, cv):  # the atlas texel of the card's UV inside view (cu, cv)
+        atlas = g.xyz(g.math("DIVIDE", g.math("ADD", cu, card[0]), n), g.math("DIVIDE", g.math("ADD", cv, card[1]), n),
+                      0.0)
+        return g.node("ShaderNodeTexImage", [("Vector", atlas)], image=colour_image, interpolation="Closest",
+                      extension="EXTEND")
+
+    if not blend:
+        tex = view(clamp(g.math("FLOOR", g.math("MULTIPLY", u, n))), clamp(g.math("FLOOR", g.math("MULTIPLY", v, n))))
+        colour, alpha = tex.outputs["Color"], tex.outputs["Alpha"]
+    else:
+        gu, gv = (g.math("SUBTRACT", g.math("MULTIPLY", t, n), 0.5) for t in (u, v))  # in cell-centre units
+        iu, iv = g.math("FLOOR", gu), g.math("FLOOR", gv)
+        fu, fv = g.math("SUBTRACT", gu, iu), g.math("SUBTRACT", gv, iv)
+        premultiplied, alpha = None, None
+        for du in (0, 1):
+            for dv in (0, 1):
+                weight = g.math("MULTIPLY", fu if du else g.math("SUBTRACT", 1.0, fu),
+                                fv if dv else g.math("SUBTRACT", 1.0, fv))
+                tex = view(clamp(g.math("ADD", iu, du)), clamp(g.math("ADD", iv, dv)))
+                wa = g.math("MULTIPLY", weight, tex.outputs["Alpha"])
+                term = g.vec("SCALE", tex.outputs["Color"], wa)
+                premultiplied = term if premultiplied is None else g.vec("ADD", premultiplied, term)
+                alpha = wa if alpha is None else g.math("ADD", alpha, wa)
+        colour = g.vec("SCALE", premultiplied, g.math("DIVIDE", 1.0, g.math("MAXIMUM", alpha, 1e-6)))
+    emit = g.node("ShaderNodeEmission", [("Color", colour), ("Strength", 1.0)])
     clear = g.node("ShaderNodeBsdfTransparent")
-    mix = g.node("ShaderNodeMixShader", [(0, tex.outputs["Alpha"]), (1, clear.outputs[0]), (2, emit.outputs[0])])
+    mix = g.node("ShaderNodeMixShader", [(0, alpha), (1, clear.outputs[0]), (2, emit.outputs[0])])
     out = g.node("ShaderNodeOutputMaterial")
     tree.links.new(mix.outputs[0], out.inputs["Surface"])
     if hasattr(mat, "blend_method"):  # EEVEE (4.2 Legacy): let the alpha through
@@ -151,15 +174,15 @@ def card_material(name, colour_image, grid, hemi):
     return mat
 
 
-def make_card(name, atlas, images, scene_camera):
+def make_card(name, atlas, images, scene_camera, blend=True):
     """A square card as big as the bounding sphere at its centre, facing ``scene_camera`` (Track To) when there is
-    one, with the atlas material: a new object (not linked)."""
+    one, with the atlas material (``blend``: see `card_material`): a new object (not linked)."""
     half = atlas.size / 2
     me = bpy.data.meshes.new(name)
     me.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
     uv = me.uv_layers.new(name="UVMap")
     uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32))
-    me.materials.append(card_material(name, images["colour"], atlas.grid, atlas.hemi))
+    me.materials.append(card_material(name, images["colour"], atlas.grid, atlas.hemi, blend))
     card = bpy.data.objects.new(name, me)
     card.location = tuple(atlas.centre)
     if scene_camera is not None:

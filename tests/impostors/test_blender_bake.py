@@ -73,3 +73,40 @@ def test_the_card_shows_the_view_of_its_direction(clean_scene, bpy_module, addon
         bpy.context.view_layer.update()
         seen = coverage(render_alpha(bpy, tmp_path / f"card_{i}_{j}.png"))
         assert seen == pytest.approx(tiles[(i, j)], abs=0.04), (i, j)
+
+
+def test_blended_views_mix_the_two_views_around_a_direction(clean_scene, bpy_module, addon_module, tmp_path):
+    """Between two views' directions the blended card mixes both (premultiplied, bilinear over the grid): where only
+    one view covers, the card is about half transparent; the nearest-view card shows one view (hard alpha, apart
+    from the render's anti-aliased outline)."""
+    bpy = bpy_module
+    oc = addon_module("kernels.impostors.octahedral")
+    bake = addon_module("addon.impostors.bake")
+    from mathutils import Vector
+
+    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))
+    box = bpy.context.active_object
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    bpy.context.scene.camera = cam
+    bpy.context.view_layer.objects.active = box
+    assert bpy.ops.tessera.impostor_bake(grid=3, tile=32, samples=1) == {"FINISHED"}
+    card = bpy.context.active_object
+    box.hide_render = True
+    uv = (np.array([1.5, 1.0]) + 0.5) / 3  # the octahedral point halfway between views (1, 1) and (2, 1)
+    direction = oc.decode(uv[None, :])[0]
+    size = float(np.linalg.norm(np.ptp(np.array([box.matrix_world @ Vector(c) for c in box.bound_box]), axis=0)))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", size
+    loc, fwd, _ = bake.view_camera(direction, np.zeros(3), size)
+    cam.location = loc * 3
+    cam.rotation_euler = Vector(fwd).to_track_quat("-Z", "Y").to_euler()
+    bpy.context.view_layer.update()
+
+    def half_transparent(alpha):
+        return float(((alpha > 0.3) & (alpha < 0.7)).mean())
+
+    blended = half_transparent(render_alpha(bpy, tmp_path / "blended.png"))
+    colour = bpy.data.images["Cube impostor colour"]
+    card.data.materials[0] = bake.card_material("nearest", colour, 3, False, blend=False)
+    nearest = half_transparent(render_alpha(bpy, tmp_path / "nearest.png"))
+    assert blended > nearest + 0.03, (blended, nearest)
