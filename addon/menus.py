@@ -18,6 +18,7 @@ class TESSERA_MT_object(bpy.types.Menu):
         self.layout.operator("tessera.curve_adaptive", icon="CURVE_BEZCURVE")
         self.layout.operator("tessera.surface_tessellate", icon="SURFACE_NSURFACE")
         self.layout.operator("tessera.impostor_bake", icon="IMAGE_PLANE")
+        self.layout.operator("tessera.impostor_export", icon="EXPORT")
 
 
 class TESSERA_MT_add(bpy.types.Menu):

@@ -1,10 +1,12 @@
 """``tessera.impostor_bake``: the active object baked into an octahedral impostor (colour, normal and depth atlases
-rendered by Cycles in a worker process) on a card that faces the camera, for EEVEE and Cycles renders."""
+rendered by Cycles in a worker process) on a card that faces the camera, for EEVEE and Cycles renders;
+``tessera.impostor_export``: such a card written to glTF (`addon.impostors.export`)."""
 
 import bpy
 
 from ..addon.guarded import guarded
 from ..addon.impostors.bake import atlas_images, bake_atlas, make_card
+from ..addon.impostors.export import export_card, impostor_info
 from .selection import object_poll, select_only
 
 
@@ -58,5 +60,40 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (TESSERA_OT_impostor_bake,)
+class TESSERA_OT_impostor_export(bpy.types.Operator):
+    """Write the active impostor card to glTF (.glb): the card with an unlit, alpha-blended material showing the
+    object's front view, the whole colour atlas, and the atlas layout in the node's extras for an engine's impostor
+    shader"""
+
+    bl_idname = "tessera.impostor_export"
+    bl_label = "Export Impostor (glTF)"
+    bl_options = {"REGISTER"}
+
+    filepath: bpy.props.StringProperty(name="File", subtype="FILE_PATH", description="The .glb file to write")
+    filter_glob: bpy.props.StringProperty(default="*.glb", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        if context.mode != "OBJECT" or impostor_info(context.active_object) is None:
+            cls.poll_message_set("Select a card made by Bake Impostor, in Object Mode")
+            return False
+        return True
+
+    def invoke(self, context, event):
+        if not self.filepath:
+            self.filepath = bpy.path.clean_name(context.active_object.name) + ".glb"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    @guarded
+    def execute(self, context, tx):
+        path = bpy.path.abspath(self.filepath)
+        if not path.lower().endswith(".glb"):
+            path += ".glb"
+        export_card(context.active_object, path)
+        self.report({"INFO"}, f"Wrote {path}")
+        return {"FINISHED"}
+
+
+classes = (TESSERA_OT_impostor_bake, TESSERA_OT_impostor_export)
 register, unregister = bpy.utils.register_classes_factory(classes)

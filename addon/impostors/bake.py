@@ -16,6 +16,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
 from ..node_groups import Graph
+from .export import PROPERTY
 from .worker import start_worker, world_box, write_job
 
 
@@ -185,6 +186,8 @@ def make_card(name, atlas, images, scene_camera, blend=True):
     me.materials.append(card_material(name, images["colour"], atlas.grid, atlas.hemi, blend))
     card = bpy.data.objects.new(name, me)
     card.location = tuple(atlas.centre)
+    card[PROPERTY] = {"grid": int(atlas.grid), "hemi": bool(atlas.hemi), "size": float(atlas.size),
+                      "blend": bool(blend)}  # what `export.export_card` writes for an engine
     if scene_camera is not None:
         track = card.constraints.new("TRACK_TO")
         track.target, track.track_axis, track.up_axis = scene_camera, "TRACK_Z", "UP_Y"

@@ -106,7 +106,74 @@ def test_blended_views_mix_the_two_views_around_a_direction(clean_scene, bpy_mod
         return float(((alpha > 0.3) & (alpha < 0.7)).mean())
 
     blended = half_transparent(render_alpha(bpy, tmp_path / "blended.png"))
-    colour = bpy.data.images["Cube impostor colour"]
+    colour = next(n.image for n in card.active_material.node_tree.nodes if n.type == "TEX_IMAGE")
     card.data.materials[0] = bake.card_material("nearest", colour, 3, False, blend=False)
     nearest = half_transparent(render_alpha(bpy, tmp_path / "nearest.png"))
     assert blended > nearest + 0.03, (blended, nearest)
+
+
+def read_glb(path):
+    """The JSON and the binary chunk of a .glb file."""
+    import json
+    import struct
+
+    data = open(path, "rb").read()
+    assert data[:4] == b"glTF"
+    length = struct.unpack("<I", data[12:16])[0]
+    doc = json.loads(data[20:20 + length])
+    binary = data[20 + length + 8:]
+    return doc, binary
+
+
+def test_the_card_exports_to_gltf_with_its_atlas_and_layout(clean_scene, bpy_module, addon_module, tmp_path):
+    """Export Impostor (glTF): one node with the layout in its extras, an unlit alpha-blended material whose base
+    colour is the whole colour atlas, the quad's UVs inside the front view's cell; the atlas image in the file has the
+    baked alpha. A folder that does not exist is refused and nothing is written or left in the scene."""
+    import OpenImageIO as oiio
+
+    bpy = bpy_module
+    oc = addon_module("kernels.impostors.octahedral")
+    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))
+    assert bpy.ops.tessera.impostor_bake(grid=3, tile=16, samples=1) == {"FINISHED"}
+    card = bpy.context.active_object
+    objects, meshes, materials = set(bpy.data.objects), set(bpy.data.meshes), set(bpy.data.materials)
+    path = tmp_path / "card.glb"
+    assert bpy.ops.tessera.impostor_export(filepath=str(path)) == {"FINISHED"}
+    assert set(bpy.data.objects) == objects and set(bpy.data.meshes) == meshes and set(bpy.data.materials) == materials
+    assert bpy.context.active_object == card and card.select_get()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["card.glb"]  # no temporary file left
+    doc, binary = read_glb(path)
+    (node,) = doc["nodes"]
+    extras = node["extras"]["tessera_impostor"]
+    i, j = oc.cell_of(np.array([0.0, -1.0, 0.0]), 3)
+    assert extras["grid"] == 3 and extras["layout"] == "octahedral" and extras["fallback_view"] == [i, j]
+    (material,) = doc["materials"]
+    assert "KHR_materials_unlit" in material.get("extensions", {}) and material.get("alphaMode") == "BLEND"
+    texture = doc["textures"][material["pbrMetallicRoughness"]["baseColorTexture"]["index"]]
+    image = doc["images"][texture["source"]]
+    assert image["mimeType"] == "image/png"
+    accessor = doc["accessors"][doc["meshes"][node["mesh"]]["primitives"][0]["attributes"]["TEXCOORD_0"]]
+    assert accessor["componentType"] == 5126 and accessor["type"] == "VEC2"  # float pairs
+    uv_view = doc["bufferViews"][accessor["bufferView"]]
+    start = uv_view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    uvs = np.frombuffer(binary, np.float32, 2 * accessor["count"], start).reshape(-1, 2)
+    lo, hi = uvs.min(axis=0), uvs.max(axis=0)
+    # glTF's v runs down the image: the cell (i, j) of an atlas with row 0 at the bottom is rows 2 - j from the top
+    assert np.allclose(lo, [i / 3, (2 - j) / 3], atol=1e-6) and np.allclose(hi, [(i + 1) / 3, (3 - j) / 3], atol=1e-6)
+    view = doc["bufferViews"][image["bufferView"]]
+    png = tmp_path / "atlas.png"
+    png.write_bytes(binary[view.get("byteOffset", 0):view.get("byteOffset", 0) + view["byteLength"]])
+    inp = oiio.ImageInput.open(str(png))
+    spec = inp.spec()
+    pixels = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, "float")).reshape(spec.height, spec.width, -1)
+    inp.close()
+    baked = np.empty(48 * 48 * 4, np.float32)
+    next(n.image for n in card.active_material.node_tree.nodes if n.type == "TEX_IMAGE").pixels.foreach_get(baked)
+    baked_alpha = baked.reshape(48, 48, 4)[::-1, :, 3]  # Blender's row 0 is the bottom, PNG's the top
+    assert (spec.width, spec.height, spec.nchannels) == (48, 48, 4)
+    assert np.array_equal(pixels[..., 3] > 0.5, baked_alpha > 0.5)
+    png.unlink()
+    with pytest.raises(RuntimeError, match="does not exist"):
+        bpy.ops.tessera.impostor_export(filepath=str(tmp_path / "missing" / "card.glb"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["card.glb"]
+    assert set(bpy.data.objects) == objects and set(bpy.data.meshes) == meshes
