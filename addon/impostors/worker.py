@@ -51,8 +51,8 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
     """Write a render job for the worker into ``folder`` and return the job file's path.
 
     ``scene.blend`` holds ``ob`` with what it depends on (mesh, materials, images, the objects its modifiers use),
-    the lights of the scene that render and its world: only these (``bpy.data.libraries.write``, with absolute
-    paths), so the main thread's pause does not grow with the scene the way saving a copy of the file does.
+    the lights of the view layer that render and the scene's world: only these (``bpy.data.libraries.write``, with
+    absolute paths), so the main thread's pause does not grow with the scene the way saving a copy of the file does.
     ``job.json`` names them, with the world matrix of every object (the worker places them in a scene of their own,
     unparented) and the views: dicts of ``location``, ``forward``, ``up`` (3 floats each) and ``out`` (an EXR path),
     and optionally ``preview``: ``{"samples", "out"}``, a quicker render of the view written first.
@@ -60,7 +60,8 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
     if ob.mode == "EDIT":  # what is being edited is not in the mesh until flushed (saving a file would flush it)
         ob.update_from_editmode()
     scene = bpy.context.scene
-    lights = [o for o in scene.objects if o.type == "LIGHT" and not o.hide_render and o is not ob]
+    # the lights that render in this view layer (not those of excluded collections or hidden from renders)
+    lights = [o for o in bpy.context.view_layer.objects if o.type == "LIGHT" and not o.hide_render and o is not ob]
     blocks = {ob, *lights}
     if scene.world is not None:
         blocks.add(scene.world)

@@ -24,6 +24,12 @@ def test_the_worker_renders_a_sphere_board(clean_scene, bpy_module, addon_module
     bpy.context.view_layer.update()
     ball.parent = holder  # the ball's world centre is now (3.5, -0.8, 2.1), its local one still (0.5, 0.2, 0.1)
     bpy.ops.mesh.primitive_cube_add(location=(4, 4, 4))  # another object: left out of the board and of its file
+    lamp = bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", "POINT"))  # lights the board: written
+    bpy.context.scene.collection.objects.link(lamp)
+    off = bpy.data.collections.new("Off")  # a collection excluded from the view layer: its light is not
+    bpy.context.scene.collection.children.link(off)
+    off.objects.link(bpy.data.objects.new("OffLamp", bpy.data.lights.new("OffLamp", "POINT")))
+    bpy.context.view_layer.layer_collection.children["Off"].exclude = True
     bpy.context.view_layer.update()
     eye = np.array([0.5, -7.0, 2.0])
     t = time.perf_counter()
@@ -36,7 +42,8 @@ def test_the_worker_renders_a_sphere_board(clean_scene, bpy_module, addon_module
         except ProcessLookupError:  # it finished in between
             pass
     with bpy.data.libraries.load(os.path.join(job.folder, "scene.blend")) as (written, _):
-        assert ball.name in written.objects and "Cube" not in written.objects and not written.scenes
+        assert ball.name in written.objects and "Lamp" in written.objects and not written.scenes
+        assert "Cube" not in written.objects and "OffLamp" not in written.objects
     board = job.result(timeout=240)
     setup = board.setup
     n = setup.resolution
