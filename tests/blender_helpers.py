@@ -6,6 +6,15 @@ import pytest
 from conftest import ADDON_MODULE
 
 
+def select_only(bpy, *obs):
+    """Select exactly ``obs`` and make the first one active (what a click and shift-clicks leave)."""
+    for other in bpy.context.selected_objects:
+        other.select_set(False)
+    for ob in obs:
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = obs[0]
+
+
 def compat():
     """The enabled add-on's `addon.compat` (what differs between Blender versions)."""
     return importlib.import_module(f"{ADDON_MODULE}.addon.compat")

@@ -4,7 +4,7 @@ scene, images and maps are as they were (tier: blender). Each case names the wor
 
 import numpy as np
 import pytest
-from blender_helpers import stroke_elements
+from blender_helpers import select_only, stroke_elements
 
 pytestmark = pytest.mark.blender
 
@@ -20,14 +20,6 @@ def snapshot(bpy):
             image.pixels.foreach_get(px)
             pixels[image.name] = px.tobytes()
     return blocks, pixels
-
-
-def select(bpy, *obs):
-    for other in bpy.context.selected_objects:
-        other.select_set(False)
-    for ob in obs:
-        ob.select_set(True)
-    bpy.context.view_layer.objects.active = obs[0]
 
 
 def refused(bpy, op, words, **kw):
@@ -64,7 +56,7 @@ def poly_curve(bpy, points, name="Curve"):
 def test_tubes_from_curves_without_length(clean_scene, bpy_module, points, words):
     bpy = bpy_module
     ob = poly_curve(bpy, points)
-    select(bpy, ob)
+    select_only(bpy, ob)
     refused(bpy, bpy.ops.tessera.tubes, words)
 
 
@@ -74,7 +66,7 @@ def test_tubes_from_hair_of_single_point_curves(clean_scene, bpy_module):
     curves.add_curves([1, 1, 1])
     ob = bpy.data.objects.new("Hair", curves)
     bpy.context.scene.collection.objects.link(ob)
-    select(bpy, ob)
+    select_only(bpy, ob)
     refused(bpy, bpy.ops.tessera.tubes, ["no length"])
 
 
@@ -84,7 +76,7 @@ def test_tubes_keep_good_sources_and_name_the_empty_one(clean_scene, bpy_module)
     bpy = bpy_module
     good = poly_curve(bpy, [(0, 0, 0), (1, 0, 0), (1, 1, 0)], "Good")
     empty = poly_curve(bpy, None, "Empty")
-    select(bpy, good, empty)
+    select_only(bpy, good, empty)
     assert bpy.ops.tessera.tubes(radius=0.1) == {"FINISHED"}
     assert "Good.tubes" in bpy.data.objects and "Empty.tubes" not in bpy.data.objects
     bpy.data.objects.remove(bpy.data.objects["Good.tubes"])
@@ -96,7 +88,7 @@ def test_tubes_keep_good_sources_and_name_the_empty_one(clean_scene, bpy_module)
         bpy.context.scene.collection.objects.link(ob)
         wires.append(ob)
     wires[0].data.attributes.new("thickness", "FLOAT", "POINT")
-    select(bpy, *wires)  # 'Plain' has no attribute 'thickness': an error, not an empty result
+    select_only(bpy, *wires)  # 'Plain' has no attribute 'thickness': an error, not an empty result
     refused(bpy, bpy.ops.tessera.tubes, ["thickness"], radius_source="ATTRIBUTE", attribute="thickness")
     assert "Thick.tubes" not in bpy.data.objects
 
@@ -105,7 +97,7 @@ def test_tubes_with_camera_sides_and_no_camera(clean_scene, bpy_module):
     bpy = bpy_module
     bpy.context.scene.camera = None
     ob = poly_curve(bpy, [(0, 0, 0), (1, 0, 0)])
-    select(bpy, ob)
+    select_only(bpy, ob)
     message = refused(bpy, bpy.ops.tessera.tubes, ["camera sides", "scene camera"], sides_mode="CAMERA")
     assert "adaptive levels" not in message.lower()
 
@@ -127,7 +119,7 @@ def test_an_unexpected_failure_is_reported_and_nothing_is_left(clean_scene, bpy_
         return real(writer, poly)
 
     monkeypatch.setattr(tubes_op.bridge.PolygonWriter, "finish", flaky)
-    select(bpy, a, b)
+    select_only(bpy, a, b)
     refused(bpy, bpy.ops.tessera.tubes, ["Tessera failed", "simulated bug", "nothing was changed"])
     assert len(calls) == 2  # the first tube was written, then removed with everything else
     assert not [m.name for m in bpy.data.meshes if m.name.endswith(".tubes")]  # both meshes, the failed one too
@@ -288,7 +280,7 @@ def _setup_for(bpy, name, tmp_path):
         bpy.ops.mesh.primitive_monkey_add()
         return {}
     if name == "tubes":
-        select(bpy, poly_curve(bpy, [(0, 0, 0), (1, 0, 0), (1, 1, 0)]))
+        select_only(bpy, poly_curve(bpy, [(0, 0, 0), (1, 0, 0), (1, 1, 0)]))
         return {}
     if name == "terrain_add":
         _height_image(bpy)
@@ -362,7 +354,7 @@ def _mesh_object(bpy, name, verts, faces, edges=()):
     me.from_pydata(verts, list(edges), faces)
     ob = bpy.data.objects.new(name, me)
     bpy.context.scene.collection.objects.link(ob)
-    select(bpy, ob)
+    select_only(bpy, ob)
     return ob
 
 
@@ -410,7 +402,7 @@ def test_tessellate_degenerate_and_huge_triangles_give_finite_geometry(clean_sce
         _mesh_object(bpy, name, v, [(0, 1, 2)])
         assert bpy.ops.tessera.loop_subdivide(levels=3) == {"FINISHED"}
         assert np.all(np.isfinite(np.array([p.co for p in bpy.context.active_object.data.vertices])))
-        select(bpy, bpy.data.objects[name])
+        select_only(bpy, bpy.data.objects[name])
         assert bpy.ops.tessera.tessellate(level=4, method="PN") == {"FINISHED"}
         out = bpy.context.active_object.data
         co = np.empty(len(out.vertices) * 3, np.float32)

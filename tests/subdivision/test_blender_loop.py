@@ -3,15 +3,9 @@ from Blender's marks, UVs carried, open meshes, bad input refused with nothing c
 
 import numpy as np
 import pytest
+from blender_helpers import select_only
 
 pytestmark = pytest.mark.blender
-
-
-def select(bpy, ob):
-    for other in bpy.context.selected_objects:
-        other.select_set(False)
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
 
 
 def arrays_of(me):
@@ -98,7 +92,7 @@ def test_sharp_and_creased_edges_are_creases(clean_scene, bpy_module, addon_modu
     soft = (values > 0) & ~flags
     assert np.count_nonzero(out_crease) == 4 * soft.sum()
     assert np.allclose(out_crease[out_crease > 0], np.sqrt(0.5 / 10), rtol=1e-6)
-    select(bpy, ob)
+    select_only(bpy, ob)
     assert bpy.ops.tessera.loop_subdivide(levels=2, use_creases=False) == {"FINISHED"}
     smooth, _, _ = arrays_of(bpy.context.active_object.data)
     assert not np.allclose(smooth, pos)
@@ -150,7 +144,7 @@ def test_baked_lighting_goes_to_every_level_without_seams(clean_scene, bpy_modul
     packed = hce.unpack_container(ob.data["tessera_hce"], arrays.triangles)
     assert len(packed.node_start) == len(arrays.triangles) + 1
     for levels in (1, 3):
-        select(bpy, ob)
+        select_only(bpy, ob)
         assert bpy.ops.tessera.loop_subdivide(levels=levels) == {"FINISHED"}
         out = bpy.context.active_object.data
         assert out.color_attributes.active_color.name == "BakedLight"
@@ -182,6 +176,6 @@ def test_baked_lighting_is_saved_with_the_file(clean_scene, bpy_module, addon_mo
     bpy.ops.wm.open_mainfile(filepath=str(path))
     ob = bpy.data.objects[name]
     assert bytes(ob.data["tessera_hce"]) == blob
-    select(bpy, ob)
+    select_only(bpy, ob)
     assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
     assert "BakedLight" in bpy.context.active_object.data.color_attributes

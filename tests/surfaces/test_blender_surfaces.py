@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from blender_helpers import select_only
 
 pytestmark = pytest.mark.blender
 
@@ -77,10 +78,7 @@ def bezier_object(bpy, co, hl, hr, cyclic=False, radius=None):
     s.use_cyclic_u = cyclic
     ob = bpy.data.objects.new("Bez", data)
     bpy.context.scene.collection.objects.link(ob)
-    for other in bpy.context.selected_objects:
-        other.select_set(False)
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
+    select_only(bpy, ob)
     return ob
 
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from blender_helpers import select_only
 
 pytestmark = pytest.mark.blender
 
@@ -117,10 +118,7 @@ def test_a_failure_after_the_mesh_was_handed_out_leaves_nothing(clean_scene, bpy
     spline.points.foreach_set("co", np.array([[0, 0, 0, 1], [1, 0, 0, 1], [1, 1, 0, 1]], np.float32).ravel())
     ob = bpy.data.objects.new("Wire", curve)
     bpy.context.scene.collection.objects.link(ob)
-    for other in bpy.context.selected_objects:
-        other.select_set(False)
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
+    select_only(bpy, ob)
     meshes = set(bpy.data.meshes)
     with pytest.raises(RuntimeError, match="simulated bug"):
         bpy.ops.tessera.tubes(caps="FLAT")

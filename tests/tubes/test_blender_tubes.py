@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from blender_helpers import select_only
 
 pytestmark = pytest.mark.blender
 
@@ -16,10 +17,7 @@ def mesh_arrays(me):
 
 
 def run_tubes(bpy, ob, **kw):
-    for other in bpy.context.selected_objects:
-        other.select_set(False)
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
+    select_only(bpy, ob)
     assert bpy.ops.tessera.tubes(**kw) == {"FINISHED"}
     return bpy.context.active_object
 
