@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _setup import enable_extension, import_path
+from _setup import enable_extension, import_path, timed_operator
 from tessellation import SUBSURF_LEVEL, subsurf_apply  # the same baseline as bench/tessellation.py
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools" / "osd_oracle"))
@@ -76,15 +76,7 @@ def vtk_filter(v, f, level):
 
 def loop_operator(bpy, ob):
     bpy.context.view_layer.objects.active = ob
-    t = time.perf_counter()
-    assert bpy.ops.tessera.loop_subdivide(levels=LOOP_LEVEL) == {"FINISHED"}
-    seconds = time.perf_counter() - t
-    new = bpy.context.active_object
-    n = len(new.data.polygons)
-    me = new.data
-    bpy.data.objects.remove(new)
-    bpy.data.meshes.remove(me)
-    return seconds, n
+    return timed_operator(bpy, lambda: bpy.ops.tessera.loop_subdivide(levels=LOOP_LEVEL))
 
 
 def row(case, seconds, n, base_name, base_seconds, base_n, **extra):

@@ -20,7 +20,7 @@ import json
 import time
 
 import numpy as np
-from _setup import best_of, enable_extension, import_path
+from _setup import best_of, enable_extension, import_path, timed_operator
 
 LEVEL = 26  # 968 * floor(3 * 26^2 / 2) = 981,552 triangles
 SUBSURF_LEVEL = 5  # 1,007,616 triangles
@@ -80,14 +80,8 @@ def operator_run(bpy, ob, method, **options):
     options = {"level": LEVEL, **options}
     for _ in range(REPEAT):
         bpy.context.view_layer.objects.active = ob
-        t = time.perf_counter()
-        bpy.ops.tessera.tessellate(method=method, **options)
-        best = min(best, time.perf_counter() - t)
-        new = bpy.context.active_object
-        n = len(new.data.polygons)
-        me = new.data
-        bpy.data.objects.remove(new)
-        bpy.data.meshes.remove(me)
+        seconds, n = timed_operator(bpy, lambda: bpy.ops.tessera.tessellate(method=method, **options))
+        best = min(best, seconds)
     return best, n
 
 

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _setup import best_of, enable_extension, import_path
+from _setup import best_of, enable_extension, import_path, timed_operator
 
 STRANDS, POINTS, SIDES, RADIUS = 100_000, 32, 8, 0.005
 REPEAT = 3
@@ -115,15 +115,9 @@ def operator_run(bpy, ob):
     ob.select_set(True)
     bpy.context.view_layer.objects.active = ob
     bpy.context.view_layer.update()  # as in the UI, where the scene is evaluated before the click (bpy.ops would
-    t = time.perf_counter()          # otherwise evaluate the hair object again inside the timed call)
-    bpy.ops.tessera.tubes(radius_source="CONSTANT", radius=RADIUS, sides=SIDES, caps="NONE", uvs=False)
-    seconds = time.perf_counter() - t
-    out = bpy.context.active_object
-    n = len(out.data.vertices)
-    me = out.data
-    bpy.data.objects.remove(out)
-    bpy.data.meshes.remove(me)
-    return seconds, n
+    # otherwise evaluate the hair object again inside the timed call)
+    return timed_operator(bpy, lambda: bpy.ops.tessera.tubes(radius_source="CONSTANT", radius=RADIUS, sides=SIDES,
+                                                             caps="NONE", uvs=False), count="vertices")
 
 
 def operator_case(bpy, ob, rounds=2 * REPEAT):
