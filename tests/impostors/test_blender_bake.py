@@ -31,18 +31,26 @@ def render_alpha(bpy, path, size=48):
     return px[..., 3]
 
 
+def baked_box(bpy, tile=32, camera=True):
+    """A box long in x (its views differ) baked into a 3 x 3 impostor, with a scene camera (the card tracks it) or
+    none: the box, the camera (or None) and the card."""
+    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))
+    box = bpy.context.active_object
+    cam = None
+    if camera:
+        cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+        bpy.context.scene.collection.objects.link(cam)
+        bpy.context.scene.camera = cam
+    bpy.context.view_layer.objects.active = box
+    assert bpy.ops.tessera.impostor_bake(grid=3, tile=tile, samples=1) == {"FINISHED"}
+    return box, cam, bpy.context.active_object
+
+
 def test_the_card_shows_the_view_of_its_direction(clean_scene, bpy_module, addon_module, tmp_path):
     bpy = bpy_module
     oc = addon_module("kernels.impostors.octahedral")
     bake = addon_module("addon.impostors.bake")
-    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))  # long in x: its views differ
-    box = bpy.context.active_object
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.scene.collection.objects.link(cam)
-    bpy.context.scene.camera = cam
-    bpy.context.view_layer.objects.active = box
-    assert bpy.ops.tessera.impostor_bake(grid=3, tile=32, samples=1) == {"FINISHED"}
-    card = bpy.context.active_object
+    box, cam, card = baked_box(bpy)
     assert card.name == "Cube impostor" and card.constraints[0].target == cam
     colour = bpy.data.images["Cube impostor colour"]
     assert tuple(colour.size) == (96, 96) and colour.packed_file is not None
@@ -84,14 +92,7 @@ def test_blended_views_mix_the_two_views_around_a_direction(clean_scene, bpy_mod
     bake = addon_module("addon.impostors.bake")
     from mathutils import Vector
 
-    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))
-    box = bpy.context.active_object
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.scene.collection.objects.link(cam)
-    bpy.context.scene.camera = cam
-    bpy.context.view_layer.objects.active = box
-    assert bpy.ops.tessera.impostor_bake(grid=3, tile=32, samples=1) == {"FINISHED"}
-    card = bpy.context.active_object
+    box, cam, card = baked_box(bpy)
     box.hide_render = True
     uv = (np.array([1.5, 1.0]) + 0.5) / 3  # the octahedral point halfway between views (1, 1) and (2, 1)
     direction = oc.decode(uv[None, :])[0]
@@ -133,9 +134,7 @@ def test_the_card_exports_to_gltf_with_its_atlas_and_layout(clean_scene, bpy_mod
 
     bpy = bpy_module
     oc = addon_module("kernels.impostors.octahedral")
-    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.2, 0.5, 0.5))
-    assert bpy.ops.tessera.impostor_bake(grid=3, tile=16, samples=1) == {"FINISHED"}
-    card = bpy.context.active_object
+    _, _, card = baked_box(bpy, tile=16, camera=False)
     objects, meshes, materials = set(bpy.data.objects), set(bpy.data.meshes), set(bpy.data.materials)
     path = tmp_path / "card.glb"
     assert bpy.ops.tessera.impostor_export(filepath=str(path)) == {"FINISHED"}

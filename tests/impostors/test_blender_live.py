@@ -132,68 +132,68 @@ def test_a_progressive_board_is_drawn_from_its_preview_until_the_full_render(cle
     assert [images for images, _ in m.cache.values()] == [job.setup]
 
 
+EYE, NARROW, WIDE = np.array([0.0, -9.0, 2.0]), np.radians(20), np.radians(80)
+
+
+def zoom_board(bpy, addon_module, resample):
+    """A cube's manager (with ``resample``) whose board was made and swapped in for `EYE` at the `NARROW` field of
+    view: the manager, its requests, the cube and its `LiveBoard`."""
+    bpy.ops.mesh.primitive_cube_add()
+    ob = bpy.context.active_object
+    m, asked = manager(addon_module)
+    m.resample = resample
+    m.update(ob, EYE, RES, NARROW)  # asks
+    return m, asked, ob, m.update(ob, EYE, RES, NARROW)  # swaps the board in
+
+
 def test_a_board_much_finer_than_needed_is_resampled_and_the_full_one_serves_again(clean_scene, bpy_module,
                                                                                    addon_module):
     """Zooming out (a wider field of view from the same eye) keeps a board valid but makes it far finer than eq. 8
     asks for: it is resampled down (no render) to twice what the view needs; zooming back in, the resampled board is
     too coarse and the full one returns from the cache (no render either)."""
-    bpy = bpy_module
     live_mod = addon_module("addon.impostors.live")
     validity = addon_module("kernels.impostors.validity")
-    bpy.ops.mesh.primitive_cube_add()
-    ob = bpy.context.active_object
-    m, asked = manager(addon_module)
     resampled = []
 
     def resample(images, resolution):
         resampled.append(resolution)
         return ("resampled", resolution)
 
-    m.resample = resample
-    eye, narrow, wide = np.array([0.0, -9.0, 2.0]), np.radians(20), np.radians(80)
-    m.update(ob, eye, RES, narrow)  # asks
-    full = m.update(ob, eye, RES, narrow)  # swaps the board in
+    m, asked, ob, full = zoom_board(bpy_module, addon_module, resample)
     full_res, full_images = full.board.resolution, full.images
-    for fov in np.linspace(narrow, wide, 30):
-        live = m.update(ob, eye, RES, fov)
+    for fov in np.linspace(NARROW, WIDE, 30):
+        live = m.update(ob, EYE, RES, fov)
     deadline = time.monotonic() + 30
     while m.resamples == 0 and time.monotonic() < deadline:  # resampled on a worker thread, swapped in when done
-        live = m.update(ob, eye, RES, wide)
+        live = m.update(ob, EYE, RES, WIDE)
         time.sleep(0.01)
     assert m.regenerations == 1 and m.resamples >= 1, (m.reasons, m.resamples)
     size = float(np.linalg.norm(live.board.hi - live.board.lo))
-    needed = validity.sprite_resolution(RES, size, float(np.linalg.norm(eye - live.board.centre)), wide)
+    needed = validity.sprite_resolution(RES, size, float(np.linalg.norm(EYE - live.board.centre)), WIDE)
     assert live.board.resolution < live_mod.RESAMPLE_AT * needed <= full_res
     assert live.images == ("resampled", live.board.resolution) == ("resampled", resampled[-1])
     hits = m.cache_hits
     for _ in range(3):  # zoomed back in: the resampled board is too coarse here
-        live = m.update(ob, eye, RES, narrow)
+        live = m.update(ob, EYE, RES, NARROW)
     assert m.regenerations == 1 and m.cache_hits == hits + 1 and len(asked) == 1
     assert live.board.resolution == full_res and live.images is full_images
 
 
 def test_a_failing_resample_leaves_the_board_as_rendered(clean_scene, bpy_module, addon_module):
     """A resampling that fails is tried once for that board, which is then drawn as it was rendered."""
-    bpy = bpy_module
-    bpy.ops.mesh.primitive_cube_add()
-    ob = bpy.context.active_object
-    m, _ = manager(addon_module)
     calls = []
 
     def broken(images, resolution):
         calls.append(resolution)
         raise MemoryError("simulated")
 
-    m.resample = broken
-    eye, narrow, wide = np.array([0.0, -9.0, 2.0]), np.radians(20), np.radians(80)
-    m.update(ob, eye, RES, narrow)
-    full = m.update(ob, eye, RES, narrow)
+    m, _, ob, full = zoom_board(bpy_module, addon_module, broken)
     images, resolution = full.images, full.board.resolution
     deadline = time.monotonic() + 30
     while full.keep is None and time.monotonic() < deadline:
-        m.update(ob, eye, RES, wide)
+        m.update(ob, EYE, RES, WIDE)
         time.sleep(0.01)
     for _ in range(5):
-        live = m.update(ob, eye, RES, wide)
+        live = m.update(ob, EYE, RES, WIDE)
     assert len(calls) == 1 and m.resamples == 0 and m.regenerations == 1
     assert live.images is images and live.board.resolution == resolution
