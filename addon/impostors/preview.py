@@ -34,6 +34,10 @@ class DeferredJob:
     def preview(self):
         return None if self.job is None else self.job.preview()
 
+    def poll(self):
+        if self.job is not None:
+            self.job.poll()
+
     def result(self):
         return self.job.result()
 
@@ -56,12 +60,11 @@ def _start_queued():
 
 
 def _poll_jobs():
-    """Redraw while a board is being rendered, so it is swapped in when done; a finished render's images start being
-    read here (on a worker thread, `worker.BoardJob.done`), not in the draw callback."""
+    """Redraw while a board is being rendered, so it is swapped in when done; its preview and final images start
+    being read here (on a worker thread, `worker.BoardJob.poll`), not in the draw callback."""
     pending = [live.pending for live in MANAGER.boards.values() if live.pending is not None]
     for job in pending:
-        job.done()
-        job.preview()
+        job.poll()
     if pending:
         tag_view3d_redraw()
         return 0.25

@@ -98,7 +98,8 @@ def start_worker(job_file, log_path):
 
 class BoardJob:
     """One board being rendered: ``done()`` never blocks; ``result()`` waits for it (or use it once done);
-    ``preview()`` gives the quick first render of a progressive job, once there is one, without waiting."""
+    ``poll()`` (a timer's job, never the draw callback's: it looks for files) starts reading what the worker has
+    written; ``preview()`` then gives the quick first render of a progressive job, without waiting."""
 
     def __init__(self, setup, process, folder, out, preview_out=None):
         self.setup, self.process, self.folder, self.out = setup, process, folder, out
@@ -106,13 +107,16 @@ class BoardJob:
         self._images = None  # the reading of the images (a future), started once the process has finished
         self._preview = None  # the reading of the preview's images, started once its file is there
 
-    def preview(self):
-        """The `BoardImages` of the preview render (few samples: the same board, noisier colours) once it has been
-        written and read (on a worker thread, like the final images), else None; never blocks."""
-        if self.preview_out is None:
-            return None
-        if self._preview is None and os.path.isfile(self.preview_out):  # moved into place whole by the worker
+    def poll(self):
+        """Start reading, on a worker thread, the preview once the worker has moved it into place and the final images
+        once the process has finished; never blocks."""
+        if self.preview_out is not None and self._preview is None and os.path.isfile(self.preview_out):
             self._preview = workers.submit(self._read_images, self.preview_out)
+        self.done()
+
+    def preview(self):
+        """The `BoardImages` of the preview render (few samples: the same board, noisier colours) once `poll` has had
+        it read, else None; never blocks and touches no file."""
         if self._preview is None or not self._preview.done() or self._preview.exception() is not None:
             return None
         return self._preview.result()

@@ -99,7 +99,8 @@ def test_a_progressive_board_writes_its_preview_first(clean_scene, bpy_module, a
                                samples=worker.PROGRESSIVE_MIN_SAMPLES)
     final = job.result(timeout=240)
     deadline = time.monotonic() + 60
-    while job.preview() is None and time.monotonic() < deadline:  # read on a worker thread
+    while job.preview() is None and time.monotonic() < deadline:  # read on a worker thread, started by poll()
+        job.poll()
         time.sleep(0.01)
     early = job.preview()
     assert early is not None
@@ -109,4 +110,5 @@ def test_a_progressive_board_writes_its_preview_first(clean_scene, bpy_module, a
     assert np.abs(early.displacement[inside] - final.displacement[inside]).max() < 0.02
     few = worker.request_board(ball, np.array([0.0, -5.0, 1.0]), res_screen=120, fov=np.radians(40), samples=1)
     few.result(timeout=240)
+    few.poll()
     assert few.preview() is None  # one sample: nothing to preview
