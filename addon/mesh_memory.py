@@ -107,11 +107,11 @@ def face_offsets_view(mesh):
     """A writable (F + 1,) int32 view of a new mesh's face offsets (each face's first corner, then the corner count:
     Blender's own layout, `compat.FACE_OFFSETS_CLOSED`), or None where they are not one array. Written in place, they
     are checked with `face_offsets_match`."""
-    polys = mesh.polygons
-    if not compat.FACE_OFFSETS_CLOSED or item_view(polys, np.int32) is None:
+    starts = item_view(mesh.polygons, np.int32) if compat.FACE_OFFSETS_CLOSED else None
+    if starts is None:
         return None
-    n = len(polys)
-    return np.frombuffer((ctypes.c_char * (4 * (n + 1))).from_address(polys[0].as_pointer()), dtype=np.int32)
+    closed = (ctypes.c_char * (starts.nbytes + 4)).from_address(starts.ctypes.data)  # the starts and the count after
+    return np.frombuffer(closed, dtype=np.int32)
 
 
 def face_offsets_match(mesh, offsets):
