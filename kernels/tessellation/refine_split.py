@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.partition import MAX_LEVEL, point_params
-from ..common.rows import put_rows, take_rows
+from ..common.rows import put_blocks, put_rows, take_rows
 from ..common.topology import group_by_class, ragged
 from .refine_general import boundary_vertices, edge_points, interior_counts, local_edge, refine_general, side_weights
 from .refine_templates import edge_segments
@@ -161,6 +161,12 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         out[n_b:] = np.arange(interior_first, interior_first + n_interior, dtype=index_type)
         return out
 
+    def ids_of(slot):  # output vertex of some slots (k, c), without every slot's id (`slot_ids`)
+        out = slot.astype(np.int64) + (interior_first - n_b)
+        boundary = slot < n_b
+        out[boundary] = b_ids[slot[boundary]]
+        return out.astype(np.int32)
+
     def slot_faces():
         out = np.empty(n_b + n_interior, index_type)
         out[:n_b] = b_face
@@ -173,9 +179,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         in_bary = slot_bary[n_b:]  # the interior points' rows, written in place
         if spacing == "EQUAL":
             for tpl, faces in zip(templates, groups, strict=True):
-                if len(tpl.bary):
-                    put_rows(in_bary, (int_start[faces][:, None] + np.arange(len(tpl.bary))).ravel(),
-                             np.tile(tpl.bary, (len(faces), 1)))
+                put_blocks(in_bary, int_start[faces], tpl.bary)
         else:
             # The inner partition's parameters once per face and point index; the weights once per point of one side
             # of each ring, rotated onto the other two (the same bits per element as `interior_bary`).
@@ -187,8 +191,8 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
                 params = table[faces]
                 weights = np.concatenate(side_weights(params[:, tpl.side_k], params[:, tpl.side_k + tpl.side_j],
                                                       tpl.side_j, tpl.side_len), axis=1)  # (F, 3Q)
-                rows = (int_start[faces][:, None] + np.arange(len(tpl.ring_k))).ravel()
-                put_rows(in_bary, rows, np.take(weights, tpl.column_source.ravel(), axis=1).reshape(-1, 3))
+                put_blocks(in_bary, int_start[faces],
+                           np.take(weights, tpl.column_source.ravel(), axis=1).reshape(len(faces), -1, 3))
         return slot_bary
 
     def strip():  # slot of every output triangle corner, and the strip rows for the output edges
@@ -227,10 +231,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         for tpl, faces in zip(templates, groups, strict=True):
             for part, offset in ((tpl.before, n_strip_outer[faces]),
                                  (tpl.after, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
-                if len(part):
-                    rows = (tri_start[faces] + offset)[:, None] + np.arange(len(part))
-                    block = (interior_base[faces][:, None, None] + part).astype(index_type).reshape(-1, 3)
-                    put_rows(tri_slots, rows.ravel(), block)
+                put_blocks(tri_slots, tri_start[faces] + offset, part, interior_base[faces])
         return tri_slots, (f, e, j, n, a_rows, a_walk), (c_face, jj, c_rows, c_walk), lone
 
     slot_bary, slots = Lazy(slot_barys), Lazy(strip)
@@ -245,8 +246,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         out = np.empty((n_seg + int(counts.sum()), 2), np.int32)
         out[:n_seg] = seg_ends
         corner = np.empty((n_out, 3), np.int32)
-        triangles = ref.triangles
-        _, a, (c_face, jj, c_rows, c_walk), lone = slots.get()
+        tri_slots, a, (c_face, jj, c_rows, c_walk), lone = slots.get()
         # The strip's spokes, numbered by walk position: a triangle's spoke is the one it starts from (its first
         # boundary and ring-1 vertex); the one it ends on is the next triangle's.
         f, e, j, n, rows, walk = a
@@ -254,28 +254,21 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         canonical = np.where(flipped[f, e], n - 1 - j, j)
         put_rows(corner, rows, np.stack([seg_start[face_edges[f, e]] + canonical, base + (walk + 1) % count,
                                               base + walk], axis=1).astype(np.int32))
-        strip = take_rows(triangles, rows)
-        put_rows(out, base + walk, np.ascontiguousarray(strip[:, [0, 2]]))
+        put_rows(out, base + walk, ids_of(take_rows(tri_slots, rows)[:, [0, 2]]))
         base, count = face_start[c_face], spokes[c_face]
         put_rows(corner, c_rows, np.stack([base + spokes[c_face] + _ring1_edges(templates, inverse[c_face], jj),
                                                 base + c_walk, base + (c_walk + 1) % count], axis=1).astype(np.int32))
-        strip = take_rows(triangles, c_rows)
-        put_rows(out, base + c_walk, np.ascontiguousarray(strip[:, [2, 1]]))
+        put_rows(out, base + c_walk, ids_of(take_rows(tri_slots, c_rows)[:, [2, 1]]))
         corner[tri_start[lone]] = seg_start[face_edges[lone]]  # one segment a side
         for tpl, faces in zip(templates, groups, strict=True):
             if not len(tpl.edges):
                 continue
             first = face_start[faces] + spokes[faces]
-            ids = (first[:, None] + np.arange(len(tpl.edges))).ravel()
-            put_rows(out, ids, ((interior_first + int_start[faces])[:, None, None] + tpl.edges)
-                          .astype(np.int32).reshape(-1, 2))
-            for part, part_edges, offset in (
-                    (tpl.before, tpl.before_edges, n_strip_outer[faces]),
-                    (tpl.after, tpl.after_edges, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
-                if len(part):
-                    rows = ((tri_start[faces] + offset)[:, None] + np.arange(len(part))).ravel()
-                    block = (first[:, None, None] + part_edges).astype(np.int32).reshape(-1, 3)
-                    put_rows(corner, rows, block)
+            put_blocks(out, first, tpl.edges, interior_first + int_start[faces])
+            for part_edges, offset in (
+                    (tpl.before_edges, n_strip_outer[faces]),
+                    (tpl.after_edges, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
+                put_blocks(corner, tri_start[faces] + offset, part_edges, first)
         return out, corner
 
     ref = Refinement(
