@@ -13,6 +13,7 @@ summation order of float64 products (checked in the tests).
 
 import numpy as np
 
+from ..common.rows import put_blocks
 from ..common.topology import group_by_class, ragged
 from .interpolate import normalize_channels
 from .refine_templates import slot_bary, stamp, triangle_starts
@@ -65,11 +66,12 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
                 if consecutive:
                     at = first + int(starts[chunk[0]])
                     block = out[at : at + len(chunk) * p].reshape(len(chunk), p, channels)
-                    for c in range(channels):
-                        block[:, :, c] = vals[c]
                 else:
-                    rows = (first + starts[chunk][:, None] + np.arange(p)).ravel()
-                    out[rows] = np.stack([v.ravel() for v in vals], axis=1)
+                    block = np.empty((len(chunk), p, channels), out.dtype)
+                for c in range(channels):
+                    block[:, :, c] = vals[c]
+                if not consecutive:
+                    put_blocks(out, first + starts[chunk], block)
         return
     owner, _, _ = ragged(counts)
     params = all_params()

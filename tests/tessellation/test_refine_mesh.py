@@ -185,7 +185,7 @@ def test_output_edges_from_the_patterns(spacing, levels, monkeypatch):
 def test_general_corner_values_per_slot_equal_per_corner(spacing, monkeypatch):
     """The general path weighs a corner attribute once per ring vertex and gathers it to the corners: the same
     bytes as weighing every corner, for float32 and float64 attributes with seams (faces disagree at shared
-    vertices)."""
+    vertices), and signed zeros."""
     import dataclasses
 
     from tessera.kernels.tessellation import refine_templates
@@ -201,11 +201,12 @@ def test_general_corner_values_per_slot_equal_per_corner(spacing, monkeypatch):
     slot_face, slot_bary, triangle_slots = ref.arrays.corner_slots.get()
     assert np.array_equal(slot_bary[triangle_slots], ref.corner_bary)
     assert np.array_equal(slot_face[triangle_slots[:, 0]], ref.triangle_face)
+    signed_zeros = rng.choice(np.array([-0.0, 0.0, -0.0, -1.5], np.float32), (len(f), 3, 2))  # -0 sums are +0
     for values in (rng.uniform(-3, 3, (len(f), 3, 2)).astype(np.float32), rng.normal(size=(len(f), 3, 4)),
-                   rng.normal(size=(len(f), 3))):
+                   rng.normal(size=(len(f), 3)), signed_zeros):
         got, want = corner_values(ref, values, "numpy"), corner_values(per_corner, values, "numpy")
         assert got.dtype == want.dtype == np.float32 and got.shape == want.shape
-        assert np.array_equal(got, want)
+        assert got.tobytes() == want.tobytes()  # bytes: array_equal takes -0.0 for +0.0
 
 
 @pytest.mark.parametrize("spacing", SPACINGS)
