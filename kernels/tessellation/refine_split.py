@@ -155,17 +155,11 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     interior_base = n_b + int_start  # slot of each face's first interior point
     # Built on first use, so the threads that evaluate the surface build them side by side (see `tessellate`).
 
-    def slot_ids():  # output vertex of every slot
-        out = np.empty(n_b + n_interior, index_type)
-        out[:n_b] = b_ids
-        out[n_b:] = np.arange(interior_first, interior_first + n_interior, dtype=index_type)
-        return out
-
-    def ids_of(slot):  # output vertex of some slots (k, c), without every slot's id (`slot_ids`)
+    def ids_of(slot):  # output vertex of some slots (k, c): interior slots are numbered in vertex order
         out = slot.astype(np.int64) + (interior_first - n_b)
         boundary = slot < n_b
         out[boundary] = b_ids[slot[boundary]]
-        return out.astype(np.int32)
+        return out.astype(index_type)
 
     def slot_faces():
         out = np.empty(n_b + n_interior, index_type)
@@ -236,6 +230,13 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
 
     slot_bary, slots = Lazy(slot_barys), Lazy(strip)
 
+    def triangle_ids():  # the slots' vertex ids; only strip rows and unrefined faces hold boundary slots
+        tri_slots, a, c, lone = slots.get()
+        out = np.add(tri_slots, interior_first - n_b, dtype=index_type)
+        for rows in (a[4], c[2], tri_start[lone]):
+            put_rows(out, rows, ids_of(take_rows(tri_slots, rows)))
+        return out
+
     def output_edges():
         seg_start, seg_ends = edge_segments(edges, edge_n, point_start, n_vertices)
         n_seg = len(seg_ends)
@@ -254,11 +255,11 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         canonical = np.where(flipped[f, e], n - 1 - j, j)
         put_rows(corner, rows, np.stack([seg_start[face_edges[f, e]] + canonical, base + (walk + 1) % count,
                                               base + walk], axis=1).astype(np.int32))
-        put_rows(out, base + walk, ids_of(take_rows(tri_slots, rows)[:, [0, 2]]))
+        put_rows(out, base + walk, ids_of(take_rows(tri_slots, rows)[:, [0, 2]]).astype(np.int32))
         base, count = face_start[c_face], spokes[c_face]
         put_rows(corner, c_rows, np.stack([base + spokes[c_face] + _ring1_edges(templates, inverse[c_face], jj),
                                                 base + c_walk, base + (c_walk + 1) % count], axis=1).astype(np.int32))
-        put_rows(out, base + c_walk, ids_of(take_rows(tri_slots, c_rows)[:, [2, 1]]))
+        put_rows(out, base + c_walk, ids_of(take_rows(tri_slots, c_rows)[:, [2, 1]]).astype(np.int32))
         corner[tri_start[lone]] = seg_start[face_edges[lone]]  # one segment a side
         for tpl, faces in zip(templates, groups, strict=True):
             if not len(tpl.edges):
@@ -277,7 +278,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
         interior_counts=n_int, n_triangles=n_out, face_edges=face_edges, flipped=flipped,
         arrays=LazyArrays(
-            triangles=Lazy(lambda: np.take(slot_ids(), slots.get()[0])),
+            triangles=Lazy(triangle_ids),
             triangle_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts)),
             interior_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), n_int)),
             interior_bary=Lazy(lambda: slot_bary.get()[n_b:]),

@@ -14,14 +14,14 @@ summation order of float64 products (checked in the tests).
 import numpy as np
 
 from ..common.rows import put_blocks
-from ..common.topology import group_by_class, ragged
+from ..common.topology import group_by_class
 from .interpolate import normalize_channels
 from .refine_templates import slot_bary, stamp, triangle_starts
 
 #: Use per-class matrix products when there are at most this many classes, or few per owner.
 MAX_CLASSES = 256
 #: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
-CHUNK = 1 << 16
+CHUNK = 1 << 14
 #: Points per chunk on the class path (keeps the float64 temporaries in cache before they are rounded).
 CHUNK_POINTS = 1 << 15
 
@@ -73,15 +73,30 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
                 if not consecutive:
                     put_blocks(out, first + starts[chunk], block)
         return
-    owner, _, _ = ragged(counts)
     params = all_params()
+    # Per point and channel ``sum_k basis[k] * control[owner, k, c]`` in k order: the products and sums of
+    # ``einsum("nk,nkc->nc")`` (which sums from +0, hence the +0.0 last; see `interpolate._slot_sums`), with each
+    # owner's control repeated over its run of points instead of gathering (n, k, C) controls.
+    tables = [[np.ascontiguousarray(control[:, j, c]) for j in range(control.shape[1])] for c in range(channels)]
+    bounds = np.append(starts, n)
     for lo in range(0, n, CHUNK):
         hi = min(n, lo + CHUNK)
-        b = basis(params[lo:hi])
-        vals = np.einsum("nk,nkc->nc", b, control[owner[lo:hi]])
+        # owners [f0, f1) hold points [lo, hi) (f0: the last owner starting at or before lo, the one holding it)
+        f0, f1 = int(np.searchsorted(bounds, lo, side="right")) - 1, int(np.searchsorted(bounds, hi, side="left"))
+        run = np.diff(np.clip(bounds[f0 : f1 + 1], lo, hi))
+        b = np.ascontiguousarray(basis(params[lo:hi]).T)  # (k, n): each term's weights one flat run
+        vals = []
+        for terms in tables:
+            acc = b[0] * np.repeat(terms[0][f0:f1], run)
+            for j in range(1, len(terms)):
+                acc += b[j] * np.repeat(terms[j][f0:f1], run)
+            acc += 0.0
+            vals.append(acc)
         if unit:
-            normalize_channels([vals[:, c] for c in range(channels)])
-        out[first + lo : first + hi] = vals
+            normalize_channels(vals)
+        block = out[first + lo : first + hi]
+        for c in range(channels):
+            block[:, c] = vals[c]
 
 
 def _edge_keys(ref):
