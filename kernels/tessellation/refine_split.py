@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.partition import MAX_LEVEL, point_params
-from ..common.rows import put_blocks, put_rows, take_rows
+from ..common.rows import put_blocks, put_rows
 from ..common.topology import group_by_class, ragged
 from .refine_general import boundary_vertices, edge_points, interior_counts, local_edge, refine_general, side_weights
 from .refine_templates import edge_segments
@@ -155,11 +155,11 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     interior_base = n_b + int_start  # slot of each face's first interior point
     # Built on first use, so the threads that evaluate the surface build them side by side (see `tessellate`).
 
-    def ids_of(slot):  # output vertex of some slots (k, c): interior slots are numbered in vertex order
-        out = slot.astype(np.int64) + (interior_first - n_b)
-        boundary = slot < n_b
-        out[boundary] = b_ids[slot[boundary]]
-        return out.astype(index_type)
+    def ids_of(block, boundary_columns):  # output vertex of the slots (k, 3) whose listed columns are boundary slots
+        out = block + (interior_first - n_b)  # interior slots are numbered in vertex order
+        for col in boundary_columns:
+            out[:, col] = b_ids[block[:, col]]
+        return out.astype(index_type, copy=False)
 
     def slot_faces():
         out = np.empty(n_b + n_interior, index_type)
@@ -201,9 +201,9 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         s = side[f]
         inner_pos = e * s + ((2 * j + 1) * s + n - 1) // (2 * n)
         a_rows = tri_start[f] + i
-        tri_slots[a_rows, 0] = b_start[f] + i
-        tri_slots[a_rows, 1] = b_start[f] + (i + 1) % boundary[f]
-        tri_slots[a_rows, 2] = interior_base[f] + inner_pos % ring1_loop[f]
+        a_block = np.stack([b_start[f] + i, b_start[f] + (i + 1) % boundary[f],
+                            interior_base[f] + inner_pos % ring1_loop[f]], axis=1)
+        put_rows(tri_slots, a_rows, a_block.astype(index_type))
         a_walk = i + inner_pos
         # Strip, ring-1 triangles: segment q of side c reaches boundary vertex `outer_pos`, the number of boundary
         # segments whose midpoint comes at or before its midpoint.
@@ -214,27 +214,30 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         before_c = np.where(c >= 1, outer_n[c_face, 0], 0) + np.where(c >= 2, outer_n[c_face, 1], 0)
         outer_pos = before_c + ((2 * q + 1) * n_c + s) // (2 * s)
         c_rows = tri_start[c_face] + n_strip_outer[c_face] + n_before[c_face] + jj
-        tri_slots[c_rows, 0] = interior_base[c_face] + (jj + 1) % ring1_loop[c_face]
-        tri_slots[c_rows, 1] = interior_base[c_face] + jj
-        tri_slots[c_rows, 2] = b_start[c_face] + outer_pos % boundary[c_face]
+        c_block = np.stack([interior_base[c_face] + (jj + 1) % ring1_loop[c_face], interior_base[c_face] + jj,
+                            b_start[c_face] + outer_pos % boundary[c_face]], axis=1)
+        put_rows(tri_slots, c_rows, c_block.astype(index_type))
         c_walk = jj + outer_pos
         # Unrefined faces (m == 1): the boundary loop's three corners.
         lone = np.flatnonzero(m == 1)
-        tri_slots[tri_start[lone]] = b_start[lone][:, None] + np.arange(3)
+        lone_block = b_start[lone][:, None] + np.arange(3)
+        tri_slots[tri_start[lone]] = lone_block
         # Interiors, stamped per inner segment count.
         for tpl, faces in zip(templates, groups, strict=True):
             for part, offset in ((tpl.before, n_strip_outer[faces]),
                                  (tpl.after, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
                 put_blocks(tri_slots, tri_start[faces] + offset, part, interior_base[faces])
-        return tri_slots, (f, e, j, n, a_rows, a_walk), (c_face, jj, c_rows, c_walk), lone
+        # The strip rows' vertex ids (their boundary slots looked up), for the triangles and the output edges.
+        return (tri_slots, (f, e, j, n, a_rows, a_walk, ids_of(a_block, (0, 1))),
+                (c_face, jj, c_rows, c_walk, ids_of(c_block, (2,))), (lone, ids_of(lone_block, (0, 1, 2))))
 
     slot_bary, slots = Lazy(slot_barys), Lazy(strip)
 
     def triangle_ids():  # the slots' vertex ids; only strip rows and unrefined faces hold boundary slots
-        tri_slots, a, c, lone = slots.get()
+        tri_slots, a, c, (lone, lone_ids) = slots.get()
         out = np.add(tri_slots, interior_first - n_b, dtype=index_type)
-        for rows in (a[4], c[2], tri_start[lone]):
-            put_rows(out, rows, ids_of(take_rows(tri_slots, rows)))
+        for rows, ids in ((a[4], a[6]), (c[2], c[4]), (tri_start[lone], lone_ids)):
+            put_rows(out, rows, ids)
         return out
 
     def output_edges():
@@ -247,19 +250,19 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
         out = np.empty((n_seg + int(counts.sum()), 2), np.int32)
         out[:n_seg] = seg_ends
         corner = np.empty((n_out, 3), np.int32)
-        tri_slots, a, (c_face, jj, c_rows, c_walk), lone = slots.get()
+        _, a, (c_face, jj, c_rows, c_walk, c_ids), (lone, _) = slots.get()
         # The strip's spokes, numbered by walk position: a triangle's spoke is the one it starts from (its first
         # boundary and ring-1 vertex); the one it ends on is the next triangle's.
-        f, e, j, n, rows, walk = a
+        f, e, j, n, rows, walk, a_ids = a
         base, count = face_start[f], spokes[f]
         canonical = np.where(flipped[f, e], n - 1 - j, j)
         put_rows(corner, rows, np.stack([seg_start[face_edges[f, e]] + canonical, base + (walk + 1) % count,
                                               base + walk], axis=1).astype(np.int32))
-        put_rows(out, base + walk, ids_of(take_rows(tri_slots, rows)[:, [0, 2]]).astype(np.int32))
+        put_rows(out, base + walk, a_ids[:, [0, 2]].astype(np.int32))
         base, count = face_start[c_face], spokes[c_face]
         put_rows(corner, c_rows, np.stack([base + spokes[c_face] + _ring1_edges(templates, inverse[c_face], jj),
                                                 base + c_walk, base + (c_walk + 1) % count], axis=1).astype(np.int32))
-        put_rows(out, base + c_walk, ids_of(take_rows(tri_slots, c_rows)[:, [2, 1]]).astype(np.int32))
+        put_rows(out, base + c_walk, c_ids[:, [2, 1]].astype(np.int32))
         corner[tri_start[lone]] = seg_start[face_edges[lone]]  # one segment a side
         for tpl, faces in zip(templates, groups, strict=True):
             if not len(tpl.edges):
