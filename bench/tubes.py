@@ -180,7 +180,7 @@ del pts
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 mesh = build_tubes(lines, TubeSettings(sides=3, caps="NONE", uvs=False))
 out = sum(a.nbytes for a in (mesh.positions, mesh.point_normals, mesh.corner_verts, mesh.corner_edges, mesh.edges,
-                             mesh.face_sizes, mesh.face_material))
+                             mesh.face_offsets, mesh.face_material) if a is not None)
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 print(before * 1024, peak * 1024, out, len(mesh.positions))
 """
@@ -205,7 +205,8 @@ from _setup import enable_extension
 bpy.ops.wm.read_factory_settings(use_empty=True)
 enable_extension()
 ob = tb.hair_object(bpy, tb.strands(tb.STRANDS, tb.POINTS))
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+with open("/proc/self/statm") as statm:  # resident now (the setup's own peak may lie above it), in KiB
+    before = int(statm.read().split()[1]) * resource.getpagesize() // 1024
 if sys.argv[2] == "operator":
     seconds, n = tb.operator_run(bpy, ob)
 else:
