@@ -148,8 +148,8 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     # Slots: every face's boundary loop, then the interior points in output order.
     b_face, b_pos, b_start = ragged(boundary)
     n_b = len(b_face)
-    b_ids, b_bary = boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t, n_vertices,
-                                      b_face, b_pos)
+    boundary_slots = Lazy(lambda: boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t,
+                                                    n_vertices, b_face, b_pos))  # (ids, barycentrics)
     n_interior = int(n_int.sum())
     index_type = np.int32 if n_b + n_interior + interior_first < 2**31 else np.int64
     interior_base = n_b + int_start  # slot of each face's first interior point
@@ -158,7 +158,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     def ids_of(block, boundary_columns):  # output vertex of the slots (k, 3) whose listed columns are boundary slots
         out = block + (interior_first - n_b)  # interior slots are numbered in vertex order
         for col in boundary_columns:
-            out[:, col] = b_ids[block[:, col]]
+            out[:, col] = boundary_slots.get()[0][block[:, col]]
         return out.astype(index_type, copy=False)
 
     def slot_faces():
@@ -169,7 +169,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
 
     def slot_barys():
         slot_bary = np.empty((n_b + n_interior, 3))
-        slot_bary[:n_b] = b_bary
+        slot_bary[:n_b] = boundary_slots.get()[1]
         in_bary = slot_bary[n_b:]  # the interior points' rows, written in place
         if spacing == "EQUAL":
             for tpl, faces in zip(templates, groups, strict=True):
