@@ -26,6 +26,27 @@ def runtime_for(backend):
     return None
 
 
+def segment_tables(run):
+    """Per point of a `builder.CurveRun`: the segment starting there (-1 at an open curve's last point) and that
+    segment's second point (0 where there is none): (P,) int32 each, written in order rather than scattered through
+    ``run.seg`` (every point starts a segment but the last of an open curve; a cyclic curve's last segment closes
+    it)."""
+    counts = run.counts.astype(np.int64)
+    ends = run.local[1:] - 1  # each curve's last point
+    open_ = ~run.cyclic
+    # segments before each curve: its points, less one for every open curve before it
+    skipped = np.concatenate(([0], np.cumsum(open_)[:-1])) if len(counts) else np.zeros(0, np.int64)
+    seg_of = np.arange(run.n_pts, dtype=np.int32)
+    seg_of -= np.repeat(skipped.astype(np.int32), counts)
+    nxt = np.arange(1, run.n_pts + 1, dtype=np.int32)
+    nonempty = counts > 0
+    last_open = ends[open_ & nonempty]
+    seg_of[last_open], nxt[last_open] = -1, 0
+    closing = run.cyclic & nonempty
+    nxt[ends[closing]] = run.local[:-1][closing]
+    return seg_of, nxt
+
+
 class TubeDevice:
     """Writes tube bodies into ``mesh`` (a preallocated `builder.PolygonMesh`) with OpenCL."""
 
@@ -55,15 +76,15 @@ class TubeDevice:
         frames: `builder.TubeFrames`; u_ends: UV u at segment ends or None; ring: (n, 2) float32 cos, sin of the
         side angles."""
         pick, n_pts = run.pick, run.n_pts
-        seg_of = np.full(n_pts, -1, np.int32)
-        seg_of[run.seg] = np.arange(len(run.seg), dtype=np.int32)
-        nxt = np.zeros(n_pts, np.int32)
-        nxt[run.seg] = run.nxt
-        u0 = np.zeros(n_pts, np.float32)
-        u1 = np.zeros(n_pts, np.float32)
+        seg_of, nxt = segment_tables(run)
+        none = np.zeros(1, np.float32)  # the kernel reads UVs and materials only when it writes them
+        u0 = u1 = none
         if u_ends is not None:
+            u0, u1 = np.zeros(n_pts, np.float32), np.zeros(n_pts, np.float32)
             u0[run.seg], u1[run.seg] = u_ends
-        material = lines.material_index[curves][run.curve_of_point]
+        material = none.view(np.int32)
+        if self.mesh.face_material is not None:
+            material = lines.material_index[curves][run.curve_of_point]
         b = self.buffers
         kernel = self.runtime.kernel("tubes/tube_body", "tube_body")
         kernel(self.runtime.queue, (max(n_pts, 1),), None,

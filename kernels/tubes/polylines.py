@@ -103,7 +103,7 @@ def drop_duplicates(lines):
     pts = lines.points
     if len(pts) == 0:
         return lines
-    extent = float(np.max(np.abs(pts))) + 1.0
+    extent = float(np.maximum(pts.max(), -pts.min())) + 1.0  # max |x|, without an (P, 3) temporary
     has_next = next_index(lines) >= 0
     seg = segment_lengths(lines)
     # a point is dropped when the segment leaving it has zero length; on an open curve the last point stays
@@ -126,8 +126,11 @@ def segment_lengths(lines):
     seg = np.zeros(len(pts))
     if len(pts) < 2:
         return seg
-    d = pts[1:] - pts[:-1]  # contiguous differences; the ends of curves are fixed below
-    np.sqrt(np.einsum("ij,ij->i", d, d), out=seg[:-1])
+    step = 1 << 15  # contiguous differences in blocks that stay in cache; the ends of curves are fixed below
+    for lo in range(0, len(pts) - 1, step):
+        hi = min(len(pts) - 1, lo + step)
+        d = pts[lo + 1 : hi + 1] - pts[lo:hi]
+        np.sqrt(np.einsum("ij,ij->i", d, d), out=seg[lo:hi])
     nonempty = lines.counts > 0
     ends = lines.offsets[1:][nonempty] - 1
     starts = lines.offsets[:-1][nonempty]

@@ -296,3 +296,26 @@ def test_camera_sides_never_increase_with_distance():
     assert np.all(np.diff(sides) <= 0) and sides[0] == 32 and sides[-1] == 3
     mesh = build_tubes(lines, settings, camera=cam)
     assert len(mesh.positions) == 2 * sides.sum()
+
+
+def test_segment_tables_in_closed_form():
+    """The OpenCL body's per-point tables (the segment starting at each point, its second point), written in order,
+    are the scatter through the run's segments: open and cyclic curves, runs of some of the curves."""
+    from tessera.kernels.tubes.builder import _run_topology
+    from tessera.kernels.tubes.opencl_path import segment_tables
+    from tessera.kernels.tubes.polylines import Polylines
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        k = int(rng.integers(1, 12))
+        counts = rng.integers(2, 7, k)
+        lines = Polylines.build(rng.normal(size=(counts.sum(), 3)), np.concatenate(([0], np.cumsum(counts))),
+                                radius=0.1, cyclic=rng.random(k) < 0.4)
+        run = _run_topology(lines, np.sort(rng.permutation(k)[: int(rng.integers(1, k + 1))]))
+        seg_of = np.full(run.n_pts, -1, np.int32)
+        seg_of[run.seg] = np.arange(len(run.seg))
+        nxt = np.zeros(run.n_pts, np.int32)
+        nxt[run.seg] = run.nxt
+        got = segment_tables(run)
+        assert got[0].dtype == got[1].dtype == np.int32
+        assert np.array_equal(got[0], seg_of) and np.array_equal(got[1], nxt)
