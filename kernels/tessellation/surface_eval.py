@@ -77,7 +77,8 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
     # Per point and channel ``sum_k basis[k] * control[owner, k, c]`` in k order: the products and sums of
     # ``einsum("nk,nkc->nc")`` (which sums from +0, hence the +0.0 last; see `interpolate._slot_sums`), with each
     # owner's control repeated over its run of points instead of gathering (n, k, C) controls.
-    tables = [[np.ascontiguousarray(control[:, j, c]) for j in range(control.shape[1])] for c in range(channels)]
+    k = control.shape[1]
+    table = np.ascontiguousarray(control.transpose(2, 1, 0).reshape(channels * k, -1))  # row c k + j: control[:, j, c]
     bounds = np.append(starts, n)
     for lo in range(0, n, CHUNK):
         hi = min(n, lo + CHUNK)
@@ -85,11 +86,13 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         f0, f1 = int(np.searchsorted(bounds, lo, side="right")) - 1, int(np.searchsorted(bounds, hi, side="left"))
         run = np.diff(np.clip(bounds[f0 : f1 + 1], lo, hi))
         b = np.ascontiguousarray(basis(params[lo:hi]).T)  # (k, n): each term's weights one flat run
+        repeated = np.repeat(table[:, f0:f1], run, axis=1)  # (C k, n): each owner's control over its run
         vals = []
-        for terms in tables:
-            acc = b[0] * np.repeat(terms[0][f0:f1], run)
-            for j in range(1, len(terms)):
-                acc += b[j] * np.repeat(terms[j][f0:f1], run)
+        for c in range(channels):
+            terms = repeated[c * k : (c + 1) * k]
+            acc = b[0] * terms[0]
+            for j in range(1, k):
+                acc += b[j] * terms[j]
             acc += 0.0
             vals.append(acc)
         if unit:
