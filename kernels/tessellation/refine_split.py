@@ -189,7 +189,7 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
                            np.take(weights, tpl.column_source.ravel(), axis=1).reshape(len(faces), -1, 3))
         return slot_bary
 
-    def strip():  # slot of every output triangle corner, and the strip rows for the output edges
+    def strip():  # slot of every output triangle corner; the strip rows (boundary, ring 1) and unrefined faces
         tri_slots = np.empty((n_out, 3), index_type)
         # Strip, boundary triangles: segment i (local edge e, index j of n) reaches ring-1 vertex `inner_pos`, the
         # number of ring-1 segments whose midpoint comes before its midpoint: e * s, plus those q of side e with
@@ -234,9 +234,9 @@ def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     slot_bary, slots = Lazy(slot_barys), Lazy(strip)
 
     def triangle_ids():  # the slots' vertex ids; only strip rows and unrefined faces hold boundary slots
-        tri_slots, a, c, (lone, lone_ids) = slots.get()
+        tri_slots, (*_, a_rows, _, a_ids), (_, _, c_rows, _, c_ids), (lone, lone_ids) = slots.get()
         out = np.add(tri_slots, interior_first - n_b, dtype=index_type)
-        for rows, ids in ((a[4], a[6]), (c[2], c[4]), (tri_start[lone], lone_ids)):
+        for rows, ids in ((a_rows, a_ids), (c_rows, c_ids), (tri_start[lone], lone_ids)):
             put_rows(out, rows, ids)
         return out
 

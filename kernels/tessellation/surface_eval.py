@@ -20,7 +20,7 @@ from .refine_templates import slot_bary, stamp, triangle_starts
 
 #: Use per-class matrix products when there are at most this many classes, or few per owner.
 MAX_CLASSES = 256
-#: Points per chunk on the point-by-point path (bounds the temporary (n, K, C) gather).
+#: Points per chunk on the point-by-point path (its float64 terms and sums stay in cache).
 CHUNK = 1 << 14
 #: Points per chunk on the class path (keeps the float64 temporaries in cache before they are rounded).
 CHUNK_POINTS = 1 << 15
