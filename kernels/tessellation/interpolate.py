@@ -38,12 +38,24 @@ def gather_weighted_numpy(values, idx, weights):
     float64 and rounded once.
     """
     n, channels = len(idx), values.shape[1]
+    taps = idx.shape[1]
     out = np.empty((n, channels), dtype=np.float32)
-    for lo in range(0, n, GATHER_CHUNK):  # the same products and sums, row block by row block (stays in cache)
+    if taps == 0:
+        out[...] = 0.0
+        return out
+    # ``sum(w * v)`` from +0 in tap order (`_weighted_sum`), worked one channel at a time on flat runs: the same
+    # bits (see `_slot_sums` for the +0.0), several times faster than gathering (n, C) rows per tap.
+    planes = [np.ascontiguousarray(values[:, c]) for c in range(channels)]
+    for lo in range(0, n, GATHER_CHUNK):  # row block by row block (stays in cache)
         hi = min(n, lo + GATHER_CHUNK)
-        i, w = idx[lo:hi], weights[lo:hi]
-        out[lo:hi] = _weighted_sum(((w[:, tap, None], values[i[:, tap]]) for tap in range(idx.shape[1])),
-                                   (hi - lo, channels))
+        i = [np.ascontiguousarray(idx[lo:hi, tap]) for tap in range(taps)]
+        w = [np.ascontiguousarray(weights[lo:hi, tap]) for tap in range(taps)]
+        for c, plane in enumerate(planes):
+            acc = w[0] * plane[i[0]]
+            for tap in range(1, taps):
+                acc += w[tap] * plane[i[tap]]
+            acc += 0.0
+            out[lo:hi, c] = acc
     return out
 
 

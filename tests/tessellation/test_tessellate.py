@@ -208,3 +208,23 @@ def test_per_face_levels_give_the_general_construction_bytes(method, spacing, mo
         for key, x in getattr(a, group).items():
             y = getattr(b, group)[key]
             assert x.dtype == y.dtype and np.array_equal(x, y), key
+
+
+@pytest.mark.parametrize("taps", [1, 2, 3])
+def test_numpy_gather_is_the_tap_order_sum_bit_for_bit(taps):
+    """`gather_weighted_numpy` works channel by channel; its bytes are those of ``sum(w * v)`` from +0 in tap order
+    (`_weighted_sum`, the one summation every numpy path shares): float32 and float64 values, signed zeros, rows
+    split between blocks."""
+    from tessera.kernels.tessellation.interpolate import GATHER_CHUNK, _weighted_sum, gather_weighted_numpy
+
+    rng = np.random.default_rng(taps)
+    n = GATHER_CHUNK + 777
+    idx = rng.integers(0, 300, (n, taps))
+    w = rng.dirichlet(np.ones(taps), n)
+    w[:50] = np.eye(taps)[0]  # a corner: the other taps' products are signed zeros
+    for values in (rng.normal(size=(300, 3)), rng.normal(size=(300, 2)).astype(np.float32),
+                   rng.choice(np.array([-0.0, 0.0, -1.5]), (300, 4))):
+        want = _weighted_sum(((w[:, t, None], values[idx[:, t]]) for t in range(taps)),
+                             (n, values.shape[1])).astype(np.float32)
+        got = gather_weighted_numpy(values, idx, w)
+        assert got.dtype == np.float32 and got.tobytes() == want.tobytes()
