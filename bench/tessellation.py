@@ -11,8 +11,9 @@ Cases on a smooth-shaded Suzanne (968 triangles):
   flat-shaded one (what *Add > Monkey* gives: every edge sharp, split corner normals written as custom normals).
 - ``operator_pn_adaptive``: adaptive PN (fractional-even, projected edge length of 3 px for a 1920x1080 camera)
   end to end against the operator at the uniform level giving about as many triangles, per output triangle;
-  ``operator_pn_adaptive_dense``: the same on Suzanne subdivided twice (15,744 triangles, 4 px), where every face has
-  a level of its own and few output triangles.
+  ``operator_pn_adaptive_equal``: the same levels with equal spacing (rounded up to whole segments, so faces fall
+  into pattern classes); ``operator_pn_adaptive_dense``: fractional-even on Suzanne subdivided twice (15,744
+  triangles, 4 px), where every face has a level of its own and few output triangles.
 - ``first_call``: in a fresh process, importing bpy, enabling Tessera and the first operator call, against a warm
   call of the same operator.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tessellation.py
@@ -149,6 +150,7 @@ def main():
                          "baseline_triangles": apply_tris, "baseline_seconds": round(apply_seconds, 4),
                          "speedup": round(rate / base, 2), "speedup_vs_evaluation_only": round(rate / sub_rate, 2)})
     rows.append(adaptive_case(bpy, ob))
+    rows.append(adaptive_case(bpy, ob, "operator_pn_adaptive_equal", spacing="EQUAL"))  # levels rounded up: classes
     dense = ob.copy()  # many small faces that all differ: Suzanne subdivided twice (15,744 triangles)
     dense.data = ob.data.copy()
     bpy.context.scene.collection.objects.link(dense)
@@ -161,7 +163,7 @@ def main():
         print(json.dumps(row))
 
 
-def adaptive_case(bpy, ob, case="operator_pn_adaptive", edge_pixels=3.0):
+def adaptive_case(bpy, ob, case="operator_pn_adaptive", edge_pixels=3.0, spacing="FRACTIONAL_EVEN"):
     """Adaptive PN (fractional-even spacing, projected edge length for a camera) end to end, against the operator at
     the uniform level that gives about as many triangles, in triangles per second; the two run alternately (best
     of REPEAT each) after one untimed adaptive run that sizes the uniform level."""
@@ -176,7 +178,7 @@ def adaptive_case(bpy, ob, case="operator_pn_adaptive", edge_pixels=3.0):
         bpy.context.scene.camera = cam
     render = bpy.context.scene.render
     render.resolution_x, render.resolution_y, render.resolution_percentage = 1920, 1080, 100
-    adaptive = {"level_mode": "ADAPTIVE", "spacing": "FRACTIONAL_EVEN", "metrics": {"PROJECTED"},
+    adaptive = {"level_mode": "ADAPTIVE", "spacing": spacing, "metrics": {"PROJECTED"},
                 "edge_pixels": edge_pixels, "max_level": 64.0}
     _, n = operator_run(bpy, ob, "PN", repeat=1, **adaptive)
     level = np.sqrt(n / len(ob.data.loop_triangles) / 1.5)  # floor(3 l^2 / 2) triangles a face
@@ -187,7 +189,7 @@ def adaptive_case(bpy, ob, case="operator_pn_adaptive", edge_pixels=3.0):
         uniform_seconds = min(uniform_seconds, one)
     rate, base = n / seconds, uniform_n / uniform_seconds
     return {"bench": "tessellation", "case": case, "input_triangles": len(ob.data.loop_triangles),
-            "output_triangles": n, "edge_pixels": edge_pixels,
+            "output_triangles": n, "edge_pixels": edge_pixels, "spacing": spacing,
             "seconds": round(seconds, 4), "triangles_per_second": round(rate),
             "baseline": f"the operator at uniform level {int(np.ceil(level))} (PN, equal spacing)",
             "baseline_triangles": uniform_n, "baseline_seconds": round(uniform_seconds, 4),
