@@ -22,12 +22,19 @@ CHUNK_FACES = 256
 GATHER_CHUNK = 1 << 14
 
 
-def _weighted_sum(terms, shape):
-    """``sum(w * v)`` over the ``(w, v)`` pairs of ``terms`` in order, from a float64 zero of ``shape``: the one
-    summation of the numpy gathers, so every path that uses it gives the same bits."""
-    acc = np.zeros(shape, dtype=np.float64)
-    for w, v in terms:
+def weighted_sum(terms):
+    """``sum(w * v)`` over the ``(w, v)`` pairs of ``terms`` in order, accumulated in float64: the one summation of
+    the numpy paths (gathers, slot and corner sums, the surface's point path), so they all give the same bits.
+
+    It starts from the first product and adds +0.0 last, which is bit for bit the sum from a +0 start: the two
+    differ only in the sign of a zero sum, and a sum from +0 is never -0. Terms are flat runs or broadcast blocks.
+    """
+    pairs = iter(terms)
+    w, v = next(pairs)
+    acc = np.asarray(w * v, dtype=np.float64)
+    for w, v in pairs:
         acc += w * v
+    acc += 0.0
     return acc
 
 
@@ -43,19 +50,14 @@ def gather_weighted_numpy(values, idx, weights):
     if taps == 0:
         out[...] = 0.0
         return out
-    # ``sum(w * v)`` from +0 in tap order (`_weighted_sum`), worked one channel at a time on flat runs: the same
-    # bits (see `_slot_sums` for the +0.0), several times faster than gathering (n, C) rows per tap.
+    # One channel at a time on flat runs: several times faster than gathering (n, C) rows per tap, the same bits.
     planes = [np.ascontiguousarray(values[:, c]) for c in range(channels)]
     for lo in range(0, n, GATHER_CHUNK):  # row block by row block (stays in cache)
         hi = min(n, lo + GATHER_CHUNK)
         i = [np.ascontiguousarray(idx[lo:hi, tap]) for tap in range(taps)]
         w = [np.ascontiguousarray(weights[lo:hi, tap]) for tap in range(taps)]
         for c, plane in enumerate(planes):
-            acc = w[0] * plane[i[0]]
-            for tap in range(1, taps):
-                acc += w[tap] * plane[i[tap]]
-            acc += 0.0
-            out[lo:hi, c] = acc
+            out[lo:hi, c] = weighted_sum((w[tap], plane[i[tap]]) for tap in range(taps))
     return out
 
 
@@ -161,8 +163,7 @@ def _corner_values_by_triangle(ref, values):
         hi = min(ref.n_triangles, lo + step)
         src = flat[faces[lo:hi]]  # (n, 3, C): the face's corner values
         w = bary[lo:hi]  # (n, 3 output corners, 3 face corners)
-        out[lo:hi] = _weighted_sum(((w[:, :, tap, None], src[:, None, tap, :]) for tap in range(3)),
-                                   (hi - lo, 3, flat.shape[2]))
+        out[lo:hi] = weighted_sum((w[:, :, tap, None], src[:, None, tap, :]) for tap in range(3))
     return out.reshape((ref.n_triangles, 3) + tail)
 
 
@@ -171,8 +172,7 @@ def _slot_sums(flat, slot_face, slot_bary):
     -> (N, C) float32; the products and sums of `_corner_values_by_triangle`, per slot instead of per corner.
 
     Worked one channel at a time on flat runs (a gather from a (T,) plane per tap), which numpy does several
-    times faster than the (n, 3, C) blocks; the sum starts from the first product and adds +0.0 last, which is
-    ``((0 + p0) + p1) + p2`` bit for bit (the two differ only in the sign of a zero sum, and the reference's is +0).
+    times faster than the (n, 3, C) blocks.
     """
     channels = flat.shape[2]
     out = np.empty((len(slot_face), channels), dtype=np.float32)
@@ -182,11 +182,7 @@ def _slot_sums(flat, slot_face, slot_bary):
         faces = slot_face[lo:hi]
         w = [np.ascontiguousarray(slot_bary[lo:hi, tap]) for tap in range(3)]
         for c, taps in enumerate(planes):
-            acc = w[0] * taps[0][faces]
-            acc += w[1] * taps[1][faces]
-            acc += w[2] * taps[2][faces]
-            acc += 0.0
-            out[lo:hi, c] = acc
+            out[lo:hi, c] = weighted_sum((w[tap], taps[tap][faces]) for tap in range(3))
     return out
 
 

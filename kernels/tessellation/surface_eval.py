@@ -15,7 +15,7 @@ import numpy as np
 
 from ..common.rows import put_blocks
 from ..common.topology import group_by_class
-from .interpolate import normalize_channels
+from .interpolate import normalize_channels, weighted_sum
 from .refine_templates import slot_bary, stamp, triangle_starts
 
 #: Use per-class matrix products when there are at most this many classes, or few per owner.
@@ -74,9 +74,9 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
                     put_blocks(out, first + starts[chunk], block)
         return
     params = all_params()
-    # Per point and channel ``sum_k basis[k] * control[owner, k, c]`` in k order: the products and sums of
-    # ``einsum("nk,nkc->nc")`` (which sums from +0, hence the +0.0 last; see `interpolate._slot_sums`), with each
-    # owner's control repeated over its run of points instead of gathering (n, k, C) controls.
+    # Per point and channel ``sum_k basis[k] * control[owner, k, c]`` in k order (`weighted_sum`): the products and
+    # sums of ``einsum("nk,nkc->nc")``, with each owner's control repeated over its run of points instead of
+    # gathering (n, k, C) controls.
     k = control.shape[1]
     table = np.ascontiguousarray(control.transpose(2, 1, 0).reshape(channels * k, -1))  # row c k + j: control[:, j, c]
     bounds = np.append(starts, n)
@@ -87,14 +87,7 @@ def _evaluate_group(out, first, counts, keys, template_of, all_params, control, 
         run = np.diff(np.clip(bounds[f0 : f1 + 1], lo, hi))
         b = np.ascontiguousarray(basis(params[lo:hi]).T)  # (k, n): each term's weights one flat run
         repeated = np.repeat(table[:, f0:f1], run, axis=1)  # (C k, n): each owner's control over its run
-        vals = []
-        for c in range(channels):
-            terms = repeated[c * k : (c + 1) * k]
-            acc = b[0] * terms[0]
-            for j in range(1, k):
-                acc += b[j] * terms[j]
-            acc += 0.0
-            vals.append(acc)
+        vals = [weighted_sum(zip(b, repeated[c * k : (c + 1) * k], strict=True)) for c in range(channels)]
         if unit:
             normalize_channels(vals)
         block = out[first + lo : first + hi]

@@ -212,10 +212,9 @@ def test_per_face_levels_give_the_general_construction_bytes(method, spacing, mo
 
 @pytest.mark.parametrize("taps", [1, 2, 3])
 def test_numpy_gather_is_the_tap_order_sum_bit_for_bit(taps):
-    """`gather_weighted_numpy` works channel by channel; its bytes are those of ``sum(w * v)`` from +0 in tap order
-    (`_weighted_sum`, the one summation every numpy path shares): float32 and float64 values, signed zeros, rows
-    split between blocks."""
-    from tessera.kernels.tessellation.interpolate import GATHER_CHUNK, _weighted_sum, gather_weighted_numpy
+    """`gather_weighted_numpy` works channel by channel; its bytes are those of ``sum(w * v)`` from a float64 +0 in
+    tap order over whole rows: float32 and float64 values, signed zeros, rows split between blocks."""
+    from tessera.kernels.tessellation.interpolate import GATHER_CHUNK, gather_weighted_numpy
 
     rng = np.random.default_rng(taps)
     n = GATHER_CHUNK + 777
@@ -224,7 +223,8 @@ def test_numpy_gather_is_the_tap_order_sum_bit_for_bit(taps):
     w[:50] = np.eye(taps)[0]  # a corner: the other taps' products are signed zeros
     for values in (rng.normal(size=(300, 3)), rng.normal(size=(300, 2)).astype(np.float32),
                    rng.choice(np.array([-0.0, 0.0, -1.5]), (300, 4))):
-        want = _weighted_sum(((w[:, t, None], values[idx[:, t]]) for t in range(taps)),
-                             (n, values.shape[1])).astype(np.float32)
+        want = np.zeros((n, values.shape[1]))
+        for t in range(taps):
+            want += w[:, t, None] * values[idx[:, t]]
         got = gather_weighted_numpy(values, idx, w)
-        assert got.dtype == np.float32 and got.tobytes() == want.tobytes()
+        assert got.dtype == np.float32 and got.tobytes() == want.astype(np.float32).tobytes()
