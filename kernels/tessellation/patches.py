@@ -39,13 +39,20 @@ def _corners(bary):
     return b[:, 0], b[:, 1], b[:, 2]
 
 
+def _product(out, first, *factors):
+    """``first * factors[0] * ...`` left to right, into ``out`` (one row of a basis)."""
+    np.multiply(first, factors[0], out=out)
+    for f in factors[1:]:
+        out *= f
+
+
 def quadratic_basis(bary):
     """(P, 3) barycentrics -> (P, 6) float64, columns as in the module docstring (the transpose of a (6, P) array:
     each column is one flat run)."""
     b0, b1, b2 = _corners(bary)
     out = np.empty((6, len(b0)))
-    for col, (x, y) in enumerate(((b0, b0), (b1, b1), (b2, b2), (b0, b1), (b1, b2), (b2, b0))):
-        np.multiply(x, y, out=out[col])
+    for row, pair in zip(out, ((b0, b0), (b1, b1), (b2, b2), (b0, b1), (b1, b2), (b2, b0)), strict=True):
+        _product(row, *pair)
     return out.T
 
 
@@ -53,19 +60,19 @@ def cubic_basis(bary):
     """(P, 3) barycentrics -> (P, 10) float64, columns as in the module docstring."""
     b0, b1, b2 = _corners(bary)
     out = np.empty((10, len(b0)))  # filled by rows and returned transposed: each column is one flat run
-    for col, x in enumerate((b0, b1, b2)):
-        np.power(x, 3, out=out[col])
+    for row, x in zip(out[:3], (b0, b1, b2), strict=True):
+        np.power(x, 3, out=row)
     # Left to right as written, ``3 * b0 * b0 * b1`` is ((3 b0) b0) b1: the shared leading products are the same
     # roundings, so each column has the bits of its expression evaluated alone.
     three0, three1 = 3 * b0, 3 * b1
     t00, t11 = three0 * b0, three1 * b1
-    np.multiply(t00, b1, out=out[3])  # 3 b0 b0 b1
-    np.multiply(np.multiply(three0, b1, out=out[4]), b1, out=out[4])  # 3 b0 b1 b1
-    np.multiply(t11, b2, out=out[5])  # 3 b1 b1 b2
-    np.multiply(np.multiply(three1, b2, out=out[6]), b2, out=out[6])  # 3 b1 b2 b2
-    np.multiply(np.multiply(three0, b2, out=out[7]), b2, out=out[7])  # 3 b0 b2 b2
-    np.multiply(t00, b2, out=out[8])  # 3 b0 b0 b2
-    np.multiply(np.multiply(np.multiply(6, b0, out=out[9]), b1, out=out[9]), b2, out=out[9])  # 6 b0 b1 b2
+    _product(out[3], t00, b1)  # 3 b0 b0 b1
+    _product(out[4], three0, b1, b1)  # 3 b0 b1 b1
+    _product(out[5], t11, b2)  # 3 b1 b1 b2
+    _product(out[6], three1, b2, b2)  # 3 b1 b2 b2
+    _product(out[7], three0, b2, b2)  # 3 b0 b2 b2
+    _product(out[8], t00, b2)  # 3 b0 b0 b2
+    _product(out[9], 6 * b0, b1, b2)  # 6 b0 b1 b2
     return out.T
 
 

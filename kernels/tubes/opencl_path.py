@@ -35,9 +35,8 @@ def segment_tables(run):
     ends = run.local[1:] - 1  # each curve's last point
     open_ = ~run.cyclic
     # segments before each curve: its points, less one for every open curve before it
-    skipped = np.concatenate(([0], np.cumsum(open_)[:-1])) if len(counts) else np.zeros(0, np.int64)
     seg_of = np.arange(run.n_pts, dtype=np.int32)
-    seg_of -= np.repeat(skipped.astype(np.int32), counts)
+    seg_of -= np.repeat((np.cumsum(open_) - open_).astype(np.int32), counts)
     nxt = np.arange(1, run.n_pts + 1, dtype=np.int32)
     nonempty = counts > 0
     last_open = ends[open_ & nonempty]
