@@ -6,7 +6,9 @@ a platform are present and otherwise warns once and falls back to numpy; ``requi
 is a case-insensitive substring of the wanted device or platform name. Without one, a GPU is preferred.
 
 Programs are read from the ``.cl`` files beside the capability code (``kernels/<capability>/*.cl``, named
-``"<capability>/<file>"``) and built once per context (in-process cache); pyopencl's
+``"<capability>/<file>"``) and built once per context (in-process cache). Every program is built with
+correctly rounded single-precision division and square root where the device offers them: the numpy
+references round those correctly, and OpenCL's default allows 2.5-3 ulp (NVIDIA's driver uses it). pyopencl's
 binary cache goes to ``TESSERA_CACHE_DIR`` or ``$XDG_CACHE_HOME/tessera``, never a fixed home path.
 """
 
@@ -47,6 +49,13 @@ class Runtime:
     def description(self):
         return f"{self.device.platform.name.strip()} / {self.device.name.strip()}"
 
+    @property
+    def base_options(self):
+        """Build options every program gets: correctly rounded float division and sqrt where the device has
+        them (``CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT``), as in the numpy references."""
+        rounded = self.device.single_fp_config & self.cl.device_fp_config.CORRECTLY_ROUNDED_DIVIDE_SQRT
+        return ("-cl-fp32-correctly-rounded-divide-sqrt",) if rounded else ()
+
     def program(self, name, options=()):
         """Built program for ``kernels/<name>.cl`` (``name`` like ``"tubes/tube_body"``); raises `TesseraError`
         with the compiler log."""
@@ -54,7 +63,8 @@ class Runtime:
         if key not in self._programs:
             source = _read_source(name)
             try:
-                prg = self.cl.Program(self.context, source).build(options=list(options), cache_dir=self.cache_dir)
+                prg = self.cl.Program(self.context, source).build(options=[*self.base_options, *options],
+                                                                  cache_dir=self.cache_dir)
             except self.cl.RuntimeError as err:
                 raise TesseraError(f"OpenCL program {name}.cl failed to build on {self.description}:\n{err}") from err
             self._programs[key] = prg

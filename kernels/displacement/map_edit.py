@@ -450,7 +450,7 @@ def compile_custom(runtime, body):
     """
     cl = runtime.cl
     try:
-        program = cl.Program(runtime.context, CUSTOM_TEMPLATE % body).build()
+        program = cl.Program(runtime.context, CUSTOM_TEMPLATE % body).build(options=list(runtime.base_options))
     except cl.RuntimeError as err:
         raise TesseraError(f"The custom kernel failed to compile:\n{err}") from err
     return cl.Kernel(program, "custom")

@@ -1,5 +1,7 @@
 // Height acceleration map (seed 000 §5.6.1) and the per-tile table (§5.6.2). Same operation order as the
-// numpy reference in terrain_analysis.py: M = |Sobel(H)|, HAM = |Sobel(M)|, clamp-to-edge borders.
+// numpy reference in terrain/analysis.py: M = |Sobel(H)|, HAM = |Sobel(M)|, clamp-to-edge borders. Contraction is
+// off (a + 2b would become one fma, and gx * gx + gy * gy another), so the device gives the reference's bits.
+#pragma OPENCL FP_CONTRACT OFF
 
 inline float at(__global const float *a, int x, int y, int w, int h) {
     x = clamp(x, 0, w - 1);

@@ -1,4 +1,5 @@
-"""Runtime selection logic (the platform simulated absent) and, in the opencl tier, program build errors."""
+"""Runtime selection logic (the platform simulated absent) and, in the opencl tier, program build errors and the
+build options every program gets."""
 
 import warnings
 
@@ -76,3 +77,30 @@ def test_build_error_reports_the_compiler_log(opencl, monkeypatch):
     with pytest.raises(TesseraError, match="failed to build") as err:
         opencl.program("broken")
     assert "y" in str(err.value)
+
+
+@pytest.mark.opencl
+def test_programs_divide_and_take_square_roots_correctly_rounded(opencl, monkeypatch):
+    """Every program gets the correctly rounded division and sqrt the numpy references use, where the device has
+    them: quotients and roots of random float32 pairs (tiny, huge, near-equal) are the reference's bytes."""
+    cl = opencl.cl
+    rounded = bool(opencl.device.single_fp_config & cl.device_fp_config.CORRECTLY_ROUNDED_DIVIDE_SQRT)
+    assert opencl.base_options == (("-cl-fp32-correctly-rounded-divide-sqrt",) if rounded else ())
+    if not rounded:
+        return  # a device without them builds with OpenCL's default accuracy (checked just above)
+    monkeypatch.setitem(opencl_runtime._sources, "div_sqrt",
+                        "__kernel void k(__global const float *a, __global const float *b, __global float *q, "
+                        "__global float *r) { int i = get_global_id(0); q[i] = a[i] / b[i]; r[i] = sqrt(a[i]); }")
+    rng = np.random.default_rng(3)
+    a = (rng.uniform(0.5, 2, 1 << 16) * 10.0 ** rng.integers(-30, 30, 1 << 16)).astype(np.float32)
+    b = np.where(rng.random(a.size) < 0.2, a * np.float32(1 + 1e-7), rng.uniform(0.5, 2, a.size) *
+                 10.0 ** rng.integers(-30, 30, a.size)).astype(np.float32)
+    q, r = np.empty_like(a), np.empty_like(a)
+    mf = cl.mem_flags
+    bufs = [cl.Buffer(opencl.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=x) for x in (a, b)]
+    outs = [cl.Buffer(opencl.context, mf.WRITE_ONLY, a.nbytes) for _ in range(2)]
+    opencl.program("div_sqrt").k(opencl.queue, a.shape, None, *bufs, *outs)
+    for host, buf in zip((q, r), outs):
+        cl.enqueue_copy(opencl.queue, host, buf)
+    assert q.tobytes() == (a / b).tobytes()
+    assert r.tobytes() == np.sqrt(a).tobytes()

@@ -37,7 +37,9 @@ def test_map_kernels_equal_the_numpy_reference(opencl, channels):
         ra = apply_dab(a, kind, backend="opencl", **params)
         rb = apply_dab(b, kind, backend="numpy", **params)
         assert ra == rb, kind
-        assert np.allclose(a, b, rtol=0, atol=FLOAT32_PATH_ATOL), (kind, np.abs(a - b).max())
+        # the same float32 operations, contraction off, division and sqrt correctly rounded (the runtime's build
+        # option): the device gives the reference's bytes (PoCL and NVIDIA's driver both do)
+        assert a.tobytes() == b.tobytes(), (kind, np.abs(a - b).max())
         if ra is not None:
             x0, y0, x1, y1 = ra
             outside = np.ones(base.shape[:2], bool)
