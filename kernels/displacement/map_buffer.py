@@ -9,6 +9,7 @@ rectangular copies (`clEnqueueReadBufferRect` and friends), correct on CPU and G
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from .dab_timing import DabTimes
 from .map_dabs import MAP_PROGRAM
 
 
@@ -27,6 +28,7 @@ class MapBuffer:
         self._scratch_bytes = 0
         self._stamp = (None, None)  # (host array, device buffer) of the last stamp
         self._stale = None  # bounding box of host-side edits not yet on the device (see `mark_stale`)
+        self.dab_times = DabTimes()  # which side runs an ``auto`` dab of this map (`map_edit.apply_dab`)
 
     @property
     def row_bytes(self):

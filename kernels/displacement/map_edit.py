@@ -10,6 +10,7 @@ the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the s
 `TesseraError` with the compiler log.
 """
 
+import time
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -17,17 +18,11 @@ import numpy as np
 from ..common.errors import BudgetError, InvalidInputError, TesseraError
 from ..common.opencl_runtime import backend_runtime
 from . import map_dabs as ref
+from .dab_timing import HOST
 from .map_buffer import MapBuffer
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
-#: With a device-resident map and the ``auto`` backend, dabs whose footprint has fewer texels than this run in numpy
-#: on the host. Measured with `bench/brushes.py` on PoCL (2 CPU cores): a device dab costs about 0.25 ms before
-#: its first texel, numpy about 0.02 µs a texel, so numpy wins below ~10k texels and ties around radius 64 (16.6k
-#: texels); the limit sits past the tie, at radius 90, so a stroke never runs slower than numpy.
-NUMPY_MAX_TEXELS = 181 * 181
-
-
 #: Memory per texel of a map being edited: Blender's float RGBA image (16 B), the RGBA mirror written to it
 #: (16 B), the pixels read at creation (16 B), plus per channel the host map and its device copy (8 B).
 MAP_BYTES_PER_TEXEL = 48
@@ -280,9 +275,10 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
 
     ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
     footprint moves; without it the footprint tile is uploaded and read back. With a device, ``backend`` picks
-    per dab: ``"opencl"`` always runs on the device; ``"auto"`` runs footprints of fewer than `NUMPY_MAX_TEXELS`
-    texels in numpy on the host (a launch and read-back cost more than the arithmetic there) and marks them for
-    the device, which gets them before its next operation (`MapBuffer.mark_stale`); ``"numpy"`` always does that.
+    per dab: ``"opencl"`` always runs on the device; ``"auto"`` runs the dab on the side measured faster for its kind
+    and footprint (`dab_timing.DabTimes`, kept by the buffer: small footprints usually on the host, where a launch
+    and read-back cost more than the arithmetic); ``"numpy"`` always runs on the host. A host dab marks its
+    footprint for the device, which gets it before its next operation (`MapBuffer.mark_stale`).
     ``before_write(region)`` is called once every check has passed and before anything is written (undo records
     the region there).
     """
@@ -300,10 +296,13 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     if kind == "SMOOTH":
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
-    on_host = device is not None and (backend == "numpy" or (backend == "auto" and _area(region) < NUMPY_MAX_TEXELS))
+    measured = device is not None and backend == "auto"
+    side = device.dab_times.choose(kind, _area(region)) if measured else None
+    on_host = device is not None and (backend == "numpy" or side == HOST)
     runtime = None if on_host else _backend_runtime(backend, device)
     if before_write is not None:
         before_write(region)
+    start = time.perf_counter()
     if runtime is None:
         tile = dmap[y0:y1, x0:x1].copy()  # scratch: committed only when every value is finite
         with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused by _commit, not warned about
@@ -317,6 +316,8 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
             device.mark_stale(region)
     else:
         _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
+    if measured:
+        device.dab_times.record(kind, _area(region), side, time.perf_counter() - start)
     return region
 
 

@@ -100,7 +100,7 @@ def test_programs_divide_and_take_square_roots_correctly_rounded(opencl, monkeyp
     bufs = [cl.Buffer(opencl.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=x) for x in (a, b)]
     outs = [cl.Buffer(opencl.context, mf.WRITE_ONLY, a.nbytes) for _ in range(2)]
     opencl.program("div_sqrt").k(opencl.queue, a.shape, None, *bufs, *outs)
-    for host, buf in zip((q, r), outs):
+    for host, buf in zip((q, r), outs, strict=True):
         cl.enqueue_copy(opencl.queue, host, buf)
     assert q.tobytes() == (a / b).tobytes()
     assert r.tobytes() == np.sqrt(a).tobytes()
