@@ -13,8 +13,8 @@ starts on the side the prior picks (`PRIOR_HOST_TEXELS`) and tries the other. On
 the class runs the side whose shortest recent time is lower. The slower side is timed again after the faster has run
 for `FIRST_RECHECK` of the slower side's dab times, then for twice as long after each recheck up to `RECHECK`, so a
 verdict from a slow spell is soon revised and a change (a busy machine, a bigger map) is followed at about 1 /
-`RECHECK` of the stroke's time. The shortest time, not the mean, stands for a side: a shared machine's noise only
-ever adds time.
+`RECHECK` of the stroke's time; a verdict changes only for a side `SWITCH_MARGIN` faster. The shortest time, not the
+mean, stands for a side: a shared machine's noise only ever adds time.
 """
 
 import math
@@ -32,8 +32,10 @@ WINDOW = 4
 #: then twice as long at each recheck, up to RECHECK: a verdict from a slow spell (a kernel built for a new
 #: footprint size) is revised within a few dabs, and a steady one costs about 1 / RECHECK of a stroke's time,
 #: however much slower the other side is.
-FIRST_RECHECK = 2
+FIRST_RECHECK = 4
 RECHECK = 64
+#: A verdict changes only for a side this much faster: near ties (both sides within 5 %) do not flip back and forth.
+SWITCH_MARGIN = 0.05
 
 
 def size_class(texels):
@@ -85,8 +87,12 @@ class DabTimes:
             other = DEVICE if prior == HOST else HOST
             tried = len(times.seconds[prior]) <= len(times.seconds[other])
             return self._implied(kind, texels) or (prior if tried else other)
-        fast, slow, t_fast, t_slow = (HOST, DEVICE, t_host, t_device) if t_host <= t_device else \
-            (DEVICE, HOST, t_device, t_host)
+        seconds = {HOST: t_host, DEVICE: t_device}
+        fast = HOST if t_host <= t_device else DEVICE
+        if times.faster not in (None, fast) and seconds[fast] > (1 - SWITCH_MARGIN) * seconds[times.faster]:
+            fast = times.faster  # a near tie keeps the verdict (and its rechecks spaced out)
+        slow = DEVICE if fast == HOST else HOST
+        t_fast, t_slow = seconds[fast], seconds[slow]
         if fast != times.faster:  # a new verdict: recheck it soon, then ever more rarely
             times.faster, times.since_recheck, times.recheck_span = fast, 0, FIRST_RECHECK
         if times.since_recheck * t_fast >= times.recheck_span * t_slow:

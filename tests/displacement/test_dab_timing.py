@@ -7,6 +7,7 @@ from tessera.kernels.displacement.dab_timing import (
     HOST,
     MIN_SAMPLES,
     RECHECK,
+    SWITCH_MARGIN,
     WINDOW,
     DabTimes,
     size_class,
@@ -103,3 +104,17 @@ def test_a_measured_class_implies_the_side_of_classes_beyond_it():
     _run(times, "SMOOTH", 50000, {HOST: 1.0, DEVICE: 2.0}, 2 * MIN_SAMPLES + 1)
     assert _run(times, "SMOOTH", 500, {HOST: 1.0, DEVICE: 2.0}, 3) == [HOST] * 3
     assert _run(times, "DRAW", 500, {HOST: 1.0, DEVICE: 2.0}, 2) == [DEVICE, HOST]  # nothing known of DRAW: trials
+
+
+def test_a_near_tie_keeps_the_verdict():
+    """The device turns out a little faster than the host (within SWITCH_MARGIN): the host keeps the class and its
+    rechecks stay spaced out; clearly faster, and the device takes over."""
+    times = DabTimes(prior_host_texels=1000)
+    _run(times, "DRAW", 500, {HOST: 1.0, DEVICE: 2.0}, 2 * MIN_SAMPLES + 1)
+    assert SWITCH_MARGIN > 0.02
+    close = {HOST: 1.0, DEVICE: 0.98}
+    for seconds in (close[DEVICE],) * WINDOW:
+        times.record("DRAW", 500, DEVICE, seconds)
+    assert _run(times, "DRAW", 500, close, 3 * FIRST_RECHECK).count(HOST) >= 3 * FIRST_RECHECK - 2
+    times.record("DRAW", 500, DEVICE, 0.9)
+    assert times.choose("DRAW", 500) == DEVICE
