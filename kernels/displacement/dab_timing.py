@@ -85,8 +85,8 @@ class DabTimes:
         if t_host == math.inf or t_device == math.inf:  # a side has fewer than MIN_SAMPLES times
             prior = HOST if texels < self.prior_host_texels else DEVICE
             other = DEVICE if prior == HOST else HOST
-            tried = len(times.seconds[prior]) <= len(times.seconds[other])
-            return self._implied(kind, texels) or (prior if tried else other)
+            prior_next = len(times.seconds[prior]) <= len(times.seconds[other])  # trials alternate, prior first
+            return self._implied(kind, texels) or (prior if prior_next else other)
         seconds = {HOST: t_host, DEVICE: t_device}
         fast = HOST if t_host <= t_device else DEVICE
         if times.faster not in (None, fast) and seconds[fast] > (1 - SWITCH_MARGIN) * seconds[times.faster]:
