@@ -18,6 +18,7 @@ mean, stands for a side: a shared machine's noise only ever adds time.
 """
 
 import math
+import weakref
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -108,3 +109,16 @@ class DabTimes:
         recent.append(float(seconds))
         if len(recent) >= MIN_SAMPLES:
             times.best[side] = min(recent)
+
+
+_TILE_TIMES = {}  # id(runtime) -> (weak reference to it, DabTimes)
+
+
+def tile_times(runtime):
+    """The `DabTimes` of dabs on maps without a device copy (each dab uploads its tile) on ``runtime``: one per
+    runtime for the process, since such maps have no `MapBuffer` to keep them."""
+    ref, times = _TILE_TIMES.get(id(runtime), (None, None))
+    if ref is None or ref() is not runtime:
+        times = DabTimes()
+        _TILE_TIMES[id(runtime)] = (weakref.ref(runtime), times)
+    return times

@@ -18,7 +18,7 @@ import numpy as np
 from ..common.errors import BudgetError, InvalidInputError, TesseraError
 from ..common.opencl_runtime import backend_runtime
 from . import map_dabs as ref
-from .dab_timing import HOST
+from .dab_timing import HOST, tile_times
 from .map_buffer import MapBuffer
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
@@ -274,11 +274,11 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     The dab's parameters are a `DabParams` (``dab``) or its fields as keywords.
 
     ``device`` (a `MapBuffer` over ``dmap``) keeps the map on the OpenCL device between dabs, so only the
-    footprint moves; without it the footprint tile is uploaded and read back. With a device, ``backend`` picks
-    per dab: ``"opencl"`` always runs on the device; ``"auto"`` runs the dab on the side measured faster for its kind
-    and footprint (`dab_timing.DabTimes`, kept by the buffer: small footprints usually on the host, where a launch
-    and read-back cost more than the arithmetic); ``"numpy"`` always runs on the host. A host dab marks its
-    footprint for the device, which gets it before its next operation (`MapBuffer.mark_stale`).
+    footprint moves; without it the footprint tile is uploaded and read back. ``backend`` picks per dab:
+    ``"opencl"`` always runs on the device; ``"numpy"`` always on the host; ``"auto"`` on the side measured faster
+    for the dab's kind and footprint (`dab_timing.DabTimes`, kept by the buffer, or per runtime for maps without
+    one: small footprints usually on the host, where a launch and read-back cost more than the arithmetic). A
+    host dab marks its footprint for the device, which gets it before its next operation (`MapBuffer.mark_stale`).
     ``before_write(region)`` is called once every check has passed and before anything is written (undo records
     the region there).
     """
@@ -296,9 +296,9 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     if kind == "SMOOTH":
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
-    measured = device is not None and backend == "auto"
-    side = device.dab_times.choose(kind, _area(region)) if measured else None
-    on_host = device is not None and (backend == "numpy" or side == HOST)
+    times = _dab_times(backend, device)
+    side = times.choose(kind, _area(region)) if times is not None else None
+    on_host = backend == "numpy" or side == HOST
     runtime = None if on_host else _backend_runtime(backend, device)
     if before_write is not None:
         before_write(region)
@@ -312,13 +312,24 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
             else:
                 numpy_fn(tile, x0, y0)
         _commit(dmap, region, tile)
-        if on_host:
+        if device is not None:
             device.mark_stale(region)
     else:
         _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
-    if measured:
-        device.dab_times.record(kind, _area(region), side, time.perf_counter() - start)
+    if times is not None:
+        times.record(kind, _area(region), side, time.perf_counter() - start)
     return region
+
+
+def _dab_times(backend, device):
+    """The `dab_timing.DabTimes` that picks the side of an ``auto`` dab: the device map's, or the runtime's for maps
+    without a device copy; None when nothing is to be picked (another backend, or no OpenCL)."""
+    if backend != "auto":
+        return None
+    if device is not None:
+        return device.dab_times
+    runtime = _runtime(backend)
+    return tile_times(runtime) if runtime is not None else None
 
 
 def _area(region):

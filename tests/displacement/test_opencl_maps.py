@@ -107,6 +107,36 @@ def test_auto_backend_runs_each_dab_where_it_was_measured_faster(opencl, monkeyp
         assert launches.count(kind.lower()) == sides.count((kind, DEVICE)), kind  # device dabs ran the kernel
 
 
+def test_auto_backend_without_a_device_copy_also_runs_where_measured_faster(opencl, monkeypatch):
+    """A map without a `MapBuffer` (each device dab uploads its tile): ``auto`` picks the side by the runtime's
+    `dab_timing.tile_times`; with made-up times that put DRAW on the host, a stroke launches only its trials and
+    rechecks on the device, and the map ends as the reference's bytes."""
+    from tessera.kernels.displacement import dab_timing, map_edit
+    from tessera.kernels.displacement.dab_timing import DEVICE, HOST
+    from tessera.kernels.displacement.map_strokes import Brush, run_stroke
+
+    monkeypatch.setattr(dab_timing, "_TILE_TIMES", {})  # nothing learnt by earlier tests
+    launches = []
+    run = map_edit._run_opencl
+    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args: (launches.append(args[3]), run(*args))[1])
+    times = dab_timing.tile_times(opencl)
+    assert dab_timing.tile_times(opencl) is times  # one per runtime
+    sides = []
+    record = times.record
+    monkeypatch.setattr(times, "record", lambda kind, texels, side, seconds: (
+        sides.append(side), record(kind, texels, side, {HOST: 1e-4, DEVICE: 3e-4}[side])))
+    rng = np.random.default_rng(13)
+    a = rng.normal(size=(60, 80, 1)).astype(np.float32)
+    b = a.copy()
+    brush = Brush(kind="DRAW", radius=6.0, strength=0.3, spacing=0.1)
+    path = np.column_stack([rng.uniform(10, 50, 4), rng.uniform(10, 50, 4), rng.uniform(0.5, 1, 4)])
+    run_stroke(a, brush, path, backend="auto")
+    run_stroke(b, brush, path, backend="numpy")
+    assert a.tobytes() == b.tobytes()
+    assert sides.count(HOST) > 4 * sides.count(DEVICE) > 0
+    assert len(launches) == sides.count(DEVICE)  # the device dabs uploaded their tiles and ran the kernel
+
+
 def test_morphing_kernel_equals_numpy(opencl):
     from tessera.kernels.displacement.map_edit import morph
 
