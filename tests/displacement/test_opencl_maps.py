@@ -111,6 +111,7 @@ def test_auto_backend_without_a_device_copy_also_runs_where_measured_faster(open
     """A map without a `MapBuffer` (each device dab uploads its tile): ``auto`` picks the side by the runtime's
     `dab_timing.tile_times`; with made-up times that put DRAW on the host, a stroke launches only its trials and
     rechecks on the device, and the map ends as the reference's bytes."""
+    from tessera.kernels.common.opencl_runtime import get_runtime
     from tessera.kernels.displacement import dab_timing, map_edit
     from tessera.kernels.displacement.dab_timing import DEVICE, HOST
     from tessera.kernels.displacement.map_strokes import Brush, run_stroke
@@ -119,8 +120,10 @@ def test_auto_backend_without_a_device_copy_also_runs_where_measured_faster(open
     launches = []
     run = map_edit._run_opencl
     monkeypatch.setattr(map_edit, "_run_opencl", lambda *args: (launches.append(args[3]), run(*args))[1])
-    times = dab_timing.tile_times(opencl)
-    assert dab_timing.tile_times(opencl) is times  # one per runtime
+    runtime = get_runtime()  # what apply_dab uses without a device (the session's `opencl` may have been replaced)
+    assert runtime is not None
+    times = dab_timing.tile_times(runtime)
+    assert dab_timing.tile_times(runtime) is times  # one per runtime
     sides = []
     record = times.record
     monkeypatch.setattr(times, "record", lambda kind, texels, side, seconds: (
