@@ -10,24 +10,13 @@ Run: make bench, or TESSERA_OPENCL_DEVICE=<name> .venv/bin/python bench/opencl_p
 """
 
 import json
-import time
 
 import numpy as np
-from _setup import import_path
+from _setup import best_of, import_path
 from bench_meshes import grid
 
 REPEAT = 3
 STRANDS, POINTS, SIDES = 100_000, 32, 8
-
-
-def best_of(fn):
-    """Shortest of REPEAT calls of ``fn`` (seconds) and the last result."""
-    best, result = float("inf"), None
-    for _ in range(REPEAT):
-        t = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, result
 
 
 def row(case, device, seconds, numpy_seconds, diff, **extra):
@@ -45,8 +34,8 @@ def tubes_case(device):
     pts = (walks + rng.uniform(-1, 1, (STRANDS, 1, 3))).reshape(-1, 3)
     lines = Polylines.build(pts, np.arange(0, STRANDS * POINTS + 1, POINTS), radius=0.005)
     settings = TubeSettings(sides=SIDES, caps="NONE", uvs=False)
-    cl, a = best_of(lambda: build_tubes(lines, settings, backend="opencl").positions)
-    ref, b = best_of(lambda: build_tubes(lines, settings, backend="numpy").positions)
+    cl, a = best_of(lambda: build_tubes(lines, settings, backend="opencl").positions, REPEAT)
+    ref, b = best_of(lambda: build_tubes(lines, settings, backend="numpy").positions, REPEAT)
     return row("tubes", device, cl, ref, float(np.abs(a - b).max()), vertices=len(a))
 
 
@@ -56,8 +45,8 @@ def loop_cases(device):
     pos, tris = grid(45)  # 4,050 triangles, on a bumpy height field so no coordinate is trivially exact
     pos[:, 2] = np.sin(0.3 * pos[:, 0]) * np.cos(0.2 * pos[:, 1])
     for level in (4, 5, 6):
-        cl, a = best_of(lambda lv=level: loop_subdivide(pos, tris, lv, backend="opencl"))
-        ref, b = best_of(lambda lv=level: loop_subdivide(pos, tris, lv, backend="numpy"))
+        cl, a = best_of(lambda lv=level: loop_subdivide(pos, tris, lv, backend="opencl"), REPEAT)
+        ref, b = best_of(lambda lv=level: loop_subdivide(pos, tris, lv, backend="numpy"), REPEAT)
         yield row(f"loop_level_{level}", device, cl, ref, float(np.abs(a.positions - b.positions).max()),
                   triangles=len(a.triangles))
 

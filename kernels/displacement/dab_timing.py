@@ -82,18 +82,17 @@ class DabTimes:
     def choose(self, kind, texels):
         """`HOST` or `DEVICE` for the next dab of ``kind`` over a footprint of ``texels`` texels (the host on a tie)."""
         times = self._times(kind, texels)
-        t_host, t_device = times.best[HOST], times.best[DEVICE]
-        if t_host == math.inf or t_device == math.inf:  # a side has fewer than MIN_SAMPLES times
+        best = times.best
+        if math.inf in best.values():  # a side has fewer than MIN_SAMPLES times
             prior = HOST if texels < self.prior_host_texels else DEVICE
             other = DEVICE if prior == HOST else HOST
             prior_next = len(times.seconds[prior]) <= len(times.seconds[other])  # trials alternate, prior first
             return self._implied(kind, texels) or (prior if prior_next else other)
-        seconds = {HOST: t_host, DEVICE: t_device}
-        fast = HOST if t_host <= t_device else DEVICE
-        if times.faster not in (None, fast) and seconds[fast] > (1 - SWITCH_MARGIN) * seconds[times.faster]:
+        fast = HOST if best[HOST] <= best[DEVICE] else DEVICE
+        if times.faster not in (None, fast) and best[fast] > (1 - SWITCH_MARGIN) * best[times.faster]:
             fast = times.faster  # a near tie keeps the verdict (and its rechecks spaced out)
         slow = DEVICE if fast == HOST else HOST
-        t_fast, t_slow = seconds[fast], seconds[slow]
+        t_fast, t_slow = best[fast], best[slow]
         if fast != times.faster:  # a new verdict: recheck it soon, then ever more rarely
             times.faster, times.since_recheck, times.recheck_span = fast, 0, FIRST_RECHECK
         if times.since_recheck * t_fast >= times.recheck_span * t_slow:

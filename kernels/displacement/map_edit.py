@@ -296,8 +296,8 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     if kind == "SMOOTH":
         halo = (max(0, x0 - 1), max(0, y0 - 1), min(dmap.shape[1], x1 + 1), min(dmap.shape[0], y1 + 1))
     _check_finite(dmap, halo or region)
-    times = _dab_times(backend, device)
-    side = times.choose(kind, _area(region)) if times is not None else None
+    times, area = _dab_times(backend, device), _area(region)
+    side = times.choose(kind, area) if times is not None else None
     on_host = backend == "numpy" or side == HOST
     runtime = None if on_host else _backend_runtime(backend, device)
     if before_write is not None:
@@ -317,7 +317,7 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     else:
         _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
     if times is not None:
-        times.record(kind, _area(region), side, time.perf_counter() - start)
+        times.record(kind, area, side, time.perf_counter() - start)
     return region
 
 
