@@ -7,6 +7,8 @@ values, face offsets), so `write_items` checks that layout (the stride and span 
 array in row blocks on the worker threads (numpy releases the GIL while it copies) and reads a sample back through
 RNA; where the layout is not found, or the sample differs, it writes with ``foreach_set``. `item_view` and
 `face_offsets_view` hand out that memory itself, for a kernel to write its output in place (`bridge.PolygonWriter`).
+Large arrays are advised to take transparent huge pages before the first write (`kernels.common.huge_pages`: far
+fewer page faults, where the system offers them).
 For data-blocks the caller has just created only: nothing else may share or cache those arrays.
 """
 
@@ -14,7 +16,7 @@ import ctypes
 
 import numpy as np
 
-from ..kernels.common import workers
+from ..kernels.common import huge_pages, workers
 from . import compat
 
 #: Arrays smaller than this go through ``foreach_set`` (the probe and the threads cost more than they save).
@@ -67,6 +69,7 @@ def _item_array(collection, n, dtype, width):
     if first == 0 or second - first != item or last - first != item * (n - 1):
         return None
     memory = (ctypes.c_char * (item * n)).from_address(first)
+    huge_pages.advise(first, item * n)  # not yet written: 2 MiB pages where the system offers them
     return np.frombuffer(memory, dtype=dtype).reshape(n, width)
 
 

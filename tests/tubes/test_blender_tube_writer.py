@@ -76,6 +76,36 @@ def test_in_place_mesh_equals_the_copied_mesh(clean_scene, addon_module, backend
     assert np.any(~a["smooth"]) == (caps == "FLAT")
 
 
+def test_huge_pages_change_nothing_in_the_mesh(clean_scene, addon_module, monkeypatch):
+    """A tube mesh large enough for huge pages (`kernels.common.huge_pages`), built in place with them asked for, is
+    the bytes of the one built without; where the system offers them, the advice reached Blender's own arrays."""
+    bridge = addon_module("addon.bridge")
+    builder = addon_module("kernels.tubes.builder")
+    huge_pages = addon_module("kernels.common.huge_pages")
+    polylines = addon_module("kernels.tubes.polylines")
+    rng = np.random.default_rng(5)
+    counts = np.full(400, 100)
+    pts = np.cumsum(rng.normal(scale=0.1, size=(counts.sum(), 3)), axis=0)
+    lines = polylines.Polylines.build(pts, np.concatenate(([0], np.cumsum(counts))), radius=0.05)
+    settings = builder.TubeSettings(sides=16, caps="ROUND", uvs=True, point_normals=False)
+    meshes, flags = {}, {}
+    for mode in ("off", "on"):
+        monkeypatch.setenv("TESSERA_HUGE_PAGES", mode)
+        writer = bridge.PolygonWriter(f"tubes_{mode}")
+
+        def allocate(sizes, s, writer=writer, mode=mode):
+            poly = writer.allocate(sizes, s)
+            assert poly.corner_verts.nbytes > 2 * huge_pages.MIN_BYTES
+            flags[mode] = huge_pages.vm_flags(poly.corner_verts.ctypes.data + poly.corner_verts.nbytes // 2)
+            return poly
+
+        meshes[mode] = mesh_arrays(writer.finish(builder.build_tubes(lines, settings, allocate=allocate)))
+    assert meshes["on"].keys() == meshes["off"].keys()
+    for name in meshes["on"]:
+        assert np.array_equal(meshes["on"][name], meshes["off"][name]), name
+    assert "hg" in flags["on"] or not huge_pages.thp_offered("/sys")
+
+
 def test_face_offsets_in_place_are_read_back(clean_scene, bpy_module, addon_module):
     """`mesh_memory.face_offsets_view` is the whole (F + 1) offsets array on every supported Blender: offsets
     written through it are what RNA reads (starts and sizes), and `face_offsets_match` notices a wrong one."""
