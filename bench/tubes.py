@@ -8,6 +8,9 @@ Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M ve
 - ``operator``: ``tessera.tubes`` end to end (read the hair, build straight into the new mesh's memory, make the
   object) against the same modifier evaluation plus copying its mesh into a new object (what applying the modifier
   costs), one run of each in turn; best and median of each (removing the results is not timed).
+- ``operator_huge_pages``: the operator with huge pages asked for and not (``TESSERA_HUGE_PAGES`` on / off,
+  `kernels.common.huge_pages`), interleaved with the same baseline, and what the automatic choice is on this machine
+  (off on a virtual machine that hands free memory back to its host, where fresh huge pages cost host faults).
 - ``mesh_write``: `bridge.write_polygons` of a kernel output already built (the copy into Blender that the
   operator no longer makes: it hands the kernel the new mesh's arrays), against the same baseline.
 - ``operator_first_run``: the first run of each in a fresh process (no freed memory of an earlier run to reuse):
@@ -20,6 +23,7 @@ Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M ve
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tubes.py
 """
 
+import importlib
 import json
 import subprocess
 import sys
@@ -133,6 +137,40 @@ def operator_case(bpy, ob, rounds=2 * REPEAT):
             "baseline_seconds": round(min(theirs), 3), "baseline_median_seconds": round(np.median(theirs), 3),
             "speed_ratio": round(min(theirs) / min(ours), 2),
             "median_speed_ratio": round(np.median(theirs) / np.median(ours), 2)}
+
+
+def huge_pages_case(bpy, ob, rounds=2 * REPEAT):
+    """The operator with huge pages forced on and off against Curve to Mesh + a new object, interleaved: best and
+    median seconds of each, and the automatic choice here. With huge pages on, two runs follow each other: the first
+    ("on_fresh") gets its 2 MiB pages wherever the system has them, the second ("on_recycled") the pages the first
+    just freed, which is where every huge page comes from on a machine that keeps its free memory (on a virtual
+    machine that hands free memory back to its host, fresh ones cost the host a fault per 4 KiB)."""
+    import os
+
+    huge = importlib.import_module(f"{enable_extension()}.kernels.common.huge_pages")
+    times = {"on_fresh": [], "on_recycled": [], "off": [], "baseline": []}
+    before = os.environ.get("TESSERA_HUGE_PAGES")
+    try:
+        for _ in range(rounds):
+            times["baseline"] += geometry_nodes(bpy, ob, copy_mesh=True, repeat=1)[0]
+            for mode, env in (("on_fresh", "on"), ("on_recycled", "on"), ("off", "off")):
+                os.environ["TESSERA_HUGE_PAGES"] = env
+                times[mode].append(operator_run(bpy, ob)[0])
+    finally:
+        os.environ.pop("TESSERA_HUGE_PAGES", None)
+        if before is not None:
+            os.environ["TESSERA_HUGE_PAGES"] = before
+    out = {"case": "operator_huge_pages", "automatic_choice": "on" if huge.auto_choice() else "off",
+           "reports_free_pages": huge.reports_free_pages("/sys"),
+           "baseline": "Curve to Mesh evaluation + copy into a new object, runs interleaved"}
+    base = times.pop("baseline")
+    for mode, seconds in times.items():
+        out[f"{mode}_seconds"] = round(min(seconds), 3)
+        out[f"{mode}_median_seconds"] = round(float(np.median(seconds)), 3)
+        out[f"{mode}_speed_ratio"] = round(min(base) / min(seconds), 2)
+        out[f"{mode}_median_speed_ratio"] = round(float(np.median(base) / np.median(seconds)), 2)
+    out["baseline_seconds"], out["baseline_median_seconds"] = round(min(base), 3), round(float(np.median(base)), 3)
+    return out
 
 
 def write_case(bpy, pts):
@@ -249,6 +287,7 @@ def main():
                           "baseline_vertices": gn_verts, "seconds": round(ours, 3),
                           "baseline_seconds": round(gn_eval, 3), "speed_ratio": round(gn_eval / ours, 2)}))
     print(json.dumps(operator_case(bpy, ob)))
+    print(json.dumps(huge_pages_case(bpy, ob)))
     print(json.dumps(fresh_case()))
     gn_copy = min(geometry_nodes(bpy, ob, copy_mesh=True)[0])
     write, _ = write_case(bpy, pts)

@@ -321,7 +321,8 @@ def lod_sides(lines, settings, camera):
 
 
 def _frames(lines, settings, camera, runtime=None):
-    """`TubeFrames` of prepared lines, chunked for memory; the frames come from OpenCL when ``runtime`` is given."""
+    """`TubeFrames` of prepared lines, chunked for memory; the frames come from OpenCL when ``runtime`` is given (one
+    launch over every curve once the chunks have their arc lengths: it reads the whole arrays in place)."""
     out = TubeFrames.empty(len(lines.points), lines.n_curves)
     for c0, c1 in chunks(lines, 1 << 20):
         sub = take_curves(lines, c0, c1)
@@ -338,10 +339,10 @@ def _frames(lines, settings, camera, runtime=None):
         else:  # read only by UVs and by closed curves' seam twist
             arc, total = np.zeros(len(sub.points)), np.zeros(sub.n_curves)
         out.arc[p0:p1], out.total[c0:c1] = arc, total
-        if runtime is not None:
-            rotation_minimizing_frames_opencl(runtime, sub, arc, total, [out.t[p0:p1], out.n[p0:p1], out.b[p0:p1]])
-        else:
+        if runtime is None:
             out.t[p0:p1], out.n[p0:p1], out.b[p0:p1] = rotation_minimizing_frames(sub)
+    if runtime is not None:
+        rotation_minimizing_frames_opencl(runtime, lines, out.arc, out.total, [out.t, out.n, out.b])
     return out
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..common import workers
 from ..common.errors import InvalidInputError
 
 #: Consecutive points closer than this (relative to the curve set's extent) are duplicates.
@@ -127,10 +128,20 @@ def segment_lengths(lines):
     if len(pts) < 2:
         return seg
     step = 1 << 15  # contiguous differences in blocks that stay in cache; the ends of curves are fixed below
-    for lo in range(0, len(pts) - 1, step):
-        hi = min(len(pts) - 1, lo + step)
-        d = pts[lo + 1 : hi + 1] - pts[lo:hi]
-        np.sqrt(np.einsum("ij,ij->i", d, d), out=seg[lo:hi])
+
+    def blocks(first, last):
+        for lo in range(first, last, step):
+            hi = min(last, lo + step)
+            d = pts[lo + 1 : hi + 1] - pts[lo:hi]
+            np.sqrt(np.einsum("ij,ij->i", d, d), out=seg[lo:hi])
+
+    # the blocks split between the worker threads (numpy lets go of the GIL); each value is computed as before
+    n_seg = len(pts) - 1
+    parts = workers.WORKERS if n_seg >= 4 * step else 1
+    bounds = [n_seg * k // parts // step * step for k in range(parts)] + [n_seg]
+    jobs = [workers.submit(blocks, lo, hi) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True) if hi > lo]
+    for job in jobs:
+        job.result()
     nonempty = lines.counts > 0
     ends = lines.offsets[1:][nonempty] - 1
     starts = lines.offsets[:-1][nonempty]

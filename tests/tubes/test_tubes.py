@@ -7,7 +7,7 @@ from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.tubes.builder import TubeSettings, build_tubes, pixel_world_size, prepare_lines
 from tessera.kernels.tubes.curve_refine import catmull_rom, select_points
 from tessera.kernels.tubes.frames import rotation_minimizing_frames, tangents
-from tessera.kernels.tubes.polylines import Polylines, drop_duplicates
+from tessera.kernels.tubes.polylines import Polylines, drop_duplicates, segment_lengths
 
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
@@ -319,3 +319,19 @@ def test_segment_tables_in_closed_form():
         got = segment_tables(run)
         assert got[0].dtype == got[1].dtype == np.int32
         assert np.array_equal(got[0], seg_of) and np.array_equal(got[1], nxt)
+
+
+@pytest.mark.parametrize("n_points", [5, 3 * (1 << 15) + 7, 9 * (1 << 15) + 3])
+def test_segment_lengths_are_each_segments_own(n_points):
+    """`polylines.segment_lengths`, split in blocks over the worker threads, gives every segment the length computed
+    on its own (the same bytes), a cyclic curve's last point its closing segment and an open curve's last point 0."""
+    rng = np.random.default_rng(n_points)
+    cuts = np.unique(np.concatenate(([0, n_points], rng.integers(1, n_points, max(1, n_points // 40)))))
+    lines = Polylines.build(rng.normal(size=(n_points, 3)), cuts, cyclic=rng.random(len(cuts) - 1) < 0.5)
+    pts = lines.points
+    d = pts[1:] - pts[:-1]
+    want = np.append(np.sqrt(np.einsum("ij,ij->i", d, d)), 0.0)
+    ends, starts = lines.offsets[1:] - 1, lines.offsets[:-1]
+    closing = pts[starts] - pts[ends]
+    want[ends] = np.where(lines.cyclic, np.sqrt(np.einsum("ij,ij->i", closing, closing)), 0.0)
+    assert np.array_equal(segment_lengths(lines), want)
