@@ -25,6 +25,7 @@ Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tube
 
 import importlib
 import json
+import os
 import subprocess
 import sys
 import time
@@ -145,11 +146,9 @@ def huge_pages_case(bpy, ob, rounds=2 * REPEAT):
     ("on_fresh") gets its 2 MiB pages wherever the system has them, the second ("on_recycled") the pages the first
     just freed, which is where every huge page comes from on a machine that keeps its free memory (on a virtual
     machine that hands free memory back to its host, fresh ones cost the host a fault per 4 KiB)."""
-    import os
-
     huge = importlib.import_module(f"{enable_extension()}.kernels.common.huge_pages")
     times = {"on_fresh": [], "on_recycled": [], "off": [], "baseline": []}
-    before = os.environ.get("TESSERA_HUGE_PAGES")
+    before = os.environ.get("TESSERA_HUGE_PAGES", "auto")
     try:
         for _ in range(rounds):
             times["baseline"] += geometry_nodes(bpy, ob, copy_mesh=True, repeat=1)[0]
@@ -157,9 +156,7 @@ def huge_pages_case(bpy, ob, rounds=2 * REPEAT):
                 os.environ["TESSERA_HUGE_PAGES"] = env
                 times[mode].append(operator_run(bpy, ob)[0])
     finally:
-        os.environ.pop("TESSERA_HUGE_PAGES", None)
-        if before is not None:
-            os.environ["TESSERA_HUGE_PAGES"] = before
+        os.environ["TESSERA_HUGE_PAGES"] = before
     out = {"case": "operator_huge_pages", "automatic_choice": "on" if huge.auto_choice() else "off",
            "reports_free_pages": huge.reports_free_pages("/sys"),
            "baseline": "Curve to Mesh evaluation + copy into a new object, runs interleaved"}

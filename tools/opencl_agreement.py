@@ -20,10 +20,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _import_tessera():
-    """The source tree as the package ``tessera``, and the map tests' dab generator importable."""
+    """The source tree as the package ``tessera``, and the tests' dab generator and height field importable."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-agreement-"))
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path[:0] = [str(folder), str(ROOT / "tests" / "displacement")]
+    sys.path[:0] = [str(folder), str(ROOT / "tests" / "displacement"), str(ROOT / "tests" / "terrain")]
 
 
 def ulp_distance(a, b):
@@ -54,13 +54,11 @@ def dab_rows():
 
 
 def ham_row(runtime):
-    from tessera.kernels.terrain import analysis, heightmap_io
+    """(differing, compared, max ulps) of the OpenCL HAM against numpy on the terrain test's height field."""
     from tessera.kernels.terrain import opencl_path as terrain_opencl
+    from test_terrain_maps import random_ham_case
 
-    rng = np.random.default_rng(11)
-    h = (rng.normal(0, 20, (150, 203)).cumsum(axis=1) * 0.1).astype(np.float32)
-    hm = heightmap_io.from_array(h, texel_size=1.5)
-    ref = analysis.ham(hm.heights() * np.float32(1.0 / 1.5))
+    hm, ref = random_ham_case()
     got = terrain_opencl.ham(runtime, hm.heights(), 1.0 / 1.5)
     n, m = ulp_distance(got, ref)
     return [n, ref.size, m]

@@ -152,15 +152,21 @@ def test_out_of_core_raw_map_gives_the_in_memory_table(tmp_path):
         assert np.array_equal(getattr(a, key), getattr(b, key)), key
 
 
+def random_ham_case():
+    """A 150 x 203 random-walk height field, 1.5 world units a texel, and its numpy HAM: (`HeightMap`, (150, 203)
+    float32). Also read by ``tools/opencl_agreement.py``."""
+    rng = np.random.default_rng(11)
+    h = (rng.normal(0, 20, (150, 203)).cumsum(axis=1) * 0.1).astype(np.float32)
+    hm = hio.from_array(h, texel_size=1.5)
+    return hm, ta.ham(hm.heights() * np.float32(1.0 / 1.5))
+
+
 @pytest.mark.opencl
 def test_opencl_ham_and_tile_table_equal_numpy(opencl):
     """The same float32 operations in the same order, contraction off: the device gives the reference's bytes."""
     from tessera.kernels.terrain import opencl_path as terrain_opencl
 
-    rng = np.random.default_rng(11)
-    h = (rng.normal(0, 20, (150, 203)).cumsum(axis=1) * 0.1).astype(np.float32)
-    hm = hio.from_array(h, texel_size=1.5)
-    ref = ta.ham(hm.heights() * np.float32(1.0 / 1.5))
+    hm, ref = random_ham_case()
     got = terrain_opencl.ham(opencl, hm.heights(), 1.0 / 1.5)
     assert got.tobytes() == ref.tobytes()
     a, b = ta.tile_table(hm, 32, backend="numpy"), ta.tile_table(hm, 32, backend="opencl")
