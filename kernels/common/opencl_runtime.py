@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+from .typed_kernel import TypedKernel
 
 log = logging.getLogger(__name__)
 
@@ -85,10 +86,10 @@ class Runtime:
         self.queue.finish()
 
     def kernel(self, program, name, options=()):
-        """A kernel object of a program, created once and reused (kernels are not free to retrieve)."""
+        """A `typed_kernel.TypedKernel` of a program, created once and reused (kernels are not free to retrieve)."""
         key = (program, name, tuple(options))
         if key not in self._kernels:
-            self._kernels[key] = self.cl.Kernel(self.program(program, options), name)
+            self._kernels[key] = TypedKernel(self.cl, self.program(program, options), name)
         return self._kernels[key]
 
 

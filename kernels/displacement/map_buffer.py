@@ -4,13 +4,40 @@
 only its footprint rectangle comes back (`pull`), so a dab costs its footprint, not the map. The host array stays
 the truth after every call; host-side edits (undo, loading a file) go back with `push`. Transfers are
 rectangular copies (`clEnqueueReadBufferRect` and friends), correct on CPU and GPU devices alike.
+
+A stroke may defer the read-back (`defer`): its dabs are queued one after another and their bounding box comes
+back once at the end (`map_edit.flush_deferred`), so a dab costs its launch, not a launch and a wait. Until then
+the device is ahead of the host; `push` and `smooth_all` refuse to run over such edits.
 """
+
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..common.errors import InvalidInputError
+from ..common.errors import InvalidInputError, TesseraError
 from .dab_timing import DabTimes
 from .map_dabs import MAP_PROGRAM
+
+
+@dataclass
+class DeferredDab:
+    """A dab run on the device whose footprint is not read back yet: what `map_edit.apply_dab` needs to run it
+    again (``kind``, ``params`` a `DabParams`), its footprint ``region``, its OpenCL ``kernel`` name and, while it
+    waits for a batched launch (`dab_batch`), its ``row`` of arguments (None once launched)."""
+
+    kind: str
+    params: object
+    region: tuple
+    kernel: str
+    row: tuple | None = None
+
+
+@dataclass
+class DeferredDabs:
+    """The device edits not read back yet: the bounding box ``region`` (x0, y0, x1, y1) and the dabs in order."""
+
+    region: tuple
+    dabs: list = field(default_factory=list)
 
 
 class MapBuffer:
@@ -28,7 +55,11 @@ class MapBuffer:
         self._scratch_bytes = 0
         self._stamp = (None, None)  # (host array, device buffer) of the last stamp
         self._stale = None  # bounding box of host-side edits not yet on the device (see `mark_stale`)
+        self.deferred = None  # `DeferredDabs`: device-side edits not yet on the host (see `defer`)
         self.dab_times = DabTimes()  # which side runs an ``auto`` dab of this map (`map_edit.apply_dab`)
+        # which side runs an ``auto`` stroke (`map_strokes.run_stroke`): on the device its dabs are read back
+        # together, so it is timed as a whole and tried on the device first
+        self.stroke_times = DabTimes(prior_host_texels=0)
 
     @property
     def row_bytes(self):
@@ -60,6 +91,25 @@ class MapBuffer:
         self.host[y0:y1, x0:x1] = tile
         return True
 
+    def defer(self, region, dab):
+        """Note a device-side edit of ``region`` by ``dab`` (a `DeferredDab`) that the host does not have yet."""
+        d = self.deferred
+        if d is None:
+            self.deferred = DeferredDabs(region, [dab])
+            return
+        r = d.region
+        d.region = (min(r[0], region[0]), min(r[1], region[1]), max(r[2], region[2]), max(r[3], region[3]))
+        d.dabs.append(dab)
+
+    def take_deferred(self):
+        """The `DeferredDabs` (or None), forgotten here: the caller reads them back."""
+        d, self.deferred = self.deferred, None
+        return d
+
+    def _check_not_deferred(self, what):
+        if self.deferred is not None:
+            raise TesseraError(f"{what} would overwrite device edits not yet read back (map_edit.flush_deferred)")
+
     def mark_stale(self, region):
         """Note a host-side edit of ``region`` (x0, y0, x1, y1) that the device does not have yet; the next device
         operation copies it over first (`sync`). Many small edits then cost one copy, not one call each."""
@@ -75,6 +125,7 @@ class MapBuffer:
 
     def push(self, region=None):
         """Copy the host rectangle (default: all of it) to the device after a host-side edit."""
+        self._check_not_deferred("Copying the host map to the device")
         h, w = self.host.shape[:2]
         if region is None or region == self._stale:
             self._stale = None
@@ -103,6 +154,7 @@ class MapBuffer:
         """
         cl = self.runtime.cl
         h, w, c = self.host.shape
+        self._check_not_deferred("A whole-map smooth")
         self.sync()
         if self._scratch_bytes != self.host.nbytes:
             self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, self.host.nbytes)

@@ -102,15 +102,38 @@ __kernel void morphing(__global const float *a, __global const float *b, __globa
   }
 }
 
-__kernel void draw(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
-                   const float4 vec)
+inline void draw_texel(__global float *t, const int x, const int y, const int channels, const float2 pos,
+                       const float radius, const float strength, const int kind, const float4 vec)
 {
-  TEXEL_SETUP
   float k;
   if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(vec, c, channels) * k;
     }
+  }
+}
+
+__kernel void draw(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
+                   const float4 vec)
+{
+  TEXEL_SETUP
+  draw_texel(t, x, y, channels, pos, radius, strength, kind, vec);
+}
+
+// Many DRAW dabs in one launch over their bounding box (kernels/displacement/dab_batch.py). The box is cut into
+// bins of `bin` x `bin` texels, `bins_x` to a row; bin b lists the dabs that reach it, in stroke order, at
+// bin_dabs[bin_start[b] .. bin_start[b + 1]). Dab i is p[8i .. 8i + 7] = pos.xy, radius, strength, vec.xyzw with
+// falloff kinds[i]. A texel's value depends on itself alone, so applying its dabs in order gives the bytes of
+// one launch per dab.
+__kernel void draw_batch(TILE_ARGS, __global const float *p, __global const int *kinds,
+                         __global const int *bin_start, __global const int *bin_dabs, const int bin, const int bins_x)
+{
+  TEXEL_SETUP
+  const int b = (gy / bin) * bins_x + gx / bin;
+  for (int j = bin_start[b]; j < bin_start[b + 1]; ++j) {
+    const int i = bin_dabs[j];
+    __global const float *q = p + 8 * (long)i;
+    draw_texel(t, x, y, channels, (float2)(q[0], q[1]), q[2], q[3], kinds[i], (float4)(q[4], q[5], q[6], q[7]));
   }
 }
 

@@ -10,6 +10,8 @@ the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the s
 `TesseraError` with the compiler log.
 """
 
+import itertools
+import math
 import time
 from dataclasses import dataclass, fields
 
@@ -17,9 +19,11 @@ import numpy as np
 
 from ..common.errors import BudgetError, InvalidInputError, TesseraError
 from ..common.opencl_runtime import backend_runtime
+from ..common.typed_kernel import TypedKernel
+from . import dab_batch
 from . import map_dabs as ref
 from .dab_timing import HOST, tile_times
-from .map_buffer import MapBuffer
+from .map_buffer import DeferredDab, MapBuffer
 
 KINDS = ("CONTACT", "FORCE", "TEST", "DRAW", "SMOOTH", "FLATTEN", "STAMP", "NOISE")
 _FALLOFF_ID = {name: i for i, name in enumerate(ref.FALLOFFS)}
@@ -51,7 +55,7 @@ def check_map(dmap):
 
 def _finite(name, value):
     v = np.asarray(value, np.float64)
-    if not np.all(np.isfinite(v)):
+    if not np.isfinite(v).all():
         raise InvalidInputError(f"Dab parameter {name!r} must be finite; got {value!r}")
     return v
 
@@ -59,10 +63,10 @@ def _finite(name, value):
 def footprint(shape, pos, radius):
     """Tile ``(x0, y0, x1, y1)`` (end exclusive) of the texels with distance < radius, clipped; None if empty."""
     h, w = shape[:2]
-    x0 = max(0, int(np.floor(pos[0] - radius)))
-    y0 = max(0, int(np.floor(pos[1] - radius)))
-    x1 = min(w, int(np.ceil(pos[0] + radius)) + 1)
-    y1 = min(h, int(np.ceil(pos[1] + radius)) + 1)
+    x0 = max(0, math.floor(pos[0] - radius))
+    y0 = max(0, math.floor(pos[1] - radius))
+    x1 = min(w, math.ceil(pos[0] + radius) + 1)
+    y1 = min(h, math.ceil(pos[1] + radius) + 1)
     if x1 <= x0 or y1 <= y0 or radius <= 0:
         return None
     return x0, y0, x1, y1
@@ -232,6 +236,12 @@ def plan_dab(dmap, kind, dab):
     return planner(dmap, dab)
 
 
+def dab_texels(dmap, kind, dab):
+    """The number of texels in the footprint of ``dab`` (a `DabParams` of ``kind``) on ``dmap``; 0 off the map."""
+    region = plan_dab(dmap, kind, dab).region
+    return 0 if region is None else _area(region)
+
+
 def _flatten_target(tile, x0, y0, pos, radius):
     """The falloff-free mean of the texels inside the disc, as a float4 (xyz(w) or z for height maps)."""
     h, w, c = tile.shape
@@ -268,7 +278,7 @@ def _backend_runtime(backend, device):
     return device.runtime if device is not None else _runtime(backend)
 
 
-def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=None, **params):
+def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=None, defer=False, **params):
     """Apply one dab in place. Returns the footprint ``(x0, y0, x1, y1)`` or None when it misses the map.
 
     The dab's parameters are a `DabParams` (``dab``) or its fields as keywords.
@@ -281,13 +291,23 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     host dab marks its footprint for the device, which gets it before its next operation (`MapBuffer.mark_stale`).
     ``before_write(region)`` is called once every check has passed and before anything is written (undo records
     the region there).
+
+    ``defer=True`` with ``backend="opencl"`` and ``device`` leaves the dab on the device (`MapBuffer.defer`; a DRAW
+    dab is not even launched yet: `launch_batched` runs such dabs together, `dab_batch`): the caller reads the dabs
+    back with `flush_deferred` (`map_strokes.run_stroke` does, at the end of a stroke, and times the stroke as a
+    whole). A host dab, an undeferred dab and a FLATTEN dab (it reads the map under it) flush earlier deferred
+    dabs first.
     """
     check_map(dmap)
     if device is not None and device.host is not dmap:
         raise InvalidInputError("The device buffer mirrors a different map")
     if dab is not None and params:
         raise InvalidInputError("Give the dab's parameters as a DabParams or as keywords, not both")
-    plan = plan_dab(dmap, kind, dab if dab is not None else DabParams.of(params))
+    dab = dab if dab is not None else DabParams.of(params)
+    defer = defer and backend == "opencl" and device is not None
+    if device is not None and (not defer or kind == "FLATTEN"):
+        flush_deferred(device)
+    plan = plan_dab(dmap, kind, dab)
     region, numpy_fn, cl_name, cl_args = plan.region, plan.reference, plan.kernel, plan.args
     if region is None:
         return None
@@ -299,7 +319,11 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     times, area = _dab_times(backend, device), _area(region)
     side = times.choose(kind, area) if times is not None else None
     on_host = backend == "numpy" or side == HOST
+    if on_host and device is not None:
+        flush_deferred(device)
     runtime = None if on_host else _backend_runtime(backend, device)
+    deferred = defer and runtime is not None
+    batch_row = None
     if before_write is not None:
         before_write(region)
     start = time.perf_counter()
@@ -314,11 +338,43 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
         _commit(dmap, region, tile)
         if device is not None:
             device.mark_stale(region)
+    elif deferred and cl_name in dab_batch.BATCHED:  # launched with the stroke's other such dabs
+        device.sync()  # host edits go over now: while dabs are deferred, the host has nothing the device lacks
+        batch_row = dab_batch.row(cl_name, cl_args)
     else:
-        _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device)
+        if device is not None:
+            launch_batched(device)
+        _run_opencl(runtime, dmap, region, cl_name, cl_args, halo, device, pull=not deferred)
+    if deferred:
+        device.defer(region, DeferredDab(kind, dab, region, cl_name, batch_row))
     if times is not None:
         times.record(kind, area, side, time.perf_counter() - start)
     return region
+
+
+def flush_deferred(device):
+    """Read back the dabs `apply_dab` deferred on ``device`` (a `MapBuffer`): their bounding box when every value
+    there is finite. Otherwise the device is put back as the host has it and the dabs run again one at a time,
+    each read back, so the first that writes NaN or infinities raises `InvalidInputError` with the ones before it
+    applied, as without deferral."""
+    launch_batched(device)
+    batch = device.take_deferred()
+    if batch is None or device.pull_finite(batch.region):
+        return
+    for d in batch.dabs:
+        apply_dab(device.host, d.kind, backend="opencl", device=device, dab=d.params)
+
+
+def launch_batched(device):
+    """Queue the deferred dabs of ``device`` that wait for a batched launch (`dab_batch`), as one launch per run of
+    consecutive dabs of one kernel; they stay deferred (not read back)."""
+    pending = device.deferred
+    waiting = [] if pending is None else [d for d in pending.dabs if d.row is not None]
+    for kernel, run in itertools.groupby(waiting, key=lambda d: d.kernel):
+        run = list(run)
+        dab_batch.launch(device, kernel, [d.row for d in run], [d.region for d in run])
+        for d in run:
+            d.row = None
 
 
 def _dab_times(backend, device):
@@ -374,8 +430,9 @@ def _check_finite(dmap, region):
         raise InvalidInputError("The map has NaN or infinite values under the brush; nothing was changed")
 
 
-def _run_opencl(runtime, dmap, region, name, args, halo, device):
-    """One kernel launch over the footprint, on the device-resident map or on an uploaded tile."""
+def _run_opencl(runtime, dmap, region, name, args, halo, device, pull=True):
+    """One kernel launch over the footprint, on the device-resident map (read back unless ``pull`` is False) or on
+    an uploaded tile."""
     cl = runtime.cl
     mf = cl.mem_flags
     ctx = runtime.context
@@ -404,7 +461,7 @@ def _run_opencl(runtime, dmap, region, name, args, halo, device):
     kernel(runtime.queue, (w, h), None, buf, np.int64(base), np.int32(mem_w), np.int32(channels), np.int32(x0),
            np.int32(y0), np.int32(w), np.int32(h), *extra, *args)
     if device is not None:
-        if not device.pull_finite(region):
+        if pull and not device.pull_finite(region):
             raise InvalidInputError(_NOT_FINITE)
     else:
         cl.enqueue_copy(runtime.queue, tile, buf)
@@ -465,7 +522,7 @@ def compile_custom(runtime, body):
         program = cl.Program(runtime.context, CUSTOM_TEMPLATE % body).build(options=list(runtime.base_options))
     except cl.RuntimeError as err:
         raise TesseraError(f"The custom kernel failed to compile:\n{err}") from err
-    return cl.Kernel(program, "custom")
+    return TypedKernel(cl, program, "custom")
 
 
 def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4, device=None):

@@ -7,12 +7,14 @@ vertical centre line when asked, and records the tiles it touches in a `TileUndo
 step holds only those tiles (memory proportional to the stroke's area), and restores the exact bytes.
 """
 
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..common.errors import InvalidInputError
-from .map_edit import KINDS, DabParams, apply_dab
+from .dab_timing import HOST
+from .map_edit import KINDS, DabParams, apply_dab, dab_texels, flush_deferred
 
 TILE = 64  # undo tile edge (texels)
 
@@ -157,24 +159,42 @@ def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, pro
     With ``spaced=False`` the samples are the dabs themselves (a live stroke that spaced them already).
     ``undo`` (a `TileUndo` of ``dmap``) records every touched tile before it changes. A dab that fails validation
     raises before it writes; earlier dabs of the stroke stay applied (undo restores them).
+
+    On a device map (``device``) the dabs run on the device are read back together when the stroke ends
+    (`map_edit.apply_dab`'s ``defer``; DRAW dabs run as one launch), with the same bytes as dab by dab. There
+    ``auto`` picks one side for the whole stroke: the one whose strokes took less time per dab for this kind and
+    footprint size (`MapBuffer.stroke_times`, a `dab_timing.DabTimes` timing strokes; it tries the device first).
+    A map without a device copy picks per dab (`map_edit.apply_dab`).
     """
     brush.validate()
     dabs = stroke_dabs(samples, brush.spacing * brush.radius) if spaced else np.asarray(samples, np.float64)
     width = dmap.shape[1]
     box = None
-    for i, (x, y, pressure) in enumerate(dabs):
-        dab = dab_params(brush, x, y, pressure)
-        todo = [dab, _mirrored(dab, width)] if brush.mirror_x else [dab]
-        for d in todo:
-            box = union_region(box, _apply(dmap, brush.kind, d, backend, device, undo))
-        if progress is not None and i % 64 == 0:
-            progress((i + 1) / len(dabs))
+    times = device.stroke_times if device is not None and backend == "auto" and len(dabs) else None
+    if times is not None:
+        texels = dab_texels(dmap, brush.kind, dab_params(brush, *dabs[0]))
+        side = times.choose(brush.kind, texels)
+        backend = "numpy" if side == HOST else "opencl"
+        start = time.perf_counter()
+    try:
+        for i, (x, y, pressure) in enumerate(dabs):
+            dab = dab_params(brush, x, y, pressure)
+            todo = [dab, _mirrored(dab, width)] if brush.mirror_x else [dab]
+            for d in todo:
+                box = union_region(box, _apply(dmap, brush.kind, d, backend, device, undo))
+            if progress is not None and i % 64 == 0:
+                progress((i + 1) / len(dabs))
+    finally:  # the dabs applied so far reach the host, whether the stroke ends or a dab is refused
+        if device is not None:
+            flush_deferred(device)
+    if times is not None:
+        times.record(brush.kind, texels, side, (time.perf_counter() - start) / (len(dabs) * (1 + brush.mirror_x)))
     return box
 
 
 def _apply(dmap, kind, dab, backend, device, undo):
     before = None if undo is None else (lambda region: undo.record(dmap, region))
-    return apply_dab(dmap, kind, backend=backend, device=device, before_write=before, dab=dab)
+    return apply_dab(dmap, kind, backend=backend, device=device, before_write=before, dab=dab, defer=True)
 
 
 def union_region(a, b):

@@ -71,40 +71,45 @@ def test_device_resident_map_equals_the_numpy_reference(opencl):
         assert np.allclose(a, b, rtol=0, atol=FLOAT32_PATH_ATOL)
 
 
-def test_auto_backend_runs_each_dab_where_it_was_measured_faster(opencl, monkeypatch):
-    """With a device and ``auto``, each dab runs on the side its kind and footprint were measured faster on
-    (`dab_timing.DabTimes`; here the times are made up: DRAW is faster on the device, SMOOTH on the host). The
-    map ends as the reference's bytes, the device copy equals the host, and the slower side runs only to try it
-    and to recheck it."""
-    from tessera.kernels.displacement import map_edit
+def test_auto_strokes_run_where_they_were_measured_faster(opencl, monkeypatch):
+    """With a device and ``auto``, each stroke runs on the side its kind and footprint were measured faster on per
+    dab (`MapBuffer.stroke_times`; here the times are made up: DRAW is faster on the device, SMOOTH on the host).
+    The map ends as the reference's bytes, the device copy equals the host, the slower side runs only to try it and
+    to recheck it, and a device stroke of DRAW dabs is one launch."""
+    from tessera.kernels.displacement import dab_batch, map_edit
     from tessera.kernels.displacement.dab_timing import DEVICE, HOST
     from tessera.kernels.displacement.map_buffer import MapBuffer
-    from tessera.kernels.displacement.map_strokes import Brush, run_stroke
+    from tessera.kernels.displacement.map_strokes import Brush, run_stroke, stroke_dabs
 
-    launches = []
-    run = map_edit._run_opencl
-    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args: (launches.append(args[3]), run(*args))[1])
+    launches, batches = [], []
+    run, launch = map_edit._run_opencl, dab_batch.launch
+    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args, **kw: (launches.append(args[3]), run(*args, **kw))[1])
+    monkeypatch.setattr(dab_batch, "launch", lambda *args: (batches.append(len(args[2])), launch(*args))[1])
     rng = np.random.default_rng(12)
     a = rng.normal(size=(70, 90, 1)).astype(np.float32)
     b = a.copy()
     device = MapBuffer(opencl, a)
     made_up = {("DRAW", DEVICE): 1e-4, ("DRAW", HOST): 2e-4, ("SMOOTH", DEVICE): 2e-4, ("SMOOTH", HOST): 1e-4}
-    sides = []
-    record = device.dab_times.record
-    monkeypatch.setattr(device.dab_times, "record", lambda kind, texels, side, seconds: (
+    sides, dabs = [], {}
+    record = device.stroke_times.record
+    monkeypatch.setattr(device.stroke_times, "record", lambda kind, texels, side, seconds: (
         sides.append((kind, side)), record(kind, texels, side, made_up[kind, side])))
-    for kind in ("DRAW", "SMOOTH", "DRAW", "SMOOTH"):
-        brush = Brush(kind=kind, radius=9.0, strength=0.3, spacing=0.1)
-        path = np.column_stack([rng.uniform(20, 50, 4), rng.uniform(20, 50, 4), rng.uniform(0.3, 1, 4)])
+    for kind in ("DRAW", "SMOOTH") * 24:
+        brush = Brush(kind=kind, radius=9.0, strength=0.3, spacing=0.3)
+        path = np.column_stack([rng.uniform(20, 50, 2), rng.uniform(20, 50, 2), rng.uniform(0.3, 1, 2)])
         run_stroke(a, brush, path, backend="auto", device=device)
         run_stroke(b, brush, path, backend="numpy")
+        side = sides[-1][1]
+        dabs[kind, side] = dabs.get((kind, side), 0) + len(stroke_dabs(path, brush.spacing * brush.radius))
     assert a.tobytes() == b.tobytes()
     on_device = np.empty_like(a)
     opencl.cl.enqueue_copy(opencl.queue, on_device, device.sync())
     assert on_device.tobytes() == a.tobytes()
     for kind, fast, slow in (("DRAW", DEVICE, HOST), ("SMOOTH", HOST, DEVICE)):
-        assert sides.count((kind, fast)) > 4 * sides.count((kind, slow)) > 0, kind  # the slower: trials, rechecks
-        assert launches.count(kind.lower()) == sides.count((kind, DEVICE)), kind  # device dabs ran the kernel
+        assert sides.count((kind, fast)) > 3 * sides.count((kind, slow)) > 0, kind  # the slower: trials, rechecks
+    assert launches.count("draw") == 0 and len(batches) == sides.count(("DRAW", DEVICE))  # one launch a stroke
+    assert sum(batches) == dabs["DRAW", DEVICE]
+    assert launches.count("smooth") == dabs["SMOOTH", DEVICE] > 0  # SMOOTH: a launch a dab, read back together
 
 
 def test_auto_backend_without_a_device_copy_also_runs_where_measured_faster(opencl, monkeypatch):
@@ -119,7 +124,7 @@ def test_auto_backend_without_a_device_copy_also_runs_where_measured_faster(open
     monkeypatch.setattr(dab_timing, "_TILE_TIMES", {})  # nothing learnt by earlier tests
     launches = []
     run = map_edit._run_opencl
-    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args: (launches.append(args[3]), run(*args))[1])
+    monkeypatch.setattr(map_edit, "_run_opencl", lambda *args, **kw: (launches.append(args[3]), run(*args, **kw))[1])
     runtime = get_runtime()  # what apply_dab uses without a device (the session's `opencl` may have been replaced)
     assert runtime is not None
     times = dab_timing.tile_times(runtime)

@@ -1,0 +1,81 @@
+"""Many dabs of a stroke in one OpenCL launch, on a device-resident map (`map_buffer.MapBuffer`).
+
+A DRAW dab changes each texel from that texel's value alone, so a stroke's DRAW dabs can run as one kernel over
+their bounding box in which every texel applies, in stroke order, the dabs that reach it: the same float
+operations in the same order as one launch per dab, so the same bytes (``map_dabs.cl``'s ``draw_batch`` calls the
+single dab's ``draw_texel``). The box is cut into square bins a quarter of the largest footprint wide (8 to 1024
+texels), and each bin lists the dabs whose footprint overlaps it, so a texel looks at the ten or so dabs near it
+rather than at all of them. One launch replaces a launch per dab: on PoCL a launch costs its arguments and a
+wake-up of the worker threads (~25 µs of the Python thread in a stroke), which is most of a small dab.
+"""
+
+import numpy as np
+
+from .map_dabs import MAP_PROGRAM
+
+#: single-dab kernel -> its batched form
+BATCHED = {"draw": "draw_batch"}
+MIN_BIN, MAX_BIN = 8, 1024
+
+
+def row(kernel, args):
+    """What the batched form of ``kernel`` needs of one dab whose single-dab scalar arguments are ``args`` (as
+    `map_edit.DabPlan.args`): ((8,) float32 pos.xy, radius, strength, vec.xyzw, the falloff id)."""
+    if kernel != "draw":
+        raise ValueError(f"{kernel!r} has no batched form")
+    pos, radius, strength, falloff, vec = args
+    values = np.array([pos["x"], pos["y"], radius, strength, vec["x"], vec["y"], vec["z"], vec["w"]], np.float32)
+    return values, int(falloff)
+
+
+def bin_size(regions):
+    """The bin edge for footprints ``regions`` (n, 4) int64 (x0, y0, x1, y1): a power of two near a quarter of the
+    largest footprint side, clamped to [MIN_BIN, MAX_BIN]."""
+    side = int(max((regions[:, 2] - regions[:, 0]).max(), (regions[:, 3] - regions[:, 1]).max()))
+    return int(np.clip(1 << max(side // 4, 1).bit_length() - 1, MIN_BIN, MAX_BIN))
+
+
+def bins(regions, box, size):
+    """The dabs of each bin, in dab order.
+
+    ``regions`` (n, 4) int64 footprints (x0, y0, x1, y1, end exclusive) inside ``box`` (x0, y0, x1, y1); bins of
+    ``size`` texels, ``bins_x`` to a row from the box's corner. Returns (bin_start (bins + 1,) int32, bin_dabs (m,)
+    int32, bins_x): bin b holds dabs bin_dabs[bin_start[b]:bin_start[b + 1]].
+    """
+    bx0, by0, bx1, by1 = box
+    bins_x, bins_y = -(-(bx1 - bx0) // size), -(-(by1 - by0) // size)
+    tx0, ty0 = (regions[:, 0] - bx0) // size, (regions[:, 1] - by0) // size
+    nx = (regions[:, 2] - 1 - bx0) // size - tx0 + 1
+    ny = (regions[:, 3] - 1 - by0) // size - ty0 + 1
+    counts = nx * ny
+    dab_of = np.repeat(np.arange(len(regions)), counts)
+    k = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)
+    width = nx[dab_of]
+    b = (ty0[dab_of] + k // width) * bins_x + tx0[dab_of] + k % width
+    bin_dabs = dab_of[np.argsort(b, kind="stable")].astype(np.int32)
+    bin_start = np.zeros(bins_x * bins_y + 1, np.int32)
+    np.cumsum(np.bincount(b, minlength=bins_x * bins_y), out=bin_start[1:])
+    return bin_start, bin_dabs, bins_x
+
+
+def launch(device, kernel, rows, regions):
+    """Queue the batched form of ``kernel`` for dabs ``rows`` (from `row`, in stroke order) with footprints
+    ``regions`` on ``device`` (a `MapBuffer`, brought up to date with host edits first). Returns the bounding box;
+    nothing is read back."""
+    rt = device.runtime
+    cl, mf = rt.cl, rt.cl.mem_flags
+    regions = np.asarray(regions, np.int64).reshape(-1, 4)
+    box = (int(regions[:, 0].min()), int(regions[:, 1].min()), int(regions[:, 2].max()), int(regions[:, 3].max()))
+    size = bin_size(regions)
+    bin_start, bin_dabs, bins_x = bins(regions, box, size)
+    values = np.stack([r[0] for r in rows])
+    kinds = np.array([r[1] for r in rows], np.int32)
+    inputs = [cl.Buffer(rt.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
+              for a in (values, kinds, bin_start, bin_dabs)]
+    x0, y0, x1, y1 = box
+    h, w, channels = device.host.shape
+    rt.kernel(MAP_PROGRAM, BATCHED[kernel])(
+        rt.queue, (x1 - x0, y1 - y0), None, device.sync(), np.int64((y0 * w + x0) * channels), np.int32(w),
+        np.int32(channels), np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *inputs,
+        np.int32(size), np.int32(bins_x))
+    return box
