@@ -6,7 +6,9 @@ operations in the same order as one launch per dab, so the same bytes (``map_dab
 single dab's ``draw_texel``). The box is cut into square bins a quarter of the largest footprint wide (8 to 1024
 texels), and each bin lists the dabs whose footprint overlaps it, so a texel looks at the ten or so dabs near it
 rather than at all of them. One launch replaces a launch per dab: on PoCL a launch costs its arguments and a
-wake-up of the worker threads (~25 µs of the Python thread in a stroke), which is most of a small dab.
+wake-up of the worker threads (~25 µs of the Python thread in a stroke), which is most of a small dab; large
+footprints (over `MAX_TEXELS`) keep a launch each. The work-groups are one row of up to 64 texels inside one bin,
+so the texels of a group loop over the same dabs.
 """
 
 import numpy as np
@@ -15,6 +17,11 @@ from .map_dabs import MAP_PROGRAM
 
 #: single-dab kernel -> its batched form
 BATCHED = {"draw": "draw_batch"}
+#: Footprints of more texels run a launch each (still read back with the stroke): the batched kernel does more per
+#: texel and dab (parameters loaded, not arguments), and on two PoCL cores that outweighs the launches saved from
+#: a radius of about 32 (65² texels) on: radius 8 / 16 / 24: 8.9 / 9.6 / 11.2 ms a 200-dab stroke batched against
+#: 14.6 / 15.1 / 14.8 ms a launch each; radius 32: a tie; radius 64 / 256: 17.5 / 55 ms against 13.8 / 35 ms.
+MAX_TEXELS = 64 * 64
 MIN_BIN, MAX_BIN = 8, 1024
 
 
@@ -74,8 +81,10 @@ def launch(device, kernel, rows, regions):
               for a in (values, kinds, bin_start, bin_dabs)]
     x0, y0, x1, y1 = box
     h, w, channels = device.host.shape
+    group = min(size, 64)  # a row of a bin: the group's texels loop over the same dabs
+    gsize = (-(-(x1 - x0) // group) * group, y1 - y0)
     rt.kernel(MAP_PROGRAM, BATCHED[kernel])(
-        rt.queue, (x1 - x0, y1 - y0), None, device.sync(), np.int64((y0 * w + x0) * channels), np.int32(w),
+        rt.queue, gsize, (group, 1), device.sync(), np.int64((y0 * w + x0) * channels), np.int32(w),
         np.int32(channels), np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *inputs,
         np.int32(size), np.int32(bins_x))
     return box

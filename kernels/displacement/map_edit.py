@@ -292,11 +292,11 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     ``before_write(region)`` is called once every check has passed and before anything is written (undo records
     the region there).
 
-    ``defer=True`` with ``backend="opencl"`` and ``device`` leaves the dab on the device (`MapBuffer.defer`; a DRAW
-    dab is not even launched yet: `launch_batched` runs such dabs together, `dab_batch`): the caller reads the dabs
-    back with `flush_deferred` (`map_strokes.run_stroke` does, at the end of a stroke, and times the stroke as a
-    whole). A host dab, an undeferred dab and a FLATTEN dab (it reads the map under it) flush earlier deferred
-    dabs first.
+    ``defer=True`` with ``backend="opencl"`` and ``device`` leaves the dab on the device (`MapBuffer.defer`; a
+    small DRAW dab is not even launched yet: `launch_batched` runs such dabs together, `dab_batch`): the caller
+    reads the dabs back with `flush_deferred` (`map_strokes.run_stroke` does, at the end of a stroke, and times the
+    stroke as a whole). A host dab, an undeferred dab and a FLATTEN dab (it reads the map under it) flush earlier
+    deferred dabs first.
     """
     check_map(dmap)
     if device is not None and device.host is not dmap:
@@ -338,7 +338,7 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
         _commit(dmap, region, tile)
         if device is not None:
             device.mark_stale(region)
-    elif deferred and cl_name in dab_batch.BATCHED:  # launched with the stroke's other such dabs
+    elif deferred and cl_name in dab_batch.BATCHED and area <= dab_batch.MAX_TEXELS:  # launched with the others
         device.sync()  # host edits go over now: while dabs are deferred, the host has nothing the device lacks
         batch_row = dab_batch.row(cl_name, cl_args)
     else:

@@ -48,10 +48,16 @@ def _stroke_pairs(rng, channels):
 
 @pytest.mark.opencl
 @pytest.mark.parametrize("channels", [1, 3, 4])
-def test_a_device_stroke_gives_the_bytes_of_dab_by_dab(opencl, channels):
-    """DRAW strokes (one launch each) and SMOOTH strokes (a launch a dab, read back once) on a device map end as
-    the numpy reference, dab by dab, ends; the device copy equals the host; undo restores the exact bytes."""
+@pytest.mark.parametrize("batch_all", [False, True])
+def test_a_device_stroke_gives_the_bytes_of_dab_by_dab(opencl, channels, batch_all, monkeypatch):
+    """DRAW strokes (small dabs in one launch, or with ``batch_all`` every dab: bins of 8 to 64 texels) and SMOOTH
+    strokes (a launch a dab, read back once) on a device map end as the numpy reference, dab by dab, ends; the
+    device copy equals the host; undo restores the exact bytes."""
+    from tessera.kernels.displacement import dab_batch
     from tessera.kernels.displacement.map_buffer import MapBuffer
+
+    if batch_all:
+        monkeypatch.setattr(dab_batch, "MAX_TEXELS", 10**9)
 
     rng = np.random.default_rng(channels)
     a = rng.normal(size=(150, 170, channels)).astype(np.float32)
