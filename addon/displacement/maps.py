@@ -43,7 +43,7 @@ class MapState:
         self.steps = {}  # serial -> TileUndo of the stroke that produced it
         runtime = get_runtime()
         self.device = MapBuffer(runtime, self.host) if runtime is not None else None
-        self.backend = "auto" if self.device is not None else "numpy"  # with a device: per dab, by footprint
+        self.backend = "auto" if self.device is not None else "numpy"  # with a device: per stroke, by measured time
 
     def to_image(self, image, region=None):
         """Write the map (or the rows/columns of ``region``) into the image pixels and tag its users."""
