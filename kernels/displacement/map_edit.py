@@ -356,20 +356,32 @@ def flush_deferred(device):
     """Read back the dabs `apply_dab` deferred on ``device`` (a `MapBuffer`): their bounding box when every value
     there is finite. Otherwise the device is put back as the host has it and the dabs run again one at a time,
     each read back, so the first that writes NaN or infinities raises `InvalidInputError` with the ones before it
-    applied, as without deferral."""
-    launch_batched(device)
+    applied, as without deferral. If the device fails meanwhile, it is put back as the host has it (the host holds
+    every dab up to the stroke) and the error goes on."""
     batch = device.take_deferred()
-    if batch is None or device.pull_finite(batch.region):
+    if batch is None:
         return
+    try:
+        _launch_waiting(device, batch.dabs)
+        if device.pull_finite(batch.region):
+            return
+    except BaseException:
+        device.push(batch.region)
+        raise
     for d in batch.dabs:
         apply_dab(device.host, d.kind, backend="opencl", device=device, dab=d.params)
 
 
 def launch_batched(device):
-    """Queue the deferred dabs of ``device`` that wait for a batched launch (`dab_batch`), as one launch per run of
-    consecutive dabs of one kernel; they stay deferred (not read back)."""
-    pending = device.deferred
-    waiting = [] if pending is None else [d for d in pending.dabs if d.row is not None]
+    """Queue the deferred dabs of ``device`` that wait for a batched launch (`dab_batch`); they stay deferred (not
+    read back)."""
+    if device.deferred is not None:
+        _launch_waiting(device, device.deferred.dabs)
+
+
+def _launch_waiting(device, dabs):
+    """One batched launch per run of consecutive waiting dabs (`DeferredDab` with a row) of one kernel, in order."""
+    waiting = [d for d in dabs if d.row is not None]
     for kernel, run in itertools.groupby(waiting, key=lambda d: d.kernel):
         run = list(run)
         dab_batch.launch(device, kernel, [d.row for d in run], [d.region for d in run])

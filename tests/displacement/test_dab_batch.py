@@ -134,3 +134,38 @@ def test_host_work_waits_for_deferred_dabs(opencl):
     apply_dab(b, "DRAW", backend="numpy", pos=(30, 30), radius=5, strength=0.5)
     flush_deferred(device)
     assert a.tobytes() == b.tobytes()
+
+
+@pytest.mark.opencl
+@pytest.mark.parametrize("fails", ["batched launch", "read-back"])
+def test_a_device_failure_at_the_stroke_end_leaves_host_and_device_equal(opencl, monkeypatch, fails):
+    """The batched launch or the read-back fails (as a lost device would) when the stroke ends: the error goes on,
+    the host keeps the map as it was before the stroke, the device (SMOOTH dabs already ran there) is put back to
+    it, and the next stroke runs normally."""
+    from tessera.kernels.displacement import dab_batch
+    from tessera.kernels.displacement.map_buffer import MapBuffer
+
+    rng = np.random.default_rng(6)
+    a = rng.normal(size=(60, 70, 1)).astype(np.float32)
+    b, before = a.copy(), a.copy()
+    device = MapBuffer(opencl, a)
+
+    def lost(*args):
+        raise RuntimeError("device lost")
+
+    brush = Brush(kind="DRAW" if fails == "batched launch" else "SMOOTH", radius=6.0, strength=0.5)
+    if fails == "batched launch":
+        monkeypatch.setattr(dab_batch, "launch", lost)
+    else:
+        monkeypatch.setattr(device, "pull_finite", lost)
+    path = [(20, 20, 1.0), (50, 40, 1.0)]
+    with pytest.raises(RuntimeError, match="device lost"):
+        run_stroke(a, brush, path, backend="opencl", device=device)
+    assert a.tobytes() == before.tobytes() and device.deferred is None
+    on_device = np.empty_like(a)
+    opencl.cl.enqueue_copy(opencl.queue, on_device, device.sync())
+    assert on_device.tobytes() == a.tobytes()
+    monkeypatch.undo()
+    run_stroke(a, brush, path, backend="opencl", device=device)
+    run_stroke(b, brush, path, backend="numpy")
+    assert a.tobytes() == b.tobytes()
