@@ -9,6 +9,17 @@ inline double3 ld(__global const double *a, long i) { return (double3)(a[3 * i],
 inline void st(__global float *a, long i, double3 v) { a[3 * i] = (float)v.x; a[3 * i + 1] = (float)v.y; a[3 * i + 2] = (float)v.z; }
 inline double3 unit_or_zero(double3 v) { double l = length(v); return l > 1e-300 ? v / l : (double3)(0.0); }
 
+// the tangent from the unit directions into and out of a point (zero where there is none), as `tangent` forms it
+inline double3 tangent_of(double3 din, double3 dout, int has_next)
+{
+  double3 sum = din + dout;
+  double l = length(sum);
+  if (l < 1e-9) {
+    return has_next ? dout : din;
+  }
+  return sum / l;
+}
+
 inline double3 tangent(__global const double *pts, long s, long e, uchar cyc, long i)
 {
   int has_prev = (i > s) || cyc;
@@ -18,12 +29,7 @@ inline double3 tangent(__global const double *pts, long s, long e, uchar cyc, lo
   double3 p = ld(pts, i);
   double3 din = has_prev ? unit_or_zero(p - ld(pts, ip)) : (double3)(0.0);
   double3 dout = has_next ? unit_or_zero(ld(pts, in) - p) : (double3)(0.0);
-  double3 sum = din + dout;
-  double l = length(sum);
-  if (l < 1e-9) {
-    return has_next ? dout : din;
-  }
-  return sum / l;
+  return tangent_of(din, dout, has_next);
 }
 
 inline double3 perpendicular(double3 t)
@@ -33,16 +39,21 @@ inline double3 perpendicular(double3 t)
   return normalize(axis - dot(axis, t) * t);
 }
 
-// carry frame vector r from (x0, t0) to (x1, t1)
-inline double3 carry(double3 x0, double3 t0, double3 r, double3 x1, double3 t1)
+// carry frame vector r from tangent t0 to t1 across the unit chord a = unit_or_zero(x1 - x0)
+inline double3 carry_along(double3 a, double3 t0, double3 r, double3 t1)
 {
-  double3 a = unit_or_zero(x1 - x0);
   double3 rl = r - 2.0 * dot(a, r) * a;
   double3 tl = t0 - 2.0 * dot(a, t0) * a;
   double3 v2 = t1 - tl;
   double c2 = length(v2);
   double3 b = c2 < 1e-12 ? t1 : v2 / c2;
   return rl - 2.0 * dot(b, rl) * b;
+}
+
+// carry frame vector r from (x0, t0) to (x1, t1)
+inline double3 carry(double3 x0, double3 t0, double3 r, double3 x1, double3 t1)
+{
+  return carry_along(unit_or_zero(x1 - x0), t0, r, t1);
 }
 
 __kernel void tube_frames(__global const double *pts, __global const long *offsets, __global const uchar *cyclic,
@@ -63,10 +74,16 @@ __kernel void tube_frames(__global const double *pts, __global const long *offse
   double3 x = ld(pts, s);
   st(t_out, s, t);
   st(n_out, s, r);
+  // the unit direction of each segment is formed once: it is the direction out of one point, the direction into
+  // the next (both of `tangent`) and the carry's reflection axis, all the same expression of the same two points
+  double3 dout = unit_or_zero(ld(pts, s + 1 < e ? s + 1 : s) - x);
   for (long i = s + 1; i < e; ++i) {
     double3 x1 = ld(pts, i);
-    double3 t1 = tangent(pts, s, e, cyc, i);
-    r = carry(x, t, r, x1, t1);
+    const int has_next = (i < e - 1) || cyc;
+    double3 din = dout;
+    dout = has_next ? unit_or_zero(ld(pts, i < e - 1 ? i + 1 : s) - x1) : (double3)(0.0);
+    double3 t1 = tangent_of(din, dout, has_next);
+    r = carry_along(din, t, r, t1);
     r = normalize(r - dot(r, t1) * t1);
     st(t_out, i, t1);
     st(n_out, i, r);
