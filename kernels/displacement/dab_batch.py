@@ -1,38 +1,52 @@
 """Many dabs of a stroke in one OpenCL launch, on a device-resident map (`map_buffer.MapBuffer`).
 
-A DRAW dab changes each texel from that texel's value alone, so a stroke's DRAW dabs can run as one kernel over
-their bounding box in which every texel applies, in stroke order, the dabs that reach it: the same float
-operations in the same order as one launch per dab, so the same bytes (``map_dabs.cl``'s ``draw_batch`` calls the
-single dab's ``draw_texel``). The box is cut into square bins a quarter of the largest footprint wide (8 to 1024
-texels), and each bin lists the dabs whose footprint overlaps it, so a texel looks at the ten or so dabs near it
-rather than at all of them. One launch replaces a launch per dab: on PoCL a launch costs its arguments and a
-wake-up of the worker threads (~25 µs of the Python thread in a stroke), which is most of a small dab; large
-footprints (over `MAX_TEXELS`) keep a launch each. The work-groups are one row of up to 64 texels inside one bin,
-so the texels of a group loop over the same dabs.
+A DRAW, CONTACT, FORCE or NOISE dab changes each texel from that texel's value alone, so a stroke's dabs of these
+kinds can run as one kernel over their bounding box in which every texel applies, in stroke order, the dabs that
+reach it: the same float operations in the same order as one launch per dab, so the same bytes
+(``map_dabs.cl``'s ``dabs_batch`` calls each single dab's texel function). The box is cut into square bins a
+quarter of the largest footprint wide (8 to 1024 texels), and each bin lists the dabs whose footprint overlaps it,
+so a texel looks at the ten or so dabs near it rather than at all of them. One launch replaces a launch per dab:
+on PoCL a launch costs its arguments and a wake-up of the worker threads (~25 µs of the Python thread in a
+stroke), which is most of a small dab; large footprints (over `MAX_TEXELS`) keep a launch each. The work-groups
+are one row of up to 64 texels inside one bin, so the texels of a group loop over the same dabs.
 """
 
 import numpy as np
 
 from .map_dabs import MAP_PROGRAM
 
-#: single-dab kernel -> its batched form
-BATCHED = {"draw": "draw_batch"}
+#: single-dab kernels with a batched form, and their kind code in ``dabs_batch``
+BATCHED = {"draw": 0, "contact": 1, "force": 2, "noise": 3}
 #: Footprints of more texels run a launch each (still read back with the stroke): the batched kernel does more per
 #: texel and dab (parameters loaded, not arguments), and on two PoCL cores that outweighs the launches saved from
-#: a radius of about 32 (65² texels) on: radius 8 / 16 / 24: 8.9 / 9.6 / 11.2 ms a 200-dab stroke batched against
-#: 14.6 / 15.1 / 14.8 ms a launch each; radius 32: a tie; radius 64 / 256: 17.5 / 55 ms against 13.8 / 35 ms.
+#: a radius of about 32 (65² texels) on: DRAW radius 8 / 16 / 24: 8.9 / 9.6 / 11.2 ms a 200-dab stroke batched
+#: against 14.6 / 15.1 / 14.8 ms a launch each; radius 32: a tie; radius 64 / 256: 17.5 / 55 ms against 13.8 / 35 ms.
 MAX_TEXELS = 64 * 64
 MIN_BIN, MAX_BIN = 8, 1024
+FLOATS, INTS = 12, 3  # per dab in ``dabs_batch``
 
 
 def row(kernel, args):
-    """What the batched form of ``kernel`` needs of one dab whose single-dab scalar arguments are ``args`` (as
-    `map_edit.DabPlan.args`): ((8,) float32 pos.xy, radius, strength, vec.xyzw, the falloff id)."""
-    if kernel != "draw":
-        raise ValueError(f"{kernel!r} has no batched form")
-    pos, radius, strength, falloff, vec = args
-    values = np.array([pos["x"], pos["y"], radius, strength, vec["x"], vec["y"], vec["z"], vec["w"]], np.float32)
-    return values, int(falloff)
+    """What ``dabs_batch`` needs of one dab of ``kernel`` whose single-dab scalar arguments are ``args`` (as
+    `map_edit.DabPlan.args`): ((FLOATS,) float32, (INTS,) int32), the kind code first among the ints, then the
+    kernel's arguments in order (floats and ints apart; NOISE's uint32 seed as its int32 bits)."""
+    floats, ints = np.zeros(FLOATS, np.float32), np.zeros(INTS, np.int32)
+    ints[0] = BATCHED[kernel]
+    pos = args[0]
+    if kernel in ("draw", "noise"):
+        _, radius, strength, falloff, vec = args[:5]
+        values = [pos["x"], pos["y"], radius, strength, vec["x"], vec["y"], vec["z"], vec["w"]]
+        ints[1] = falloff
+        if kernel == "noise":
+            values.append(args[5])  # cell
+            ints[2] = np.uint32(args[6]).view(np.int32)  # seed
+    elif kernel == "contact":
+        values = [pos["x"], pos["y"], args[1], args[2]]  # depth, radius
+    else:  # force
+        f, area = args[1], args[2]
+        values = [pos["x"], pos["y"], f["x"], f["y"], f["z"], f["w"], area]
+    floats[: len(values)] = values
+    return floats, ints
 
 
 def bin_size(regions):
@@ -65,8 +79,8 @@ def bins(regions, box, size):
     return bin_start, bin_dabs, bins_x
 
 
-def launch(device, kernel, rows, regions):
-    """Queue the batched form of ``kernel`` for dabs ``rows`` (from `row`, in stroke order) with footprints
+def launch(device, rows, regions):
+    """Queue ``dabs_batch`` for dabs ``rows`` (from `row`, in stroke order) with footprints
     ``regions`` on ``device`` (a `MapBuffer`, brought up to date with host edits first). Returns the bounding box;
     nothing is read back."""
     rt = device.runtime
@@ -75,15 +89,15 @@ def launch(device, kernel, rows, regions):
     box = (int(regions[:, 0].min()), int(regions[:, 1].min()), int(regions[:, 2].max()), int(regions[:, 3].max()))
     size = bin_size(regions)
     bin_start, bin_dabs, bins_x = bins(regions, box, size)
-    values = np.stack([r[0] for r in rows])
-    kinds = np.array([r[1] for r in rows], np.int32)
+    floats = np.stack([r[0] for r in rows])
+    ints = np.stack([r[1] for r in rows])
     inputs = [cl.Buffer(rt.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
-              for a in (values, kinds, bin_start, bin_dabs)]
+              for a in (floats, ints, bin_start, bin_dabs)]
     x0, y0, x1, y1 = box
     h, w, channels = device.host.shape
     group = min(size, 64)  # a row of a bin: the group's texels loop over the same dabs
     gsize = (-(-(x1 - x0) // group) * group, y1 - y0)
-    rt.kernel(MAP_PROGRAM, BATCHED[kernel])(
+    rt.kernel(MAP_PROGRAM, "dabs_batch")(
         rt.queue, gsize, (group, 1), device.sync(), np.int64((y0 * w + x0) * channels), np.int32(w),
         np.int32(channels), np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *inputs,
         np.int32(size), np.int32(bins_x))

@@ -64,23 +64,36 @@ inline bool brush_weight(const float2 pos, const int x, const int y, const float
   const int x = x0 + gx, y = y0 + gy;                           \
   __global float *t = map + base + ((long)gy * mem_w + gx) * channels;
 
-__kernel void contact(TILE_ARGS, const float2 pos, const float depth, const float radius)
+// Each pointwise dab has its texel's work as an inline function, called by the dab's kernel and by `dabs_batch`.
+inline void contact_texel(__global float *t, const int x, const int y, const int channels, const float2 pos,
+                          const float depth, const float radius)
 {
-  TEXEL_SETUP
   if (texel_distance(pos, x, y) < radius) {
     t[channels == 1 ? 0 : 2] -= depth;
   }
 }
 
-__kernel void force(TILE_ARGS, const float2 pos, const float4 f, const float area)
+__kernel void contact(TILE_ARGS, const float2 pos, const float depth, const float radius)
 {
   TEXEL_SETUP
+  contact_texel(t, x, y, channels, pos, depth, radius);
+}
+
+inline void force_texel(__global float *t, const int x, const int y, const int channels, const float2 pos,
+                        const float4 f, const float area)
+{
   const float dissipation = (area - texel_distance(pos, x, y)) / area;  // = 1 - d / R, exact at the seed's values
   if (dissipation > 0.0f) {
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(f, c, channels) * dissipation;
     }
   }
+}
+
+__kernel void force(TILE_ARGS, const float2 pos, const float4 f, const float area)
+{
+  TEXEL_SETUP
+  force_texel(t, x, y, channels, pos, f, area);
 }
 
 __kernel void test(TILE_ARGS, const float4 arg1, const float4 arg2, const float4 arg3, const float4 arg4)
@@ -120,22 +133,6 @@ __kernel void draw(TILE_ARGS, const float2 pos, const float radius, const float 
   draw_texel(t, x, y, channels, pos, radius, strength, kind, vec);
 }
 
-// Many DRAW dabs in one launch over their bounding box (kernels/displacement/dab_batch.py). The box is cut into
-// bins of `bin` x `bin` texels, `bins_x` to a row; bin b lists the dabs that reach it, in stroke order, at
-// bin_dabs[bin_start[b] .. bin_start[b + 1]). Dab i is p[8i .. 8i + 7] = pos.xy, radius, strength, vec.xyzw with
-// falloff kinds[i]. A texel's value depends on itself alone, so applying its dabs in order gives the bytes of
-// one launch per dab.
-__kernel void draw_batch(TILE_ARGS, __global const float *p, __global const int *kinds,
-                         __global const int *bin_start, __global const int *bin_dabs, const int bin, const int bins_x)
-{
-  TEXEL_SETUP
-  const int b = (gy / bin) * bins_x + gx / bin;
-  for (int j = bin_start[b]; j < bin_start[b + 1]; ++j) {
-    const int i = bin_dabs[j];
-    __global const float *q = p + 8 * (long)i;
-    draw_texel(t, x, y, channels, (float2)(q[0], q[1]), q[2], q[3], kinds[i], (float4)(q[4], q[5], q[6], q[7]));
-  }
-}
 
 __kernel void flatten(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
                       const float4 target)
@@ -215,15 +212,50 @@ inline float value_noise(const int x, const int y, const float cell, const uint 
 }
 
 // noise: add vec * strength * falloff * value_noise (map-anchored, so overlapping dabs agree)
-__kernel void noise(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
-                    const float4 vec, const float cell, const uint seed)
+inline void noise_texel(__global float *t, const int x, const int y, const int channels, const float2 pos,
+                        const float radius, const float strength, const int kind, const float4 vec, const float cell,
+                        const uint seed)
 {
-  TEXEL_SETUP
   float k;
   if (brush_weight(pos, x, y, radius, strength, kind, &k)) {
     const float n = value_noise(x, y, cell, seed);
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(vec, c, channels) * k * n;
+    }
+  }
+}
+
+__kernel void noise(TILE_ARGS, const float2 pos, const float radius, const float strength, const int kind,
+                    const float4 vec, const float cell, const uint seed)
+{
+  TEXEL_SETUP
+  noise_texel(t, x, y, channels, pos, radius, strength, kind, vec, cell, seed);
+}
+
+// Many pointwise dabs (DRAW, CONTACT, FORCE, NOISE) in one launch over their bounding box
+// (kernels/displacement/dab_batch.py). The box is cut into bins of `bin` x `bin` texels, `bins_x` to a row; bin b
+// lists the dabs that reach it, in stroke order, at bin_dabs[bin_start[b] .. bin_start[b + 1]). Dab i has 12 floats
+// p[12i ..] and 3 ints n[3i ..]: n[3i] its kind (0 DRAW, 1 CONTACT, 2 FORCE, 3 NOISE), then that kind's arguments in
+// the order of its kernel (dab_batch.row). A texel's value depends on itself alone, so applying its dabs in order
+// gives the bytes of one launch per dab.
+__kernel void dabs_batch(TILE_ARGS, __global const float *p, __global const int *n, __global const int *bin_start,
+                         __global const int *bin_dabs, const int bin, const int bins_x)
+{
+  TEXEL_SETUP
+  const int b = (gy / bin) * bins_x + gx / bin;
+  for (int j = bin_start[b]; j < bin_start[b + 1]; ++j) {
+    const int i = bin_dabs[j];
+    __global const float *q = p + 12 * (long)i;
+    __global const int *m = n + 3 * (long)i;
+    const float2 pos = (float2)(q[0], q[1]);
+    if (m[0] == 0) {
+      draw_texel(t, x, y, channels, pos, q[2], q[3], m[1], (float4)(q[4], q[5], q[6], q[7]));
+    } else if (m[0] == 1) {
+      contact_texel(t, x, y, channels, pos, q[2], q[3]);
+    } else if (m[0] == 2) {
+      force_texel(t, x, y, channels, pos, (float4)(q[2], q[3], q[4], q[5]), q[6]);
+    } else {
+      noise_texel(t, x, y, channels, pos, q[2], q[3], m[1], (float4)(q[4], q[5], q[6], q[7]), q[8], (uint)m[2]);
     }
   }
 }

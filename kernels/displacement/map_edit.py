@@ -10,7 +10,6 @@ the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the s
 `TesseraError` with the compiler log.
 """
 
-import itertools
 import math
 import time
 from dataclasses import dataclass, fields
@@ -293,10 +292,10 @@ def apply_dab(dmap, kind, backend="auto", device=None, before_write=None, dab=No
     the region there).
 
     ``defer=True`` with ``backend="opencl"`` and ``device`` leaves the dab on the device (`MapBuffer.defer`; a
-    small DRAW dab is not even launched yet: `launch_batched` runs such dabs together, `dab_batch`): the caller
-    reads the dabs back with `flush_deferred` (`map_strokes.run_stroke` does, at the end of a stroke, and times the
-    stroke as a whole). A host dab, an undeferred dab and a FLATTEN dab (it reads the map under it) flush earlier
-    deferred dabs first.
+    small DRAW, CONTACT, FORCE or NOISE dab is not even launched yet: `launch_batched` runs such dabs together,
+    `dab_batch`): the caller reads the dabs back with `flush_deferred` (`map_strokes.run_stroke` does, at the end
+    of a stroke, and times the stroke as a whole). A host dab, an undeferred dab and a FLATTEN dab (it reads the
+    map under it) flush earlier deferred dabs first.
     """
     check_map(dmap)
     if device is not None and device.host is not dmap:
@@ -380,12 +379,11 @@ def launch_batched(device):
 
 
 def _launch_waiting(device, dabs):
-    """One batched launch per run of consecutive waiting dabs (`DeferredDab` with a row) of one kernel, in order."""
+    """One batched launch for the waiting dabs (`DeferredDab` with a row), in order."""
     waiting = [d for d in dabs if d.row is not None]
-    for kernel, run in itertools.groupby(waiting, key=lambda d: d.kernel):
-        run = list(run)
-        dab_batch.launch(device, kernel, [d.row for d in run], [d.region for d in run])
-        for d in run:
+    if waiting:
+        dab_batch.launch(device, [d.row for d in waiting], [d.region for d in waiting])
+        for d in waiting:
             d.row = None
 
 

@@ -39,7 +39,8 @@ def _stroke_pairs(rng, channels):
     for radius, spacing in ((3.0, 0.2), (11.0, 0.1), (40.0, 0.25), (130.0, 0.05)):
         for mirror in (False, True):
             params = {"falloff": str(rng.choice(["SMOOTH", "SPHERE", "LINEAR", "SHARP", "CONSTANT"])),
-                      "vector": tuple(rng.normal(size=4))}
+                      "vector": tuple(rng.normal(size=4)), "cell": float(rng.uniform(0.7, 9)),
+                      "seed": int(rng.integers(0, 2**32))}
             brush = Brush(kind="DRAW", radius=radius, strength=float(rng.uniform(-1, 1)), spacing=spacing,
                           pressure_radius=bool(rng.integers(2)), mirror_x=mirror, params=params)
             path = np.column_stack([rng.uniform(-20, 190, 3), rng.uniform(-20, 170, 3), rng.uniform(0.2, 1, 3)])
@@ -50,9 +51,9 @@ def _stroke_pairs(rng, channels):
 @pytest.mark.parametrize("channels", [1, 3, 4])
 @pytest.mark.parametrize("batch_all", [False, True])
 def test_a_device_stroke_gives_the_bytes_of_dab_by_dab(opencl, channels, batch_all, monkeypatch):
-    """DRAW strokes (small dabs in one launch, or with ``batch_all`` every dab: bins of 8 to 64 texels) and SMOOTH
-    strokes (a launch a dab, read back once) on a device map end as the numpy reference, dab by dab, ends; the
-    device copy equals the host; undo restores the exact bytes."""
+    """DRAW, CONTACT, FORCE and NOISE strokes (small dabs in one launch, or with ``batch_all`` every dab: bins of 8
+    to 64 texels) and SMOOTH strokes (a launch a dab, read back once) on a device map end as the numpy reference,
+    dab by dab, ends; the device copy equals the host; undo restores the exact bytes."""
     from tessera.kernels.displacement import dab_batch
     from tessera.kernels.displacement.map_buffer import MapBuffer
 
@@ -66,7 +67,7 @@ def test_a_device_stroke_gives_the_bytes_of_dab_by_dab(opencl, channels, batch_a
     device = MapBuffer(opencl, a)
     undo = TileUndo(a)
     for brush, path in _stroke_pairs(rng, channels):
-        for kind in ("DRAW", "SMOOTH"):
+        for kind in ("DRAW", "CONTACT", "FORCE", "NOISE", "SMOOTH"):
             brush.kind = kind
             assert run_stroke(a, brush, path, backend="opencl", device=device, undo=undo) == \
                 run_stroke(b, brush, path, backend="numpy")

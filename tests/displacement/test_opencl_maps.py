@@ -84,7 +84,7 @@ def test_auto_strokes_run_where_they_were_measured_faster(opencl, monkeypatch):
     launches, batches = [], []
     run, launch = map_edit._run_opencl, dab_batch.launch
     monkeypatch.setattr(map_edit, "_run_opencl", lambda *args, **kw: (launches.append(args[3]), run(*args, **kw))[1])
-    monkeypatch.setattr(dab_batch, "launch", lambda *args: (batches.append(len(args[2])), launch(*args))[1])
+    monkeypatch.setattr(dab_batch, "launch", lambda *args: (batches.append(len(args[1])), launch(*args))[1])
     rng = np.random.default_rng(12)
     a = rng.normal(size=(70, 90, 1)).astype(np.float32)
     b = a.copy()
