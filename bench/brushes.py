@@ -9,6 +9,8 @@
   and DRAW dabs run as one launch), the device for the whole stroke (``opencl``), the numpy reference, and ``auto``
   on a map without a device copy (each dab on its measured side; a device dab uploads its tile). Target: ``auto``
   >= 1x numpy at every radius.
+- ``stroke_kinds``: the same 200-dab stroke for the other brushes (CONTACT, FORCE, NOISE, FLATTEN, STAMP), the
+  stroke path against the numpy reference.
 - ``operator_stroke``: ``tessera.displacement_stroke`` end to end in Blender (a 200-dab DRAW stroke of radius 64
   replayed from 10 samples on a 4096² height map, its undo step and the image write included; the map's first
   stroke, which reads the image and uploads the map, is left out) against the same stroke through `run_stroke` on
@@ -90,6 +92,31 @@ def stroke_cases(runtime):
                "without_device_speedup": round(out["numpy_ms"] / out["auto_without_device_ms"], 2)}
 
 
+def stroke_kinds_cases(runtime, rounds=6):
+    """The stroke of `stroke_cases` for the other brushes: ``auto`` on a device map against numpy (best of rounds,
+    taken in turn; the first four ``auto`` rounds try both sides)."""
+    size = 4096
+    stamp = np.random.default_rng(0).normal(size=(64, 64, 1)).astype(np.float32)
+    kinds = ("CONTACT", "FORCE", "NOISE", "FLATTEN", "STAMP")
+    for kind, radius in ((kind, radius) for kind in kinds for radius in RADII):
+        brush = Brush(kind=kind, radius=float(radius), strength=0.01, spacing=0.25,
+                      params={"stamp": stamp} if kind == "STAMP" else {})
+        length = 199 * brush.spacing * radius
+        x = (size - min(length, size - 2 * radius - 2)) / 2
+        path = np.column_stack([[x, x + length], [size / 2 - 50, size / 2 + 50], [1.0, 1.0]])
+        maps = {name: np.ones((size, size, 1), np.float32) for name in ("auto", "numpy")}
+        device = MapBuffer(runtime, maps["auto"])
+        best = dict.fromkeys(maps, float("inf"))
+        for _ in range(rounds):
+            for name, m in maps.items():
+                t = time.perf_counter()
+                run_stroke(m, brush, path, backend=name, device=device if name == "auto" else None, undo=TileUndo(m))
+                best[name] = min(best[name], time.perf_counter() - t)
+        yield {"case": "stroke_kinds", "kind": kind, "map": size, "radius": radius, "dabs": 200,
+               "auto_ms": round(best["auto"] * 1e3, 2), "numpy_ms": round(best["numpy"] * 1e3, 2),
+               "baseline": "numpy reference", "speedup": round(best["numpy"] / best["auto"], 2)}
+
+
 def operator_case(rounds=6):
     """The stroke operator against its kernels (see the module docstring); None where bpy is missing."""
     try:
@@ -158,6 +185,8 @@ def main():
     for row in dab_cases(runtime):
         print(json.dumps(row))
     for row in stroke_cases(runtime):
+        print(json.dumps(row))
+    for row in stroke_kinds_cases(runtime):
         print(json.dumps(row))
     print(json.dumps(smooth_case(runtime)))
     row = operator_case()
