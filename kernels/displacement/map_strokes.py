@@ -161,7 +161,8 @@ def run_stroke(dmap, brush, samples, backend="auto", device=None, undo=None, pro
     raises before it writes; earlier dabs of the stroke stay applied (undo restores them).
 
     On a device map (``device``) the dabs run on the device are read back together when the stroke ends
-    (`map_edit.apply_dab`'s ``defer``; DRAW dabs run as one launch), with the same bytes as dab by dab. There
+    (`map_edit.apply_dab`'s ``defer``; small DRAW, CONTACT, FORCE and NOISE dabs run as one launch,
+    `dab_batch`), with the same bytes as dab by dab. There
     ``auto`` picks one side for the whole stroke: the one whose strokes took less time per dab for this kind and
     footprint size (`MapBuffer.stroke_times`, a `dab_timing.DabTimes` timing strokes; it tries the device first).
     A map without a device copy picks per dab (`map_edit.apply_dab`).
