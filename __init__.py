@@ -2,7 +2,7 @@
 
 Registration only: submodules are registered in the order below and unregistered in reverse. `addon.properties`
 registers every capability's settings and the ``tessera`` pointers; panels register in the sidebar's order.
-Nothing is computed or compiled at import or register time.
+Nothing is computed or compiled at import or register time (`addon.opencl_warmup` only schedules its thread).
 """
 
 import importlib
@@ -10,6 +10,7 @@ import importlib
 _modules = (
     "addon.viewport",
     "addon.preferences",
+    "addon.opencl_warmup",
     "addon.properties",
     "addon.displacement.maps",
     "operators.tessellate",

@@ -6,7 +6,9 @@ a platform are present and otherwise warns once and falls back to numpy; ``requi
 is a case-insensitive substring of the wanted device or platform name. Without one, a GPU is preferred.
 
 Programs are read from the ``.cl`` files beside the capability code (``kernels/<capability>/*.cl``, named
-``"<capability>/<file>"``) and built once per context (in-process cache). Every program is built with
+``"<capability>/<file>"``) and built once per context (in-process cache; threads asking for a program being built
+wait for that build). `warm_up` creates the runtime and builds programs ahead of their first use (the add-on does it
+on a background thread once Blender's window is up). Every program is built with
 correctly rounded single-precision division and square root where the device offers them: the numpy
 references round those correctly, and OpenCL's default allows 2.5-3 ulp (NVIDIA's driver uses it). pyopencl's
 binary cache goes to ``TESSERA_CACHE_DIR`` or ``$XDG_CACHE_HOME/tessera``, never a fixed home path.
@@ -14,6 +16,7 @@ binary cache goes to ``TESSERA_CACHE_DIR`` or ``$XDG_CACHE_HOME/tessera``, never
 
 import logging
 import os
+import threading
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,6 +48,8 @@ class Runtime:
     cache_dir: str
     _programs: dict = field(default_factory=dict)
     _kernels: dict = field(default_factory=dict)
+    _building: dict = field(default_factory=dict)  # (name, options) -> lock held while that program builds
+    _lock: object = field(default_factory=threading.Lock)
 
     @property
     def description(self):
@@ -61,14 +66,21 @@ class Runtime:
         """Built program for ``kernels/<name>.cl`` (``name`` like ``"tubes/tube_body"``); raises `TesseraError`
         with the compiler log."""
         key = (name, tuple(options))
-        if key not in self._programs:
-            source = _read_source(name)
-            try:
-                prg = self.cl.Program(self.context, source).build(options=[*self.base_options, *options],
-                                                                  cache_dir=self.cache_dir)
-            except self.cl.RuntimeError as err:
-                raise TesseraError(f"OpenCL program {name}.cl failed to build on {self.description}:\n{err}") from err
-            self._programs[key] = prg
+        prg = self._programs.get(key)
+        if prg is not None:
+            return prg
+        with self._lock:
+            building = self._building.setdefault(key, threading.Lock())
+        with building:  # another thread building the same program: wait for it instead of building it twice
+            if key not in self._programs:
+                source = _read_source(name)
+                try:
+                    prg = self.cl.Program(self.context, source).build(options=[*self.base_options, *options],
+                                                                      cache_dir=self.cache_dir)
+                except self.cl.RuntimeError as err:
+                    raise TesseraError(f"OpenCL program {name}.cl failed to build on {self.description}:\n{err}") \
+                        from err
+                self._programs[key] = prg
         return self._programs[key]
 
     def shared(self, host, read_only=False):
@@ -96,6 +108,9 @@ class Runtime:
 _settings = _Settings()
 _state = {"resolved": False, "runtime": None, "warned": False}
 _sources = {}
+#: held while the runtime is chosen or the settings change, so a runtime made on one thread (`warm_up`) is never
+#: stored after `configure` has reset the choice on another
+_choice = threading.RLock()
 
 
 def _read_source(name):
@@ -111,8 +126,9 @@ def configure(mode=None, device=None, cache_dir=None):
     """Set the mode, device preference and cache folder (None: from the environment); resets the choice."""
     if mode is not None and mode not in MODES:
         raise TesseraError(f"OpenCL mode must be one of {', '.join(MODES)}; got {mode!r}")
-    _settings.mode, _settings.device, _settings.cache_dir = mode, device, cache_dir
-    _state.update(resolved=False, runtime=None, warned=False)
+    with _choice:
+        _settings.mode, _settings.device, _settings.cache_dir = mode, device, cache_dir
+        _state.update(resolved=False, runtime=None, warned=False)
 
 
 def current_mode():
@@ -168,24 +184,56 @@ def get_runtime():
 
     Raises `OpenCLUnavailableError` only in ``require`` mode. The fallback warning is given once.
     """
-    mode = current_mode()
-    if mode == "0":
-        return None
-    if not _state["resolved"]:
+    with _choice:
+        mode = current_mode()
+        if mode == "0":
+            return None
+        if not _state["resolved"]:
+            try:
+                _state["runtime"] = _create()
+                log.info("Tessera OpenCL device: %s", _state["runtime"].description)
+            except OpenCLUnavailableError as err:
+                if mode == "require":
+                    raise
+                _state["runtime"] = None
+                if not _state["warned"]:
+                    _state["warned"] = True
+                    warnings.warn(f"Tessera: OpenCL unavailable, using numpy instead. {err}", RuntimeWarning,
+                                  stacklevel=2)
+            _state["resolved"] = True
+        if _state["runtime"] is None and mode == "require":
+            raise OpenCLUnavailableError("OpenCL is required (TESSERA_OPENCL=require) but unavailable")
+        return _state["runtime"]
+
+
+def program_names():
+    """Every program shipped with the kernels (``"<capability>/<file>"`` for ``kernels/*/*.cl``), sorted."""
+    return sorted(f"{path.parent.name}/{path.stem}" for path in KERNELS_DIR.glob("*/*.cl"))
+
+
+def warm_up(names, stop=None):
+    """Create the runtime and build the programs ``names`` now, so that their first use does not wait for them.
+
+    For a background thread: never raises (an unavailable device or a failing build is logged, and reported again
+    by the first real use). Stops early when ``stop`` (a `threading.Event`) is set or `configure` changes the
+    settings meanwhile. Returns the names built (or found built).
+    """
+    try:
+        runtime = get_runtime()
+    except TesseraError as err:
+        log.info("Tessera OpenCL warm-up skipped: %s", err)
+        return []
+    built = []
+    for name in names if runtime is not None else ():
+        if (stop is not None and stop.is_set()) or _state["runtime"] is not runtime:
+            break
         try:
-            _state["runtime"] = _create()
-            log.info("Tessera OpenCL device: %s", _state["runtime"].description)
-        except OpenCLUnavailableError as err:
-            if mode == "require":
-                raise
-            _state["runtime"] = None
-            if not _state["warned"]:
-                _state["warned"] = True
-                warnings.warn(f"Tessera: OpenCL unavailable, using numpy instead. {err}", RuntimeWarning, stacklevel=2)
-        _state["resolved"] = True
-    if _state["runtime"] is None and mode == "require":
-        raise OpenCLUnavailableError("OpenCL is required (TESSERA_OPENCL=require) but unavailable")
-    return _state["runtime"]
+            runtime.program(name)
+        except TesseraError as err:
+            log.warning("Tessera OpenCL warm-up: %s", err)
+            continue
+        built.append(name)
+    return built
 
 
 BACKENDS = ("auto", "numpy", "opencl")

@@ -104,3 +104,111 @@ def test_programs_divide_and_take_square_roots_correctly_rounded(opencl, monkeyp
         cl.enqueue_copy(opencl.queue, host, buf)
     assert q.tobytes() == (a / b).tobytes()
     assert r.tobytes() == np.sqrt(a).tobytes()
+
+
+def _fake_runtime(build):
+    """A `Runtime` whose pyopencl is a stand-in: building a program calls ``build()``, then returns a new object."""
+    from types import SimpleNamespace
+
+    class Program:
+        def __init__(self, context, source):
+            self.source = source
+
+        def build(self, options, cache_dir):
+            build()
+            return object()
+
+    cl = SimpleNamespace(Program=Program, RuntimeError=RuntimeError,
+                         device_fp_config=SimpleNamespace(CORRECTLY_ROUNDED_DIVIDE_SQRT=1))
+    device = SimpleNamespace(single_fp_config=0, name="fake", platform=SimpleNamespace(name="fake"))
+    return opencl_runtime.Runtime(cl=cl, context=None, queue=None, device=device, cache_dir="")
+
+
+def test_a_program_asked_for_on_two_threads_is_built_once():
+    import threading
+    import time
+
+    builds = []
+    runtime = _fake_runtime(lambda: (builds.append(1), time.sleep(0.2)))
+    got = []
+    threads = [threading.Thread(target=lambda: got.append(runtime.program("tubes/tube_body"))) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(builds) == 1
+    assert got[0] is got[1] is runtime.program("tubes/tube_body")
+
+
+def test_configure_while_another_thread_creates_the_runtime_is_never_undone(monkeypatch):
+    """A runtime made on a warm-up thread while `configure` runs on another is not kept past the reset: the next
+    `get_runtime` makes one with the new settings."""
+    import threading
+    from types import SimpleNamespace
+
+    inside, release, made = threading.Event(), threading.Event(), []
+
+    def slow_create():
+        made.append(SimpleNamespace(description=f"fake {len(made)}"))
+        if len(made) == 1:
+            inside.set()
+            release.wait(5)
+        return made[-1]
+
+    monkeypatch.setattr(opencl_runtime, "_create", slow_create)
+    opencl_runtime.configure(mode="1")
+    try:
+        first = threading.Thread(target=opencl_runtime.get_runtime)
+        first.start()
+        assert inside.wait(5)
+        threading.Timer(0.2, release.set).start()  # configure below waits for the creation, then resets
+        opencl_runtime.configure(mode="1", device="other")
+        first.join()
+        assert opencl_runtime.get_runtime() is made[1]
+        assert len(made) == 2
+    finally:
+        release.set()
+        opencl_runtime.configure()
+
+
+def test_warm_up_builds_what_it_can_and_never_raises(monkeypatch, no_platform):
+    import threading
+
+    opencl_runtime.configure(mode="require")  # no platform: nothing to warm, and no error escapes
+    assert opencl_runtime.warm_up(["tubes/tube_body"]) == []
+
+    built = []
+
+    def build():
+        if len(built) == 0 and not hasattr(build, "failed"):
+            build.failed = True
+            raise RuntimeError("simulated compiler error")
+        built.append(1)
+
+    runtime = _fake_runtime(build)
+    monkeypatch.setattr(opencl_runtime, "_create", lambda: runtime)
+    opencl_runtime.configure(mode="1")
+    names = ["terrain/terrain_ham", "tubes/tube_body", "tubes/tube_frames"]
+    assert opencl_runtime.warm_up(names) == names[1:]  # the failing build is logged and skipped
+    assert {key[0] for key in runtime._programs} == set(names[1:])
+    stop = threading.Event()
+    stop.set()
+    assert opencl_runtime.warm_up(["displacement/map_dabs"], stop) == []
+    assert ("displacement/map_dabs", ()) not in runtime._programs
+
+
+def test_program_names_are_the_shipped_sources():
+    names = opencl_runtime.program_names()
+    assert {"tubes/tube_body", "tubes/tube_frames", "displacement/map_dabs", "terrain/terrain_ham"} <= set(names)
+    assert all((opencl_runtime.KERNELS_DIR / f"{name}.cl").is_file() for name in names)
+
+
+@pytest.mark.opencl
+def test_warm_up_builds_every_shipped_program(opencl):
+    """Every program the kernels ship builds on the device, and after `warm_up` asking for one builds nothing."""
+    names = opencl_runtime.program_names()
+    assert opencl_runtime.warm_up(names) == names
+    runtime = opencl_runtime.get_runtime()
+    built = dict(runtime._programs)
+    assert {(name, ()) for name in names} <= set(built)
+    assert all(runtime.program(name) is built[(name, ())] for name in names)
