@@ -223,8 +223,10 @@ def warm_up(names, stop=None):
     except TesseraError as err:
         log.info("Tessera OpenCL warm-up skipped: %s", err)
         return []
+    if runtime is None:  # OpenCL off or unavailable: nothing to build
+        return []
     built = []
-    for name in names if runtime is not None else ():
+    for name in names:
         if (stop is not None and stop.is_set()) or _state["runtime"] is not runtime:
             break
         try:
