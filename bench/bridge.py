@@ -9,7 +9,6 @@ import time
 
 import numpy as np
 from _setup import import_path
-from bench_meshes import grid
 
 
 def best_of(fn, repeat=3):
@@ -26,6 +25,7 @@ def main():
     import bpy
     from tessera.addon import bridge
     from tessera.kernels.common.mesh_arrays import MeshArrays
+    from tessera.tools.generators import grid
 
     pos, tris = grid(708)  # 1,002,528 triangles
     uv = pos[tris][:, :, :2] / 708.0

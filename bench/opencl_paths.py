@@ -13,7 +13,6 @@ import json
 
 import numpy as np
 from _setup import best_of, import_path
-from bench_meshes import grid
 
 REPEAT = 3
 STRANDS, POINTS, SIDES = 100_000, 32, 8
@@ -41,6 +40,7 @@ def tubes_case(device):
 
 def loop_cases(device):
     from tessera.kernels.subdivision.loop import loop_subdivide
+    from tessera.tools.generators import grid
 
     pos, tris = grid(45)  # 4,050 triangles, on a bumpy height field so no coordinate is trivially exact
     pos[:, 2] = np.sin(0.3 * pos[:, 0]) * np.cos(0.2 * pos[:, 1])

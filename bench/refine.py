@@ -9,7 +9,6 @@ import time
 
 import numpy as np
 from _setup import import_path
-from bench_meshes import grid
 
 REPEAT = 3
 
@@ -19,6 +18,7 @@ def main():
     from tessera.kernels.common.topology import triangle_edges
     from tessera.kernels.tessellation.interpolate import point_values
     from tessera.kernels.tessellation.refine import refine
+    from tessera.tools.generators import grid
 
     pos, tris = grid(224)  # 100,352 triangles
     edges, _, _ = triangle_edges(tris)

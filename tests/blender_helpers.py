@@ -1,4 +1,4 @@
-"""Helpers shared by the blender-tier tests (importable as ``blender_helpers``, like ``meshes``)."""
+"""Helpers shared by the blender-tier tests (importable as ``blender_helpers``, like ``mesh_checks``)."""
 
 import importlib
 

@@ -18,10 +18,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _import_tessera():
-    """The source tree as the package ``tessera``, and the tests' mesh builders as ``meshes``."""
+    """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path[:0] = [str(folder), str(ROOT / "tests")]
+    sys.path.insert(0, str(folder))
 
 
 def _digest(*arrays):
@@ -34,9 +34,9 @@ def _digest(*arrays):
 
 
 def tessellation():
-    from meshes import random_closed
     from tessera.kernels.common.mesh_arrays import MeshArrays
     from tessera.kernels.tessellation.tessellate import tessellate, uniform_levels
+    from tessera.tools.generators import random_closed
 
     v, f = random_closed(3, major=12, minor=8)
     n = v / np.linalg.norm(v, axis=1, keepdims=True)
@@ -86,9 +86,9 @@ def terrain():
 
 
 def subdivision():
-    from meshes import cup, random_irregular_closed
     from tessera.kernels.subdivision.loop import loop_subdivide
     from tessera.kernels.subdivision.loop_topology import coarse_level
+    from tessera.tools.generators import cup, random_irregular_closed
 
     out = []
     for v, f in (random_irregular_closed(3), cup()):

@@ -20,10 +20,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _import_tessera():
-    """The source tree as the package ``tessera``, and the tests' dab generator and height field importable."""
+    """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-agreement-"))
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path[:0] = [str(folder), str(ROOT / "tests" / "displacement"), str(ROOT / "tests" / "terrain")]
+    sys.path.insert(0, str(folder))
 
 
 def ulp_distance(a, b):
@@ -35,15 +35,15 @@ def ulp_distance(a, b):
 
 
 def dab_rows():
-    """Per dab kind: (differing, compared, max ulps) of OpenCL against numpy over the tests' random dabs."""
+    """Per dab kind: (differing, compared, max ulps) of OpenCL against numpy over the shared random dabs."""
     from tessera.kernels.displacement.map_edit import apply_dab
-    from test_opencl_maps import _random_dabs
+    from tessera.tools.generators import random_dabs
 
     rows = {}
     for channels in (1, 3, 4):
         rng = np.random.default_rng(channels)
         base = rng.normal(size=(64, 72, channels)).astype(np.float32)
-        for kind, params in _random_dabs(rng, channels):
+        for kind, params in random_dabs(rng, channels):
             a, b = base.copy(), base.copy()
             apply_dab(a, kind, backend="opencl", **params)
             apply_dab(b, kind, backend="numpy", **params)
@@ -54,9 +54,9 @@ def dab_rows():
 
 
 def ham_row(runtime):
-    """(differing, compared, max ulps) of the OpenCL HAM against numpy on the terrain test's height field."""
+    """(differing, compared, max ulps) of the OpenCL HAM against numpy on the shared random height field."""
     from tessera.kernels.terrain import opencl_path as terrain_opencl
-    from test_terrain_maps import random_ham_case
+    from tessera.tools.generators import random_ham_case
 
     hm, ref = random_ham_case()
     got = terrain_opencl.ham(runtime, hm.heights(), 1.0 / 1.5)

@@ -4,26 +4,11 @@ import numpy as np
 import pytest
 from tessera.kernels.common.errors import TesseraError
 from tessera.kernels.common.tolerances import FLOAT32_PATH_ATOL
+from tessera.tools.generators import random_dabs
 
 pytestmark = pytest.mark.opencl
 
 
-
-
-def _random_dabs(rng, channels):
-    st = rng.normal(size=(7, 11, channels)).astype(np.float32)
-    for _ in range(6):
-        pos = rng.uniform(-5, 70, size=2)
-        vec = rng.normal(size=4)
-        yield "CONTACT", {"pos": pos, "depth": rng.uniform(-1, 1), "radius": rng.uniform(0.5, 20)}
-        yield "FORCE", {"pos": pos, "force": (*rng.normal(size=3), rng.uniform(0.5, 8))}
-        yield "TEST", {"arg1": (*pos, 0, 0), "arg2": vec, "arg3": (rng.uniform(1, 15), 0, 0, 0)}
-        for kind in ("DRAW", "SMOOTH", "FLATTEN", "NOISE"):
-            yield kind, {"pos": pos, "radius": rng.uniform(1, 20), "strength": rng.uniform(-1, 1),
-                         "falloff": rng.choice(["SMOOTH", "SPHERE", "LINEAR", "SHARP", "CONSTANT"]), "vector": vec,
-                         "cell": rng.uniform(0.7, 9), "seed": int(rng.integers(0, 2**32))}
-        yield "STAMP", {"stamp": st, "pos": pos, "angle": rng.uniform(0, 6.3), "scale": rng.uniform(0.5, 3),
-                        "strength": rng.uniform(-1, 1)}
 
 
 @pytest.mark.parametrize("channels", [1, 3, 4])
@@ -32,7 +17,7 @@ def test_map_kernels_equal_the_numpy_reference(opencl, channels):
 
     rng = np.random.default_rng(channels)
     base = rng.normal(size=(64, 72, channels)).astype(np.float32)
-    for kind, params in _random_dabs(rng, channels):
+    for kind, params in random_dabs(rng, channels):
         a, b = base.copy(), base.copy()
         ra = apply_dab(a, kind, backend="opencl", **params)
         rb = apply_dab(b, kind, backend="numpy", **params)
@@ -57,7 +42,7 @@ def test_device_resident_map_equals_the_numpy_reference(opencl):
         a = rng.normal(size=(80, 96, channels)).astype(np.float32)
         b = a.copy()
         device = MapBuffer(opencl, a)
-        for kind, params in _random_dabs(rng, channels):
+        for kind, params in random_dabs(rng, channels):
             assert apply_dab(a, kind, device=device, backend="opencl", **params) == apply_dab(b, kind, backend="numpy",
                                                                                                **params)
         smooth_map(a, 0.7, device=device)

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from meshes import cup, random_irregular_closed
+from tessera.tools.generators import cup, random_irregular_closed
 
 pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 

@@ -5,7 +5,6 @@ import struct
 
 import numpy as np
 import pytest
-from meshes import random_irregular_closed
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.common.normals import face_unit_normals
 from tessera.kernels.subdivision.hce import (
@@ -18,6 +17,7 @@ from tessera.kernels.subdivision.hce import (
     vertex_colours,
 )
 from tessera.kernels.subdivision.loop import loop_subdivide
+from tessera.tools.generators import random_irregular_closed
 
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 

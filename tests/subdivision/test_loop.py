@@ -4,21 +4,21 @@ scheme and trimesh as oracles, creases, boundaries, face-varying data, 1-ring su
 import numpy as np
 import pytest
 from loop_oracles import match_faces, match_vertices, opensubdiv, rel_err
-from meshes import (
+from mesh_checks import is_closed_oriented_manifold
+from tessera.kernels.common.errors import BudgetError, InvalidInputError
+from tessera.kernels.subdivision.loop import estimate, loop_subdivide
+from tessera.kernels.subdivision.loop_rules import correction_factor, correction_table, crease_to_sharpness, loop_beta
+from tessera.kernels.subdivision.loop_topology import coarse_level
+from tessera.tools.generators import (
     bipyramid,
     cup,
     grid,
     icosahedron,
-    is_closed_oriented_manifold,
     octahedron,
     plane_with_hole,
     random_irregular_closed,
     torus,
 )
-from tessera.kernels.common.errors import BudgetError, InvalidInputError
-from tessera.kernels.subdivision.loop import estimate, loop_subdivide
-from tessera.kernels.subdivision.loop_rules import correction_factor, correction_table, crease_to_sharpness, loop_beta
-from tessera.kernels.subdivision.loop_topology import coarse_level
 
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 

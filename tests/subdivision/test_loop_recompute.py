@@ -4,10 +4,10 @@ whatever the order the triangles are taken in."""
 
 import numpy as np
 import pytest
-from meshes import bipyramid, cup, plane_with_hole, random_irregular_closed
 from tessera.kernels.subdivision.loop import loop_subdivide
 from tessera.kernels.subdivision.loop_recompute import Recomputation, one_ring
 from tessera.kernels.subdivision.loop_topology import coarse_level
+from tessera.tools.generators import bipyramid, cup, plane_with_hole, random_irregular_closed
 
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 

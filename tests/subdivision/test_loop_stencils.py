@@ -4,10 +4,10 @@ positions."""
 
 import numpy as np
 import pytest
-from meshes import bipyramid, cup, random_irregular_closed
 from tessera.kernels.subdivision import loop_stencils
 from tessera.kernels.subdivision.loop import loop_subdivide
 from tessera.kernels.subdivision.loop_topology import coarse_level
+from tessera.tools.generators import bipyramid, cup, random_irregular_closed
 
 MESHES = {"irregular": lambda: random_irregular_closed(2), "bipyramid16": lambda: bipyramid(16), "cup": cup}
 

@@ -3,10 +3,18 @@ bit, and the same values within float64 rounding; semi-sharp creases stay on num
 
 import numpy as np
 import pytest
-from meshes import bipyramid, cup, icosahedron, octahedron, plane_with_hole, random_irregular_closed, torus
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.subdivision.loop import loop_subdivide
 from tessera.kernels.subdivision.loop_topology import coarse_level
+from tessera.tools.generators import (
+    bipyramid,
+    cup,
+    icosahedron,
+    octahedron,
+    plane_with_hole,
+    random_irregular_closed,
+    torus,
+)
 
 pytestmark = pytest.mark.opencl
 

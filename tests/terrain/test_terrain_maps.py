@@ -5,6 +5,7 @@ import pytest
 from tessera.kernels.common.errors import InvalidInputError, TesseraError
 from tessera.kernels.terrain import analysis as ta
 from tessera.kernels.terrain import heightmap_io as hio
+from tessera.tools.generators import random_ham_case
 
 
 def _write(path, data, fmt):
@@ -150,15 +151,6 @@ def test_out_of_core_raw_map_gives_the_in_memory_table(tmp_path):
     b = ta.tile_table(in_memory, 32, backend="numpy")
     for key in ("ham_max", "h_min", "h_max", "peak_x", "peak_y"):
         assert np.array_equal(getattr(a, key), getattr(b, key)), key
-
-
-def random_ham_case():
-    """A 150 x 203 random-walk height field, 1.5 world units a texel, and its numpy HAM: (`HeightMap`, (150, 203)
-    float32). Also read by ``tools/opencl_agreement.py``."""
-    rng = np.random.default_rng(11)
-    h = (rng.normal(0, 20, (150, 203)).cumsum(axis=1) * 0.1).astype(np.float32)
-    hm = hio.from_array(h, texel_size=1.5)
-    return hm, ta.ham(hm.heights() * np.float32(1.0 / 1.5))
 
 
 @pytest.mark.opencl

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from meshes import edge_use_counts
+from mesh_checks import edge_use_counts
 
 pytestmark = pytest.mark.blender
 

@@ -95,7 +95,7 @@ def mesh_object(bpy, name, positions, triangles):
 def sharp_mesh(bpy, shape, seed=0):
     """Meshes an artist has: flat-shaded (every edge sharp), smooth with marked sharp edges, random closed meshes
     with random sharp edges and flat faces, and custom normals (where the Normal node reads them)."""
-    from meshes import random_irregular_closed
+    from tessera.tools.generators import random_irregular_closed
 
     rng = np.random.default_rng(seed)
     if shape == "random":

@@ -89,7 +89,7 @@ def test_adaptive_pn_preview_has_no_cracks(gpu_renderer, addon_module):
     """A closed mesh (a torus with random vertex order; a cube with sharp edges, watertight mode), PN with
     adaptive fractional levels, flat white on black from 20 random cameras: no black pixel where the welded CPU
     mesh covers the view (eroded by one pixel, so outline rasterisation does not count)."""
-    from meshes import random_closed
+    from tessera.tools.generators import random_closed
 
     tess = addon_module("kernels.tessellation.tessellate")
     adaptive = addon_module("kernels.tessellation.adaptive")

@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
-from meshes import random_closed
 from tessera.kernels.common.tolerances import FLOAT32_PATH_ATOL, FLOAT32_PATH_RTOL
 from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation import interpolate
 from tessera.kernels.tessellation.refine import refine
+from tessera.tools.generators import random_closed
 
 pytestmark = pytest.mark.opencl
 

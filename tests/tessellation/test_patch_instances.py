@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
-from meshes import random_closed
 from tessera.kernels.common.mesh_arrays import MeshArrays
 from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation import patch_instances as pi
 from tessera.kernels.tessellation.refine import refine
 from tessera.kernels.tessellation.tessellate import SurfaceOptions, surface_inputs
+from tessera.tools.generators import random_closed
 
 
 def _mesh_and_levels(seed, spacing):

@@ -4,11 +4,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from meshes import grid, is_closed_oriented_manifold, octahedron, random_closed, torus
+from mesh_checks import is_closed_oriented_manifold
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation.interpolate import point_values
 from tessera.kernels.tessellation.refine import refine, refinement_counts
+from tessera.tools.generators import grid, octahedron, random_closed, torus
 
 SPACINGS = ["EQUAL", "FRACTIONAL_EVEN"]
 

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from meshes import random_closed, torus
 from tessera.kernels.common.budget import check_budget
 from tessera.kernels.common.errors import BudgetError, InvalidInputError, TesseraError
 from tessera.kernels.common.mesh_arrays import MeshArrays
@@ -11,6 +10,7 @@ from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation.interpolate import corner_values, face_values, point_values
 from tessera.kernels.tessellation.refine import refine
 from tessera.kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
+from tessera.tools.generators import random_closed, torus
 
 
 def mesh_with_attributes(seed=0):

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from meshes import edge_use_counts, is_closed_oriented_manifold, octahedron, random_closed
+from mesh_checks import edge_use_counts, is_closed_oriented_manifold
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.common.mesh_arrays import MeshArrays
@@ -11,6 +11,7 @@ from tessera.kernels.common.topology import triangle_edges
 from tessera.kernels.tessellation import surface_eval
 from tessera.kernels.tessellation.adaptive import METRICS, AdaptiveSettings, adaptive_levels, face_side_edge_levels
 from tessera.kernels.tessellation.tessellate import SurfaceOptions, tessellate, uniform_levels
+from tessera.tools.generators import octahedron, random_closed
 
 
 def sharp_mesh(seed):

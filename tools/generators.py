@@ -1,4 +1,9 @@
-"""Small test meshes built with numpy (no Blender): closed, open, with seams."""
+"""Deterministic inputs shared by the tests, `tools/` and `bench/`: meshes built with numpy (closed, open, with
+seams and holes), random brush dabs and a random height field with its HAM.
+
+Import it as ``tessera.tools.generators`` (the tests, tools and benches all make the source tree importable as the
+package ``tessera``). Nothing here needs Blender.
+"""
 
 import numpy as np
 
@@ -44,21 +49,6 @@ def grid(n=4):
     i = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
     f = np.concatenate([np.stack([i, i + 1, i + n + 2], 1), np.stack([i, i + n + 2, i + n + 1], 1)])
     return v, f.astype(np.int32)
-
-
-def edge_use_counts(triangles):
-    """Undirected edge -> number of triangles using it, as (edges (E, 2), counts (E,))."""
-    t = np.asarray(triangles, np.int64)
-    e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], -1).reshape(-1, 2), axis=1)
-    return np.unique(e, axis=0, return_counts=True)
-
-
-def is_closed_oriented_manifold(triangles):
-    """Every undirected edge used exactly twice, each directed edge once (consistent orientation)."""
-    t = np.asarray(triangles, np.int64)
-    _, counts = edge_use_counts(t)
-    directed = np.stack([t, np.roll(t, -1, axis=1)], -1).reshape(-1, 2)
-    return bool(np.all(counts == 2)) and len(np.unique(directed, axis=0)) == len(directed)
 
 
 def icosahedron():
@@ -135,3 +125,33 @@ def cup(sides=12, rings=4):
     f = np.concatenate([np.stack([p0, p1, q1], -1).reshape(-1, 3), np.stack([p0, q1, q0], -1).reshape(-1, 3)])
     bottom = np.stack([(np.arange(sides) + 1) % sides, np.arange(sides), np.full(sides, len(v) - 1)], 1)
     return np.array(v), np.concatenate([f, bottom]).astype(np.int32)
+
+
+def random_dabs(rng, channels):
+    """Random dabs of every kind of the map kernels over a map of about 64 x 72 texels with ``channels`` channels:
+    yields (kind, keyword arguments of ``kernels.displacement.map_edit.apply_dab``) from ``rng``
+    (a `numpy.random.Generator`); six rounds of the eight kinds, positions partly outside the map."""
+    st = rng.normal(size=(7, 11, channels)).astype(np.float32)
+    for _ in range(6):
+        pos = rng.uniform(-5, 70, size=2)
+        vec = rng.normal(size=4)
+        yield "CONTACT", {"pos": pos, "depth": rng.uniform(-1, 1), "radius": rng.uniform(0.5, 20)}
+        yield "FORCE", {"pos": pos, "force": (*rng.normal(size=3), rng.uniform(0.5, 8))}
+        yield "TEST", {"arg1": (*pos, 0, 0), "arg2": vec, "arg3": (rng.uniform(1, 15), 0, 0, 0)}
+        for kind in ("DRAW", "SMOOTH", "FLATTEN", "NOISE"):
+            yield kind, {"pos": pos, "radius": rng.uniform(1, 20), "strength": rng.uniform(-1, 1),
+                         "falloff": rng.choice(["SMOOTH", "SPHERE", "LINEAR", "SHARP", "CONSTANT"]), "vector": vec,
+                         "cell": rng.uniform(0.7, 9), "seed": int(rng.integers(0, 2**32))}
+        yield "STAMP", {"stamp": st, "pos": pos, "angle": rng.uniform(0, 6.3), "scale": rng.uniform(0.5, 3),
+                        "strength": rng.uniform(-1, 1)}
+
+
+def random_ham_case():
+    """A 150 x 203 random-walk height field, 1.5 world units a texel, and its numpy HAM: (`HeightMap`, (150, 203)
+    float32)."""
+    from ..kernels.terrain import analysis, heightmap_io
+
+    rng = np.random.default_rng(11)
+    h = (rng.normal(0, 20, (150, 203)).cumsum(axis=1) * 0.1).astype(np.float32)
+    hm = heightmap_io.from_array(h, texel_size=1.5)
+    return hm, analysis.ham(hm.heights() * np.float32(1.0 / 1.5))
