@@ -7,6 +7,7 @@ buffer and returns the pixels as numpy; with ``lit=False`` every pixel of the me
 
 import numpy as np
 
+from ..kernels.common.tolerances import FLOAT32_TINY
 from . import loader
 
 
@@ -59,7 +60,7 @@ def triangle_batch(positions, triangles, normals=None):
     corners = np.ascontiguousarray(positions, dtype=np.float32)[tris]  # (T, 3, 3) unshared
     if normals is None:
         flat = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-30)
+        flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), FLOAT32_TINY)
         nor = np.repeat(flat, 3, axis=0).astype(np.float32)
     else:
         normals = np.asarray(normals, np.float32)

@@ -8,6 +8,7 @@ import mathutils
 import numpy as np
 
 from ...kernels.common.errors import TesseraError
+from ...kernels.common.tolerances import FLOAT32_TINY
 
 
 def texel(mesh, poly_index, co, uv_name, size):
@@ -30,7 +31,7 @@ def texel_world_size(ob, mesh, poly_index, uv_name, size):
     uv_area = 0.5 * abs(sum(uv[i].x * uv[i - 1].y - uv[i - 1].x * uv[i].y for i in range(len(uv))))
     scale = ob.matrix_world.to_scale()
     world_area = poly.area * abs(scale.x * scale.y)  # close enough for a cursor
-    return math.sqrt(world_area / max(uv_area * size[0] * size[1], 1e-30))
+    return math.sqrt(world_area / max(uv_area * size[0] * size[1], FLOAT32_TINY))
 
 
 class Hit:

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
+from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
 from ..node_groups import Graph
@@ -77,7 +78,7 @@ def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600, dilat
         r, g, b, a, z, nx, ny, nz = read_channels(view["out"], "impostor view", (
             "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
         rows, cols = slice(j * tile, (j + 1) * tile), slice(i * tile, (i + 1) * tile)
-        alpha = np.maximum(a, 1e-6)[..., None]
+        alpha = np.maximum(a, ALPHA_FLOOR)[..., None]
         colour[rows, cols] = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1)
         normal[rows, cols] = np.stack([nx, ny, nz], -1)
         depth[rows, cols] = np.where(a > 0.5, np.clip(z / size - 0.5, 0, 1), 1.0)
@@ -161,7 +162,7 @@ def card_material(name, colour_image, grid, hemi, blend=True):
                 term = g.vec("SCALE", tex.outputs["Color"], wa)
                 premultiplied = term if premultiplied is None else g.vec("ADD", premultiplied, term)
                 alpha = wa if alpha is None else g.math("ADD", alpha, wa)
-        colour = g.vec("SCALE", premultiplied, g.math("DIVIDE", 1.0, g.math("MAXIMUM", alpha, 1e-6)))
+        colour = g.vec("SCALE", premultiplied, g.math("DIVIDE", 1.0, g.math("MAXIMUM", alpha, ALPHA_FLOOR)))
     emit = g.node("ShaderNodeEmission", [("Color", colour), ("Strength", 1.0)])
     clear = g.node("ShaderNodeBsdfTransparent")
     mix = g.node("ShaderNodeMixShader", [(0, alpha), (1, clear.outputs[0]), (2, emit.outputs[0])])

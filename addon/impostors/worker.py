@@ -20,6 +20,7 @@ import numpy as np
 from ...kernels.common import workers
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
+from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
 
@@ -148,7 +149,7 @@ class BoardJob:
         r, g, b, a, z, nx, ny, nz = read_channels(path, "board render", (
             "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
         present = a > 0.5
-        alpha = np.maximum(a, 1e-6)[..., None]
+        alpha = np.maximum(a, ALPHA_FLOOR)[..., None]
         colours = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1).astype(np.float32)
         d = np.where(present, self.setup.displacement(z), 0.0)
         return BoardImages(self.setup, colours, d, np.stack([nx, ny, nz], -1), present)

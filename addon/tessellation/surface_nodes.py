@@ -20,7 +20,7 @@ tessellate.surface_inputs` does:
     surface follows it; the mesh opens along those edges.
 """
 
-from ...kernels.common.tolerances import SAME_NORMAL_DOT
+from ...kernels.common.tolerances import FLOAT32_TINY, SAME_NORMAL_DOT
 from ..compat import NORMAL_NODE_CORNER_NORMALS, has_set_mesh_normal_node
 from ..node_groups import socket
 
@@ -122,7 +122,7 @@ def _vertex_normal(g):
     angle = g.math("ARCCOSINE", g.math("MINIMUM", g.math("MAXIMUM", cosine, -1.0), 1.0))
     weighted = g.on("CORNER", "FLOAT_VECTOR", g.vec("SCALE", g.named(CORNER_NORMAL, "FLOAT_VECTOR"), angle))
     # normals that cancel: the angle-weighted face normals (Blender's point normal), as the kernel falls back
-    cancelled = g.math("LESS_THAN", g.vec("LENGTH", weighted, out=1), 1e-30)
+    cancelled = g.math("LESS_THAN", g.vec("LENGTH", weighted, out=1), FLOAT32_TINY)
     normal = g.switch("VECTOR", cancelled, g.vec("NORMALIZE", weighted), g.input("GeometryNodeInputNormal"))
     return g.on("POINT", "FLOAT_VECTOR", normal)  # a point value, read from corners too
 

@@ -18,6 +18,7 @@ Corner UVs: u along the curve (arc length fraction), v around (j / Sides), the s
 
 import math
 
+from ...kernels.common.tolerances import FLOAT32_TINY
 from ..compat import set_node_mode
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
@@ -189,7 +190,7 @@ class _Tubes:
         closed = g.math("MULTIPLY", g.input("GeometryNodeInputSplineCyclic"),
                         g.math("GREATER_THAN", length.outputs["Point Count"], 2.5))
         fraction = g.math("DIVIDE", g.node("GeometryNodeSplineParameter").outputs["Length"],
-                          g.math("MAXIMUM", length.outputs["Length"], 1e-30))
+                          g.math("MAXIMUM", length.outputs["Length"], FLOAT32_TINY))
         angle = g.math("ADD", acc.outputs["Leading"], g.math("MULTIPLY", closed, g.math("MULTIPLY", phi, fraction)))
         normal = g.vec("ADD", g.vec("SCALE", f, g.math("COSINE", angle)),
                        g.vec("SCALE", g.vec("CROSS_PRODUCT", t, f), g.math("SINE", angle)))

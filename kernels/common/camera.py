@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InvalidInputError
+from .tolerances import NO_DIRECTION
 
 
 def perspective(fovy, aspect, near, far):
@@ -23,7 +24,7 @@ def look_at_view(eye, target, up=(0.0, 0.0, 1.0)):
     f = target - eye
     f /= np.linalg.norm(f)
     s = np.cross(f, up)
-    if np.linalg.norm(s) < 1e-12:
+    if np.linalg.norm(s) < NO_DIRECTION:
         s = np.cross(f, (0.0, 1.0, 0.0))
     s /= np.linalg.norm(s)
     u = np.cross(s, f)

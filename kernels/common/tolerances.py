@@ -12,3 +12,17 @@ SAME_NORMAL_DOT = 1.0 - 1e-6
 FLAT_FACE_NORMAL_ATOL = 1e-6
 #: Tolerance of the curved-patch identities (linear precision, projections) in float64 tests.
 PATCH_IDENTITY_ATOL = 1e-12
+
+# Guards in the kernels' own arithmetic (not test tolerances): named here so the same meaning has one value.
+
+#: A float64 divisor floor: a length, weight or denominator below this counts as zero, so dividing by
+#: ``max(x, FLOAT64_TINY)`` gives 0 for a zero numerator instead of NaN.
+FLOAT64_TINY = 1e-300
+#: The same floor for float32 arithmetic (geometry-node graphs, GPU read-backs), well above float32's smallest normal.
+FLOAT32_TINY = 1e-30
+#: A float64 vector (or weight) shorter than this has no direction: normalising it would only amplify round-off.
+NO_DIRECTION = 1e-12
+#: Slack for float64 round-off where a computed value should land exactly on a whole number or an interval's end.
+ROUND_OFF_SLACK = 1e-9
+#: Alpha below this counts as transparent where premultiplied colours are divided by their alpha.
+ALPHA_FLOOR = 1e-6

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import ROUND_OFF_SLACK
 from .dab_timing import HOST
 from .map_edit import KINDS, DabParams, apply_dab, dab_texels, flush_deferred
 
@@ -60,7 +61,7 @@ def stroke_dabs(samples, spacing):
         raise InvalidInputError("Stroke pressure must lie in [0, 1]")
     seg = np.hypot(*np.diff(s[:, :2], axis=0).T)
     arc = np.concatenate([[0.0], np.cumsum(seg)])
-    at = np.arange(0.0, arc[-1] + 1e-9, spacing)
+    at = np.arange(0.0, arc[-1] + ROUND_OFF_SLACK, spacing)
     return np.stack([np.interp(at, arc, s[:, i]) for i in range(3)], axis=1)
 
 

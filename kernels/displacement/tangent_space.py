@@ -9,6 +9,7 @@ UV map's orientation, and the offset is strength x ((r - mid) T + (g - mid) B + 
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import NO_DIRECTION
 
 
 def sample_linear(image, uv):
@@ -59,7 +60,7 @@ def tangent_frames(normals, tangents, signs):
     t = np.asarray(tangents, np.float64)
     t = t - n * np.sum(n * t, axis=1, keepdims=True)
     length = np.linalg.norm(t, axis=1, keepdims=True)
-    if np.any(length < 1e-12):
+    if np.any(length < NO_DIRECTION):
         raise InvalidInputError("a tangent is parallel to its normal (degenerate UVs)")
     t = t / length
     return t, np.asarray(signs, np.float64)[:, None] * np.cross(n, t)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import FLOAT64_TINY
 
 #: |1 + k3 d| below this: the ray from C_d is parallel to the source plane (no pre-warped position).
 PARALLEL_EPS = 1e-12
@@ -55,7 +56,7 @@ def prewarp_constants(frame, eye):
     a, b, f = (np.asarray(x, np.float64) for x in (frame.a, frame.b, frame.f))
     c = np.asarray(frame.origin, np.float64) - np.asarray(eye, np.float64)
     den = (np.dot(a, np.cross(b, c)), np.dot(b, np.cross(c, a)), np.dot(c, np.cross(a, b)))
-    if min(abs(x) for x in den) < 1e-300:
+    if min(abs(x) for x in den) < FLOAT64_TINY:
         raise InvalidInputError("The destination centre of projection lies in the source plane: no pre-warp")
     return (np.dot(f, np.cross(b, c)) / den[0], np.dot(f, np.cross(c, a)) / den[1], np.dot(f, np.cross(a, b)) / den[2])
 

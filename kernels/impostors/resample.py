@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import NO_DIRECTION
 from .prewarp import ReliefFrame
 
 
@@ -56,11 +57,12 @@ def resample_board(setup, colours, displacement, normals, present, resolution):
     out_present = coverage >= 0.5
     out_alpha = box_mean(alpha, resolution)
     premultiplied = box_mean(colours[..., :3] * alpha[..., None], resolution)
-    out_colours = np.concatenate([premultiplied / np.maximum(out_alpha, 1e-12)[..., None], out_alpha[..., None]], -1)
-    weight = np.maximum(coverage, 1e-12)
+    out_colours = np.concatenate([premultiplied / np.maximum(out_alpha, NO_DIRECTION)[..., None],
+                                  out_alpha[..., None]], -1)
+    weight = np.maximum(coverage, NO_DIRECTION)
     out_d = np.where(out_present, box_mean(displacement * mask, resolution) / weight, 0.0)
     out_n = box_mean(normals * mask[..., None], resolution)
-    out_n /= np.maximum(np.linalg.norm(out_n, axis=-1, keepdims=True), 1e-12)
+    out_n /= np.maximum(np.linalg.norm(out_n, axis=-1, keepdims=True), NO_DIRECTION)
     scale = n / resolution
     frame = setup.frame
     new_setup = replace(setup, frame=ReliefFrame(frame.origin, frame.a * scale, frame.b * scale, frame.f),

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import ROUND_OFF_SLACK
 
 
 def sprite_resolution(res_screen, size, distance, fov, rounding="CEIL"):
@@ -30,7 +31,7 @@ def sprite_resolution(res_screen, size, distance, fov, rounding="CEIL"):
     if not (distance > 0 and size > 0 and 0 < fov < np.pi and res_screen > 0):
         raise InvalidInputError("Sprite resolution needs a positive size, distance and resolution, 0 < FOV < 180°")
     res = res_screen * size / (2.0 * distance * np.tan(fov / 2.0))
-    n = int(np.ceil(res - 1e-9))
+    n = int(np.ceil(res - ROUND_OFF_SLACK))
     if rounding == "POW2":
         return int(2 ** int(np.ceil(np.log2(max(n, 1)))))
     if rounding != "CEIL":

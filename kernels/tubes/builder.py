@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..common.errors import EmptyResultError, InvalidInputError
+from ..common.tolerances import FLOAT64_TINY
 from .caps import CapEnds, cap_pieces, cap_sizes
 from .curve_refine import catmull_rom, select_points
 from .frames import rotation_minimizing_frames, rotation_minimizing_frames_opencl
@@ -418,7 +419,7 @@ def _segment_u(frames, curves, run):
     """UV u at both ends of every segment: (S,) float32 each (a closing segment ends at u = 1)."""
     arc = frames.arc[run.pick]
     total = frames.total[curves][run.curve_of_point]
-    u = arc / np.maximum(total, 1e-300)
+    u = arc / np.maximum(total, FLOAT64_TINY)
     return u[run.seg].astype(np.float32), np.where(run.closing, 1.0, u[run.nxt]).astype(np.float32)
 
 

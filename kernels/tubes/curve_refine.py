@@ -9,6 +9,7 @@ points however many the input had.
 import numpy as np
 
 from ..common.errors import InvalidInputError
+from ..common.tolerances import FLOAT64_TINY
 from .polylines import Polylines, next_index
 
 CATMULL_ROM = ("UNIFORM", "CENTRIPETAL")
@@ -43,7 +44,7 @@ def catmull_rom(lines, subdivisions, kind="CENTRIPETAL"):
 
     # Barry-Goldman pyramid with knots t0=0, t1, t2, t3 from chord lengths ** alpha
     def knot(a, b):
-        return np.maximum(np.linalg.norm(b - a, axis=1), 1e-300) ** alpha
+        return np.maximum(np.linalg.norm(b - a, axis=1), FLOAT64_TINY) ** alpha
 
     k1 = knot(p0, p1)
     k2 = k1 + knot(p1, p2)
@@ -97,7 +98,7 @@ def turning_angles(lines):
     has_next = nxt >= 0
     d = np.zeros_like(pts)
     d[has_next] = pts[nxt[has_next]] - pts[has_next]
-    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), FLOAT64_TINY)
     prev = np.full(len(pts), -1, np.int64)
     prev[nxt[has_next]] = np.nonzero(has_next)[0]
     ok = (prev >= 0) & has_next
@@ -118,7 +119,7 @@ def select_points(lines, angle, radius_change=0.05):
         return lines
     curve = lines.curve_of_point()
     turn = turning_angles(lines)
-    scale = np.maximum(lines.radius, 1e-300)
+    scale = np.maximum(lines.radius, FLOAT64_TINY)
     nxt = next_index(lines)
     dr = np.zeros(len(turn))
     ok = nxt >= 0

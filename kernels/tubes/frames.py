@@ -14,6 +14,7 @@ by one that acts identically on the frame vector.
 
 import numpy as np
 
+from ..common.tolerances import FLOAT64_TINY, NO_DIRECTION
 from .polylines import arc_lengths, next_index
 
 _TINY = 1e-24
@@ -21,7 +22,7 @@ _TINY = 1e-24
 
 def _unit(v):
     n = np.linalg.norm(v, axis=-1, keepdims=True)
-    return v / np.maximum(n, 1e-300), n[..., 0]
+    return v / np.maximum(n, FLOAT64_TINY), n[..., 0]
 
 
 def tangents(lines):
@@ -85,7 +86,7 @@ def step_rotations(points, t0, t1):
     b, nb = _unit(t1 - t_l)
     # reflection 2 undefined (t1 == reflected t0): reflecting across the plane normal to t1 acts on the frame
     # vector (already perpendicular to t1 after reflection 1) exactly like the identity
-    flat = nb < 1e-12
+    flat = nb < NO_DIRECTION
     b[flat] = t1[flat]
     return np.concatenate((np.sum(a * b, axis=1, keepdims=True), np.cross(a, b)), axis=1)
 
