@@ -13,7 +13,7 @@ _modules = (
     "addon.opencl_warmup",
     "addon.properties",
     "addon.displacement.maps",
-    "operators.tessellate",
+    "operators.tessellation",
     "operators.tubes",
     "operators.displacement",
     "operators.custom_kernel",

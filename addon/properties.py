@@ -12,25 +12,25 @@ roots, then the pointers, so the order is written here and nowhere else.
 import bpy
 
 from .displacement import settings as displacement_settings
-from .impostors import settings as nailboard_settings
-from .subdivision import settings as loop_settings
-from .surfaces import settings as surface_settings
+from .impostors import settings as impostors_settings
+from .subdivision import settings as subdivision_settings
+from .surfaces import settings as surfaces_settings
 from .terrain import settings as terrain_settings
 from .tessellation import settings as tessellation_settings
-from .tubes import settings as tube_settings
+from .tubes import settings as tubes_settings
 
-_SETTINGS = (tessellation_settings, tube_settings, displacement_settings, terrain_settings, loop_settings,
-             surface_settings, nailboard_settings)
+_SETTINGS = (tessellation_settings, tubes_settings, displacement_settings, terrain_settings, subdivision_settings,
+             surfaces_settings, impostors_settings)
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
-    tessellate: bpy.props.PointerProperty(type=tessellation_settings.TESSERA_PG_tessellate)
-    tubes: bpy.props.PointerProperty(type=tube_settings.TESSERA_PG_tubes)
+    tessellate: bpy.props.PointerProperty(type=tessellation_settings.TESSERA_PG_tessellation)
+    tubes: bpy.props.PointerProperty(type=tubes_settings.TESSERA_PG_tubes)
     displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement)
     terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
-    loop: bpy.props.PointerProperty(type=loop_settings.TESSERA_PG_loop)
-    surface: bpy.props.PointerProperty(type=surface_settings.TESSERA_PG_surface)
-    nailboard: bpy.props.PointerProperty(type=nailboard_settings.TESSERA_PG_nailboard)
+    loop: bpy.props.PointerProperty(type=subdivision_settings.TESSERA_PG_subdivision)
+    surface: bpy.props.PointerProperty(type=surfaces_settings.TESSERA_PG_surfaces)
+    nailboard: bpy.props.PointerProperty(type=impostors_settings.TESSERA_PG_impostors)
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):

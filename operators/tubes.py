@@ -6,7 +6,7 @@ from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
-from ..addon.tubes.settings import TubeOptions, copy_tube_settings, draw_tube_settings, kernel_settings
+from ..addon.tubes.settings import TubeOptions, copy_tubes_settings, draw_tubes_settings, kernel_settings
 from ..addon.tubes.sources import SOURCE_TYPES, read_lines
 from ..kernels.common.errors import BudgetError, EmptyResultError
 from ..kernels.tubes.builder import build_tubes
@@ -36,7 +36,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
         return True
 
     def draw(self, context):
-        draw_tube_settings(self.layout, self)
+        draw_tubes_settings(self.layout, self)
 
     def settings(self):
         return kernel_settings(self)
@@ -73,7 +73,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
             raise EmptyResultError(empty[0] if len(empty) == 1 else f"No tubes from {len(empty)} sources. {empty[0]}")
         made = [self._place(tx, ob, mesh) for ob, mesh, _ in results]  # every source built before any is placed
         for ob, _, notes in results:
-            copy_tube_settings(self, ob.tessera.tubes)  # a batch script can re-run them
+            copy_tubes_settings(self, ob.tessera.tubes)  # a batch script can re-run them
             for note in notes:
                 self.report({"WARNING"}, note)
         for note in empty:

@@ -5,8 +5,8 @@ import bpy
 from ..sidebar import Sidebar
 
 
-class TESSERA_PT_nailboard(Sidebar, bpy.types.Panel):
-    bl_idname = "TESSERA_PT_nailboard"
+class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_impostors"
     bl_label = "Nailboard"
     bl_options = {"DEFAULT_CLOSED"}
 
@@ -23,5 +23,5 @@ class TESSERA_PT_nailboard(Sidebar, bpy.types.Panel):
             col.prop(s, name)
 
 
-classes = (TESSERA_PT_nailboard,)
+classes = (TESSERA_PT_impostors,)
 register, unregister = bpy.utils.register_classes_factory(classes)

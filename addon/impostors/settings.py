@@ -5,11 +5,11 @@ import bpy
 from ..viewport import invalidator
 
 #: The invalidation topic of these settings (`addon.viewport`).
-TOPIC = "nailboard"
+TOPIC = "impostors"
 _changed = invalidator(TOPIC)
 
 
-class TESSERA_PG_nailboard(bpy.types.PropertyGroup):
+class TESSERA_PG_impostors(bpy.types.PropertyGroup):
     enabled: bpy.props.BoolProperty(
         name="Nailboard", default=False, update=_changed,
         description="Draw this object in the viewport from a board rendered by Cycles in a background process "
@@ -31,5 +31,5 @@ class TESSERA_PG_nailboard(bpy.types.PropertyGroup):
                                 description="Ask for the board the camera will need this many frames ahead")
 
 
-classes = (TESSERA_PG_nailboard,)
+classes = (TESSERA_PG_impostors,)
 register, unregister = bpy.utils.register_classes_factory(classes)

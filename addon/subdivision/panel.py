@@ -5,11 +5,11 @@ import bpy
 
 from ..sidebar import Sidebar
 from .build import HCE_PROPERTY
-from .settings import copy_loop_settings, draw_loop_settings
+from .settings import copy_subdivision_settings, draw_subdivision_settings
 
 
-class TESSERA_PT_loop_subdivision(Sidebar, bpy.types.Panel):
-    bl_idname = "TESSERA_PT_loop_subdivision"
+class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_subdivision"
     bl_label = "Loop Subdivision"
     bl_options = {"DEFAULT_CLOSED"}
 
@@ -20,7 +20,7 @@ class TESSERA_PT_loop_subdivision(Sidebar, bpy.types.Panel):
         layout = self.layout
         ob = context.active_object
         settings = ob.tessera.loop
-        draw_loop_settings(layout, settings)
+        draw_subdivision_settings(layout, settings)
         me = ob.data
         col = layout.column(align=True)
         creases = [a.name for a in me.attributes if a.name in ("crease_edge", "sharp_edge", "crease_vert")]
@@ -32,8 +32,8 @@ class TESSERA_PT_loop_subdivision(Sidebar, bpy.types.Panel):
         row = layout.row()
         row.scale_y = 1.4
         op = row.operator("tessera.loop_subdivide", icon="MOD_SUBSURF", text="Make Loop Mesh")
-        copy_loop_settings(settings, op)
+        copy_subdivision_settings(settings, op)
 
 
-classes = (TESSERA_PT_loop_subdivision,)
+classes = (TESSERA_PT_subdivision,)
 register, unregister = bpy.utils.register_classes_factory(classes)

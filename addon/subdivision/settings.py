@@ -15,7 +15,7 @@ BAKED_COLOUR = "BakedLight"  # the point colour attribute written from the mesh'
 
 
 class LoopOptions:
-    """The Loop options, declared once: the operator inherits them as they are, `TESSERA_PG_loop` with the
+    """The Loop options, declared once: the operator inherits them as they are, `TESSERA_PG_subdivision` with the
     preview's invalidation added (`with_update`)."""
 
     levels: bpy.props.IntProperty(
@@ -33,12 +33,12 @@ class LoopOptions:
 
 
 #: The invalidation topic of these settings (`addon.viewport`).
-TOPIC = "loop"
+TOPIC = "subdivision"
 _changed = invalidator(TOPIC)
 LOOP_SETTING_NAMES = tuple(LoopOptions.__annotations__)
 
 
-class TESSERA_PG_loop(bpy.types.PropertyGroup):
+class TESSERA_PG_subdivision(bpy.types.PropertyGroup):
     __annotations__ = {
         **with_update(LoopOptions, _changed),
         "preview": bpy.props.BoolProperty(name="Preview Loop Subdivision", update=_changed, default=False,
@@ -47,12 +47,12 @@ class TESSERA_PG_loop(bpy.types.PropertyGroup):
     }
 
 
-def copy_loop_settings(source, target):
+def copy_subdivision_settings(source, target):
     for name in LOOP_SETTING_NAMES:
         setattr(target, name, getattr(source, name))
 
 
-def draw_loop_settings(layout, s):
+def draw_subdivision_settings(layout, s):
     layout.use_property_split = True
     layout.use_property_decorate = False
     col = layout.column()
@@ -60,5 +60,5 @@ def draw_loop_settings(layout, s):
         col.prop(s, name)
 
 
-classes = (TESSERA_PG_loop,)
+classes = (TESSERA_PG_subdivision,)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -6,8 +6,8 @@ from ..sidebar import Sidebar
 from .settings import draw_surface_options
 
 
-class TESSERA_PT_parametric_surface(Sidebar, bpy.types.Panel):
-    bl_idname = "TESSERA_PT_parametric_surface"
+class TESSERA_PT_surfaces(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_surfaces"
     bl_label = "Parametric Surface"
     object_types = frozenset({"EMPTY"})
 
@@ -33,5 +33,5 @@ class TESSERA_PT_parametric_surface(Sidebar, bpy.types.Panel):
         row.operator("tessera.parametric_surface_bake", icon="MESH_DATA")
 
 
-classes = (TESSERA_PT_parametric_surface,)
+classes = (TESSERA_PT_surfaces,)
 register, unregister = bpy.utils.register_classes_factory(classes)

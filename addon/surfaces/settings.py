@@ -67,7 +67,7 @@ TOPIC = "surfaces"
 _changed = invalidator(TOPIC)
 
 
-class TESSERA_PG_surface(bpy.types.PropertyGroup):
+class TESSERA_PG_surfaces(bpy.types.PropertyGroup):
     """``Object.tessera.surface``: an object with no mesh of its own drawn as a one-point surface (the GPU path:
     one instance per control point) and baked on demand."""
 
@@ -267,5 +267,5 @@ def draw_patch_options(layout, options):
         col.prop(options, "camera_source")
 
 
-classes = (TESSERA_PG_surface,)
+classes = (TESSERA_PG_surfaces,)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -6,8 +6,8 @@ from ..sidebar import Sidebar
 from .settings import draw_settings
 
 
-class TESSERA_PT_tessellate(Sidebar, bpy.types.Panel):
-    bl_idname = "TESSERA_PT_tessellate"
+class TESSERA_PT_tessellation(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_tessellation"
     bl_label = "Tessellate"
 
     def draw(self, context):
@@ -20,5 +20,5 @@ class TESSERA_PT_tessellate(Sidebar, bpy.types.Panel):
         op.use_object_settings = True
 
 
-classes = (TESSERA_PT_tessellate,)
+classes = (TESSERA_PT_tessellation,)
 register, unregister = bpy.utils.register_classes_factory(classes)

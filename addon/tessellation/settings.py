@@ -1,6 +1,6 @@
 """Tessellation settings: one set of properties shared by the operator (redo panel) and the object.
 
-The same annotations define `TESSERA_PG_tessellate` (stored on every object as ``Object.tessera.tessellate``,
+The same annotations define `TESSERA_PG_tessellation` (stored on every object as ``Object.tessera.tessellate``,
 so a batch script can re-run what the artist chose) and the properties of ``tessera.tessellate``.
 `copy_settings` moves values between the two; `surface_options` and `adaptive_settings` turn either
 into the kernels' dataclasses.
@@ -64,7 +64,7 @@ OUTPUT_ITEMS = (
 
 
 class TessellateOptions:
-    """The tessellation options, declared once: the operator ``tessera.tessellate`` and `TESSERA_PG_tessellate`
+    """The tessellation options, declared once: the operator ``tessera.tessellate`` and `TESSERA_PG_tessellation`
     (``Object.tessera.tessellate``) both inherit them."""
 
     method: bpy.props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN")
@@ -106,11 +106,11 @@ SETTING_NAMES = tuple(TessellateOptions.__annotations__)
 
 
 #: The invalidation topic of these settings (`addon.viewport`).
-TOPIC = "tessellate"
+TOPIC = "tessellation"
 _redraw = invalidator(TOPIC)
 
 
-class TESSERA_PG_tessellate(TessellateOptions, bpy.types.PropertyGroup):
+class TESSERA_PG_tessellation(TessellateOptions, bpy.types.PropertyGroup):
     stored: bpy.props.BoolProperty(name="Stored", description="These settings were saved by a tessellation run",
                                    default=False)
     preview: bpy.props.BoolProperty(
@@ -186,5 +186,5 @@ def draw_settings(layout, settings, show_output=True):
         layout.prop(settings, "output")
 
 
-classes = (TESSERA_PG_tessellate,)
+classes = (TESSERA_PG_tessellation,)
 register, unregister = bpy.utils.register_classes_factory(classes)

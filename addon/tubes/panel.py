@@ -3,7 +3,7 @@
 import bpy
 
 from ..sidebar import Sidebar
-from .settings import copy_tube_settings, draw_tube_settings
+from .settings import copy_tubes_settings, draw_tubes_settings
 from .sources import SOURCE_TYPES
 
 
@@ -17,11 +17,11 @@ class TESSERA_PT_tubes(Sidebar, bpy.types.Panel):
 
     def draw(self, context):
         settings = context.active_object.tessera.tubes
-        draw_tube_settings(self.layout, settings)
+        draw_tubes_settings(self.layout, settings)
         row = self.layout.row()
         row.scale_y = 1.4
         op = row.operator("tessera.tubes", icon="MESH_CYLINDER", text="Make Tube Mesh")
-        copy_tube_settings(settings, op)
+        copy_tubes_settings(settings, op)
 
 
 classes = (TESSERA_PT_tubes,)

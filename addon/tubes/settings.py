@@ -82,7 +82,7 @@ class TESSERA_PG_tubes(bpy.types.PropertyGroup):
     }
 
 
-def copy_tube_settings(source, target):
+def copy_tubes_settings(source, target):
     for name in TUBE_SETTING_NAMES:
         setattr(target, name, getattr(source, name))
 
@@ -95,7 +95,7 @@ def kernel_settings(s, aa_clamp=None):
         point_normals=False)  # Blender derives a written mesh's normals
 
 
-def draw_tube_settings(layout, s):
+def draw_tubes_settings(layout, s):
     layout.use_property_split = True
     layout.use_property_decorate = False
     col = layout.column()

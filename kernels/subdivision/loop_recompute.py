@@ -7,7 +7,7 @@ support keeps the triangle's own sub-triangles exact although the patch's outer 
 renumbering keeps every sum in the order the whole-mesh reference uses (edges by id, opposite vertices by id),
 so a vertex on a shared coarse edge comes out bit for bit the same from both triangles, and the same as the
 reference (`loop.loop_subdivide`): the tests check both, and that the order the triangles are taken in changes
-nothing. numpy here is a reference, not a fast path: one patch at a time (bench/loop.py, B4).
+nothing. numpy here is a reference, not a fast path: one patch at a time (bench/subdivision.py, B4).
 """
 
 import numpy as np

@@ -124,5 +124,5 @@ def test_split_mode_reports_the_opened_edges(clean_scene, bpy_module):
 
 
 def test_sidebar_panel_is_registered(addon, bpy_module):
-    assert hasattr(bpy_module.types, "TESSERA_PT_tessellate")
+    assert hasattr(bpy_module.types, "TESSERA_PT_tessellation")
     assert hasattr(bpy_module.types.Object, "tessera")

@@ -1,4 +1,4 @@
-"""OpenSubdiv's Loop refinement through ctypes: the subdivision oracle of the tests and `bench/loop.py`.
+"""OpenSubdiv's Loop refinement through ctypes: the subdivision oracle of the tests and `bench/subdivision.py`.
 
 The shared library is built by ``tools/setup.sh`` (Debian ``libosd-dev``) into ``out/osd/libosd_loop.so``;
 `load` says why when it is missing.

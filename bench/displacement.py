@@ -18,7 +18,7 @@
 - ``smooth``: one whole-map smooth of a 4096² map, on the device only and including the read-back to the host,
   and the numpy reference, each against ``np.copyto`` of the same map in the same run (the bandwidth ratio is
   copy time / smooth time: both move the map once in and once out). Target: >= 25 %.
-Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/brushes.py
+Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/displacement.py
 """
 
 import json

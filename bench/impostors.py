@@ -20,7 +20,7 @@
   validity metric (K = 1), the cache of recent boards (reuse), velocity prediction. Reported: renders asked for per
   second, boards swapped in per second (the effective update rate), cache hits, and the share of frames drawn from a
   board that is valid for that frame's eye (R3).
-Run: .venv/bin/python bench/nailboards.py (``--r3``: the R3 rows only)
+Run: .venv/bin/python bench/impostors.py (``--r3``: the R3 rows only)
 """
 
 import importlib
@@ -87,7 +87,7 @@ def r3_cases(mod, ob, fov):
                 empty += 1
             elif not va.check(state.board, eye, fov, SIZE, 1.0, 0.25).regenerate:
                 valid += 1
-        print(json.dumps({"bench": "nailboards", "case": f"r3_{name}", "frames": n, "fps": R3_FPS,
+        print(json.dumps({"bench": "impostors", "case": f"r3_{name}", "frames": n, "fps": R3_FPS,
                           "render_latency_frames": R3_LATENCY, "renders_per_second": round(manager.regenerations
                                                                                            / R3_SECONDS, 2),
                           "boards_swapped_in_per_second": round(swaps / R3_SECONDS, 2),
@@ -156,7 +156,7 @@ def main():
             return next((k for k, e in enumerate(errs) if e > 1.0), len(errs))
 
         lr, lp = life(rel), life(plain)
-        print(json.dumps({"bench": "nailboards", "case": f"lifetime_{name}",
+        print(json.dumps({"bench": "impostors", "case": f"lifetime_{name}",
                           "board_texels": int(images.setup.resolution), "relief_frames": lr, "plain_frames": lp,
                           "ratio": round(lr / max(lp, 1), 2),
                           "relief_error_px": [round(e, 2) for e in rel[::8]],
@@ -168,7 +168,7 @@ def main():
         hit = next((i for i, e in enumerate(paths["strafe"]) if va.check(board, e, fov, SIZE, k_tol, 1.0).regenerate),
                    None)
         measured = errors["strafe"][1][hit] if hit is not None else None
-        print(json.dumps({"bench": "nailboards", "case": f"k_{k_tol:g}", "plain_regenerate_at_frame": hit,
+        print(json.dumps({"bench": "impostors", "case": f"k_{k_tol:g}", "plain_regenerate_at_frame": hit,
                           "measured_plain_error_px_there": None if measured is None else round(measured, 2)}),
               flush=True)
 
@@ -190,7 +190,7 @@ def main():
     busy, running = draw_times(True)
     print(json.dumps(request_pause_case(bpy, worker, ball, o1, fov)), flush=True)
     print(json.dumps(resample_case(mod)), flush=True)
-    print(json.dumps({"bench": "nailboards", "case": "r1_draw_with_worker", "worker_running_throughout": running,
+    print(json.dumps({"bench": "impostors", "case": "r1_draw_with_worker", "worker_running_throughout": running,
                       "busy_max_ms": round(1e3 * max(busy), 1), "busy_mean_ms": round(1e3 * np.mean(busy), 1),
                       "idle_max_ms": round(1e3 * max(idle), 1), "idle_mean_ms": round(1e3 * np.mean(idle), 1),
                       "mean_ratio": round(np.mean(busy) / np.mean(idle), 2)}), flush=True)
@@ -219,7 +219,7 @@ def resample_case(mod, repeat=5):
     small = resample.resample_board(setup, colours, d, normals, present, n // 4)
     once = time.perf_counter() - t
     fine, coarse = frame_cost(setup, d, present), frame_cost(small[0], small[2], small[4])
-    return {"bench": "nailboards", "case": "resampled_board_frame", "texels": f"{n // 4}²",
+    return {"bench": "impostors", "case": "resampled_board_frame", "texels": f"{n // 4}²",
             "seconds": round(coarse, 4), "baseline": f"the board drawn at its {n}² texels", "baseline_seconds":
             round(fine, 4), "ratio": round(fine / coarse, 1), "resample_once_seconds": round(once, 3)}
 
@@ -246,7 +246,7 @@ def request_pause_case(bpy, worker, ball, eye, fov, repeat=3):
     mesh = heavy.data
     bpy.data.objects.remove(heavy)
     bpy.data.meshes.remove(mesh)
-    return {"bench": "nailboards", "case": "r1_request_pause", "scene_triangles": 2 * 1413 * 1413 + 64 * 30 * 2,
+    return {"bench": "impostors", "case": "r1_request_pause", "scene_triangles": 2 * 1413 * 1413 + 64 * 30 * 2,
             "seconds": round(min(ours), 4), "baseline": "save a copy of the file", "baseline_seconds":
             round(min(saves), 4), "ratio": round(min(saves) / min(ours), 1)}
 

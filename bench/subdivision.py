@@ -19,7 +19,7 @@ Cases (Suzanne, 968 triangles, smooth, except where said):
   flat-shaded Suzanne *Add > Monkey* gives, against adding Subdivision Surface level 5 and applying it, per output
   triangle (Loop 991,232 triangles, Catmull-Clark 1,007,616).
 Timings are the best of REPEAT, the cases interleaved round by round. Prints one JSON object per case.
-Run: make bench, or .venv/bin/python bench/loop.py
+Run: make bench, or .venv/bin/python bench/subdivision.py
 """
 
 import json
@@ -81,7 +81,7 @@ def loop_operator(bpy, ob):
 
 def row(case, seconds, n, base_name, base_seconds, base_n, **extra):
     rate, base_rate = n / seconds, base_n / base_seconds
-    return {"bench": "loop", "case": case, "output_triangles": int(n), "seconds": round(seconds, 4),
+    return {"bench": "subdivision", "case": case, "output_triangles": int(n), "seconds": round(seconds, 4),
             "triangles_per_second": round(rate), "baseline": base_name, "baseline_triangles": int(base_n),
             "baseline_seconds": round(base_seconds, 4), "baseline_triangles_per_second": round(base_rate),
             "speedup": round(rate / base_rate, 2), **extra}
