@@ -24,6 +24,7 @@ _modules = (
     "operators.node_groups",
     "addon.node_library",
     "addon.menus",
+    "addon.start_panel",
     "addon.tessellation.panel",
     "addon.tubes.panel",
     "addon.displacement.panel",

@@ -130,3 +130,12 @@ def use_material_nodes(material):
     has its node tree and deprecates the flag)."""
     if material.node_tree is None:
         material.use_nodes = True
+
+
+def set_socket_subtype(item, subtype):
+    """Give a group interface socket ``item`` a subtype (DISTANCE, ANGLE, FACTOR, PIXEL ...) where this Blender has
+    it for that socket type (4.2 has no PIXEL sockets); elsewhere it keeps its plain number display."""
+    try:
+        item.subtype = subtype
+    except TypeError:
+        pass

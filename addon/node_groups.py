@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import bpy
 
-from .compat import menu_input_value, set_modifier_input
+from .compat import menu_input_value, set_modifier_input, set_socket_subtype
 
 
 class Graph:
@@ -96,10 +96,14 @@ class Graph:
                          data_type=data_type).outputs[0]
 
 
-def socket(tree, name, kind, in_out="INPUT", description="", default=None, min_value=None, max_value=None):
-    """An interface socket with its tooltip, default and range."""
+def socket(tree, name, kind, in_out="INPUT", description="", default=None, min_value=None, max_value=None,
+           subtype=None):
+    """An interface socket with its tooltip, default, range and ``subtype`` (DISTANCE, ANGLE, FACTOR, PIXEL ...: the
+    unit the modifier panel shows)."""
     item = tree.interface.new_socket(name, in_out=in_out, socket_type=kind)
     item.description = description
+    if subtype is not None:
+        set_socket_subtype(item, subtype)
     if default is not None:
         item.default_value = default
     if min_value is not None:
@@ -111,12 +115,13 @@ def socket(tree, name, kind, in_out="INPUT", description="", default=None, min_v
 
 @dataclass(frozen=True)
 class GroupSpec:
-    """A Tessera group: its name, graph version, builder ``build(tree)``, catalog path and whether it is a
-    modifier (shown in Add Modifier)."""
+    """A Tessera group: its name, graph version, builder ``build(tree)``, one-sentence ``description`` (the group's
+    tooltip and its asset description), catalog path and whether it is a modifier (shown in Add Modifier)."""
 
     name: str
     version: int
     build: object
+    description: str
     catalog: str = "Tessera"
     modifier: bool = True
     available: object = None  # callable -> None or the reason this Blender cannot build it
@@ -141,6 +146,7 @@ def ensure_group(spec):
     else:
         tree = bpy.data.node_groups.new(spec.name, "GeometryNodeTree")
     spec.build(tree)
+    tree.description = spec.description
     if spec.modifier and hasattr(tree, "is_modifier"):
         tree.is_modifier = True
     tree["tessera_version"] = spec.version

@@ -19,6 +19,7 @@ import bpy
 
 from . import node_groups
 from .displacement import nodes as _displace_nodes  # noqa: F401 (registers its group)
+from .manifest import license_id, manifest
 from .preferences import BASE_PACKAGE
 from .terrain import nodes as _terrain_nodes  # noqa: F401 (registers its group)
 from .tessellation import phong_nodes as _phong_nodes  # noqa: F401 (registers its group)
@@ -56,6 +57,14 @@ def catalog_id(path):
     return str(uuid.uuid5(_NAMESPACE, path))
 
 
+def describe_asset(asset_data, spec):
+    """Fill a group's asset metadata: its description, and the extension's author, license and copyright."""
+    asset_data.description = spec.description
+    asset_data.author = manifest().get("maintainer", "")
+    asset_data.license = license_id()
+    asset_data.copyright = ", ".join(manifest().get("copyright", []))
+
+
 def write_library(directory):
     """Write the groups' .blend and the catalogs into ``directory`` (older Tessera .blends removed). Returns the
     file. Groups this file already had are left as they were; the ones built for writing are removed again."""
@@ -69,7 +78,7 @@ def write_library(directory):
         for spec, tree in zip(specs, trees, strict=True):
             tree.asset_mark()
             tree.asset_data.catalog_id = catalog_id(spec.catalog)
-            tree.asset_data.description = f"Tessera: {spec.name}"
+            describe_asset(tree.asset_data, spec)
         tmp = path.with_suffix(".tmp.blend")
         bpy.data.libraries.write(str(tmp), set(trees), fake_user=True, compress=True)
         tmp.replace(path)  # never a half-written library

@@ -39,13 +39,14 @@ class TESSERA_AddonPreferences(bpy.types.AddonPreferences):
 
     memory_budget_mb: bpy.props.IntProperty(
         name="Memory Budget (MiB)",
-        description="Refuse operations whose estimated peak memory exceeds this (0: no limit)",
+        description="Refuse operations whose estimated peak memory exceeds this many mebibytes (0: no limit)",
         default=4096,
         min=0,
         soft_max=65536,
     )
     opencl_mode: bpy.props.EnumProperty(
-        name="OpenCL", items=_OPENCL_MODES, default="ENV", update=_on_opencl_change
+        name="OpenCL", items=_OPENCL_MODES, default="ENV", update=_on_opencl_change,
+        description="Whether heavy work (tubes, brushes, terrain, Loop subdivision) runs on an OpenCL device",
     )
     opencl_device: bpy.props.StringProperty(
         name="OpenCL Device",

@@ -70,23 +70,28 @@ def new_map_image(name, width, height, data=None):
 
 
 class TESSERA_OT_displacement_add(bpy.types.Operator):
-    """Give the active mesh a float displacement map (new, or read from an EXR/PNG/TIFF file) shown by a
-    Displace modifier"""
+    """Give the active mesh a displacement map to paint, new or read from a file, shown by a Displace modifier"""
 
     bl_idname = "tessera.displacement_add"
     bl_label = "Add Displacement Map"
     bl_options = {"REGISTER", "UNDO"}
 
-    width: bpy.props.IntProperty(name="Width", default=1024, min=8, max=32768)
-    height: bpy.props.IntProperty(name="Height", default=1024, min=8, max=32768)
-    mode: bpy.props.EnumProperty(name="Mode", items=MODE_ITEMS, default="HEIGHT")
-    space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL")
+    width: bpy.props.IntProperty(name="Width", default=1024, min=8, max=32768, soft_max=8192, subtype="PIXEL",
+                                 description="Width of a new map")
+    height: bpy.props.IntProperty(name="Height", default=1024, min=8, max=32768, soft_max=8192, subtype="PIXEL",
+                                  description="Height of a new map")
+    mode: bpy.props.EnumProperty(name="Mode", items=MODE_ITEMS, default="HEIGHT",
+                                 description="One height per texel, or an XYZ offset per texel")
+    space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL",
+                                  description="The axes a vector map's X, Y and Z follow")
     filepath: bpy.props.StringProperty(name="From File", subtype="FILE_PATH",
                                        description="Read the map from this file instead (EXR, PNG, TIFF)")
     low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                 description="Value of a 0 texel in integer files")
+                                 soft_min=-100.0, soft_max=100.0,
+                                 description="Map value of a black texel in 8- or 16-bit files")
     high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                  description="Value of a full texel")
+                                  soft_min=-100.0, soft_max=100.0,
+                                  description="Map value of a white texel in 8- or 16-bit files")
 
     @classmethod
     def poll(cls, context):
@@ -135,14 +140,20 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
 
 
 class TESSERA_OT_displacement_export(bpy.types.Operator):
-    """Write the active object's displacement map to a 32-bit EXR (exact) or a 16-bit PNG/TIFF file"""
+    """Write the active object's displacement map to a 32-bit EXR (exact) or a 16-bit PNG or TIFF file"""
 
     bl_idname = "tessera.displacement_export"
     bl_label = "Export Displacement Map"
 
-    filepath: bpy.props.StringProperty(subtype="FILE_PATH")
-    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE)
-    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE)
+    filepath: bpy.props.StringProperty(name="File", subtype="FILE_PATH",
+                                       description="The file to write: .exr, .png or .tif")
+    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                 soft_min=-100.0, soft_max=100.0,
+                                 description="Map value written as black in a 16-bit file (lower values are clipped)")
+    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                  soft_min=-100.0, soft_max=100.0,
+                                  description="Map value written as white in a 16-bit file (higher values are "
+                                              "clipped)")
 
     @classmethod
     def poll(cls, context):
@@ -177,7 +188,9 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
     bl_label = "Displacement Stroke"
     bl_options = {"REGISTER", "UNDO", "BLOCKING"}
 
-    stroke: bpy.props.CollectionProperty(type=bpy.types.OperatorStrokeElement, options={"SKIP_SAVE"})
+    stroke: bpy.props.CollectionProperty(type=bpy.types.OperatorStrokeElement, options={"SKIP_SAVE"},
+                                         description="The stroke's points (recorded while painting, or given by a "
+                                                     "script)")
     map_space: bpy.props.BoolProperty(name="Map Space", default=False, options={"SKIP_SAVE"},
                                       description="Stroke locations are map texels (x, y) instead of surface points")
 

@@ -11,26 +11,27 @@ from .selection import object_poll, select_only
 
 
 class TESSERA_OT_impostor_bake(bpy.types.Operator):
-    """Bake the active object into an impostor: views from an octahedral set of directions rendered by Cycles into
-    atlases, on a card that faces the scene camera and shows the view of its direction"""
+    """Render the active object from many directions with Cycles onto a camera-facing card that stands in for it"""
 
     bl_idname = "tessera.impostor_bake"
     bl_label = "Bake Impostor"
     bl_options = {"REGISTER", "UNDO"}
 
-    grid: bpy.props.IntProperty(name="Views", default=8, min=1, max=32, description="Views a side of the atlas")
-    tile: bpy.props.IntProperty(name="View Size", default=128, min=8, max=2048, description="Pixels a view")
-    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, description="Cycles samples a view")
-    dilation: bpy.props.IntProperty(name="Dilation", default=4, min=0, max=64,
+    grid: bpy.props.IntProperty(name="Views", default=8, min=1, max=32,
+                                description="Views along each side of the atlas (Views × Views directions)")
+    tile: bpy.props.IntProperty(name="View Size", default=128, min=8, max=2048, soft_max=1024, subtype="PIXEL",
+                                description="Width and height of each view")
+    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, soft_max=1024,
+                                   description="Cycles samples per view")
+    dilation: bpy.props.IntProperty(name="Dilation", default=4, min=0, max=64, subtype="PIXEL",
                                     description="Texels each view's colours and normals spread into the empty texels "
                                                 "around it (alpha stays 0), so engines that filter the atlas show no "
                                                 "dark halo at the outline")
     blend: bpy.props.BoolProperty(name="Blend Views", default=True,
-                                  description="Mix the four views around the view direction (bilinear over the "
-                                              "atlas grid), so the card changes smoothly as it turns; off: the "
-                                              "nearest view, switching at cell borders")
+                                  description="Mix the four views nearest the view direction, so the card changes "
+                                              "smoothly as it turns; off: the nearest view alone")
     hemi: bpy.props.BoolProperty(name="Upper Hemisphere", default=False,
-                                 description="Views only from above (hemi-octahedral): finer for objects on the "
+                                 description="Views only from above: more detail for objects that stand on the "
                                              "ground")
 
     @classmethod
@@ -61,16 +62,14 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
 
 class TESSERA_OT_impostor_export(bpy.types.Operator):
-    """Write the active impostor card to glTF (.glb): the card with an unlit, alpha-blended material showing the
-    object's front view, the whole colour atlas, and the atlas layout in the node's extras for an engine's impostor
-    shader"""
+    """Write the active impostor card and its atlas to a glTF binary (.glb) file for game engines"""
 
     bl_idname = "tessera.impostor_export"
-    bl_label = "Export Impostor (glTF)"
+    bl_label = "Tessera Impostor (.glb)"
     bl_options = {"REGISTER"}
 
     filepath: bpy.props.StringProperty(name="File", subtype="FILE_PATH", description="The .glb file to write")
-    filter_glob: bpy.props.StringProperty(default="*.glb", options={"HIDDEN"})
+    filter_glob: bpy.props.StringProperty(default="*.glb", options={"HIDDEN"}, description="Files listed")
 
     @classmethod
     def poll(cls, context):

@@ -15,14 +15,13 @@ def _group_items(self, context):
 
 
 class TESSERA_OT_node_group_add(bpy.types.Operator):
-    """Add a Tessera node group as a geometry-nodes modifier to the selected objects (the file keeps its own copy
-    of the group, so it evaluates without the add-on)"""
+    """Add a Tessera node group to the selected objects as a modifier that renders even without the add-on"""
 
     bl_idname = "tessera.node_group_add"
     bl_label = "Add Tessera Node Group"
     bl_options = {"REGISTER", "UNDO"}
 
-    group: bpy.props.EnumProperty(name="Group", items=_group_items)
+    group: bpy.props.EnumProperty(name="Group", items=_group_items, description="The node group to add")
 
     @classmethod
     def poll(cls, context):

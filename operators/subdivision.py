@@ -22,7 +22,7 @@ from .selection import mesh_poll, place_mesh, read_source
 
 
 class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
-    """Subdivide the active mesh with Loop's scheme for triangles; sharp and creased edges stay creased"""
+    """Smooth the active mesh with Loop subdivision, made for triangles; sharp and creased edges stay creased"""
 
     bl_idname = "tessera.loop_subdivide"
     bl_label = "Loop Subdivide"
@@ -30,7 +30,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
 
     # levels, boundary, use_creases, use_baked_lighting: LoopOptions (addon/subdivision/settings.py)
     output: bpy.props.EnumProperty(
-        name="Output", default="NEW_OBJECT",
+        name="Output", default="NEW_OBJECT", description="Make a new object, or replace this object's mesh",
         items=(("NEW_OBJECT", "New Object", "Add a new object beside the source (its modifiers applied first)"),
                ("REPLACE", "Replace", "Replace the object's mesh (one undo step brings it back)")))
 
@@ -88,24 +88,23 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
 
 
 class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
-    """Bake the light on the active mesh with Cycles (diffuse, direct and indirect) at its Loop sub-triangles and
-    store it on the mesh as a hierarchical colour encoding, for Loop Subdivide to carry to any level"""
+    """Bake the active mesh's light with Cycles and store it on the mesh, so Loop Subdivide shows it at any level"""
 
     bl_idname = "tessera.bake_lighting_hce"
-    bl_label = "Bake Lighting to HCE"
+    bl_label = "Bake Lighting"
     bl_options = {"REGISTER", "UNDO"}
 
     depth: bpy.props.IntProperty(
-        name="Depth", description="Loop level of the sub-triangles the light is baked at (colours hold to any "
-        "level: finer levels share their ancestors' colours)", default=2, min=0, max=4)
+        name="Depth", description="Loop level the light is baked at (finer levels share the colours of the "
+        "triangles they come from)", default=2, min=0, max=4)
     samples: bpy.props.IntProperty(name="Samples", description="Cycles samples per texel", default=32, min=1,
                                    max=4096, soft_max=512)
     normals: bpy.props.IntProperty(
-        name="Normals", description="Extra normals per coarse triangle, each with its own colours (light that "
-        "differs with the surface's direction, e.g. across a bend)", default=4, min=0, max=8)
+        name="Normals", description="Extra directions stored per triangle, each with its own colours (for light "
+        "that changes with the surface's direction, e.g. across a bend)", default=4, min=0, max=8)
     tolerance: bpy.props.FloatProperty(
-        name="Tolerance", description="A node is split while some sub-triangle under it differs from its colour "
-        "by more than this (0: full depth everywhere)", default=1.0 / 255, min=0.0, max=1.0, precision=4)
+        name="Colour Tolerance", description="Colours closer than this are stored once (0: every triangle at "
+        "Depth keeps its own colour)", default=1.0 / 255, min=0.0, max=1.0, precision=4, subtype="FACTOR")
     albedo: bpy.props.BoolProperty(name="Surface Colour", default=True,
                                    description="Multiply by the surface colour (off: the light alone)")
 

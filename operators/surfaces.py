@@ -37,14 +37,13 @@ from .selection import object_poll, place_mesh, select_only
 
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
-    """Add a parametric surface (sphere, cone, torus, Steiner's surface, Klein bottle, Möbius band, trefoil tube,
-    superellipsoid): a mesh welded where it closes, with UVs, or a live object drawn by the GPU from one point"""
+    """Add a mathematical surface (torus, Klein bottle, Möbius band and more) as a mesh or as a live GPU object"""
 
     bl_idname = "tessera.parametric_surface_add"
     bl_label = "Parametric Surface"
     bl_options = {"REGISTER", "UNDO"}
 
-    output: bpy.props.EnumProperty(name="Output", default="MESH", items=(
+    output: bpy.props.EnumProperty(name="Output", default="MESH", description="A mesh, or a live object", items=(
         ("MESH", "Mesh", "Bake the surface into a mesh"),
         ("LIVE", "Live", "An empty drawn as the surface by the GPU (no mesh; Bake Surface makes one on demand)")))
 
@@ -95,7 +94,7 @@ def _surface_arrays(mesh, offsets=None):
 
 
 class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
-    """Bake the active live surface into a mesh: one welded copy at each of its control points, at its Factor"""
+    """Make a mesh of the active live surface: one copy at each of its control points, at its Factor"""
 
     bl_idname = "tessera.parametric_surface_bake"
     bl_label = "Bake Surface"
@@ -132,8 +131,7 @@ class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
 
 
 class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
-    """Turn the active curve's Bézier splines into polylines with segments where they bend (by curvature, a
-    tolerance, or pixels for the camera), optionally as several offset copies"""
+    """Turn the active curve's Bézier splines into polylines with more points where they bend"""
 
     bl_idname = "tessera.curve_adaptive"
     bl_label = "Curve to Adaptive Polyline"
@@ -184,8 +182,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
 
 
 class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
-    """Render a steady vector field (a preset, or vectors on a grid mesh) as a line-integral-convolution image for
-    materials: noise advected along the field, denser when the camera is near"""
+    """Make an image of streaks that follow a flow (a preset, or vectors on a grid mesh), for materials"""
 
     bl_idname = "tessera.vector_field_texture"
     bl_label = "Vector Field Texture"
@@ -250,8 +247,7 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
 
 
 class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
-    """Turn the active surface object's bicubic Bézier patches into a mesh with levels per patch side from their
-    curvature or the camera: shared sides get one level, so the mesh is welded with no crack"""
+    """Turn the active surface object into a mesh with detail where it bends or near the camera, without cracks"""
 
     bl_idname = "tessera.surface_tessellate"
     bl_label = "Tessellate Surface"

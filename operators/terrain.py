@@ -77,7 +77,8 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     # the options: TerrainOptions (addon/terrain/settings.py), shared with Object.tessera.terrain
-    filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw", options={"HIDDEN"})
+    filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw", options={"HIDDEN"},
+                                          description="Files listed")
 
     @classmethod
     def poll(cls, context):
@@ -115,7 +116,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
 
 
 class TESSERA_OT_terrain_bake(bpy.types.Operator):
-    """Re-mesh the active terrain for its camera (scene camera or viewport): crack-free, for render and export"""
+    """Re-mesh the active terrain for its camera (the scene camera or the viewport), for render and export"""
 
     bl_idname = "tessera.terrain_bake"
     bl_label = "Bake Terrain for Camera"

@@ -29,7 +29,7 @@ def _world_positions(positions, matrix):
 
 
 class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
-    """Tessellate the active mesh: PN triangles, Phong or linear, with uniform or adaptive crack-free levels"""
+    """Add detail to the active mesh: smooth it with PN triangles or Phong, uniformly or where the camera needs it"""
 
     bl_idname = "tessera.tessellate"
     bl_label = "Tessellate"
@@ -37,7 +37,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
 
     # the options: TessellateOptions (addon/tessellation/settings.py), shared with Object.tessera.tessellate
     use_object_settings: bpy.props.BoolProperty(
-        name="Use Object Settings", description="Take every setting from the object (Object > Tessera panel)",
+        name="Use Object Settings", description="Take every setting from the object (Sidebar › Tessera › Tessellate)",
         default=False, options={"SKIP_SAVE"})
 
     @classmethod

@@ -17,7 +17,7 @@ from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
 from ..node_groups import Graph, GroupSpec, ensure_group, register_group, socket
 
 GROUP_NAME = "Tessera Displace"
-VERSION = 1  # bump when the graph changes: older groups in a file are rebuilt
+VERSION = 2  # bump when the graph changes: older groups in a file are rebuilt
 
 
 def maps():
@@ -79,7 +79,8 @@ def _build(tree):
     tree.links.new(moved.outputs[0], go.inputs[0])
 
 
-SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Displacement"))
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Displacement",
+                                description="Displace a mesh by a height or vector map laid out on its UVs"))
 
 
 def node_group(kind="Tangent"):

@@ -17,18 +17,18 @@ SPACE_ITEMS = (
     ("LOCAL", "Object", "X, Y, Z in the object's own axes"),
     ("GLOBAL", "World", "X, Y, Z in world axes"),
     ("TANGENT", "Tangent", "X along the UV map's U tangent, Y along the bitangent, Z along the normal "
-                           "(MikkTSpace; Blender 5.0 and newer)"),
+                           "(the tangent space of baked normal maps; Blender 5.0 and newer)"),
 )
 BRUSH_ITEMS = (
     ("DRAW", "Draw", "Raise (or lower, with negative strength) along the brush direction with a falloff"),
     ("SMOOTH", "Smooth", "Move texels toward the mean of their neighbours"),
     ("FLATTEN", "Flatten", "Move texels toward the mean height under the brush"),
     ("NOISE", "Noise", "Add value noise anchored to the map"),
-    ("CONTACT", "Contact", "Seed kernel: a hard disc pressed in by Strength (z only)"),
-    ("FORCE", "Force", "Seed kernel: a linear cone of depth Strength and the brush radius"),
-    ("TEST", "Test", "Seed kernel: a hard disc adding the direction times Strength"),
+    ("CONTACT", "Contact", "Press a hard-edged disc in by Strength (Z only)"),
+    ("FORCE", "Force", "Push in a cone of depth Strength as wide as the brush"),
+    ("TEST", "Offset Disc", "Add the brush direction times Strength inside a hard-edged disc"),
 )
-FALLOFF_ITEMS = tuple((f, f.title(), f"{f.title()} falloff curve") for f in FALLOFFS)
+FALLOFF_ITEMS = tuple((f, f.title(), f"{f.title()} falloff curve, as in Blender's brushes") for f in FALLOFFS)
 
 
 def _sync_modifier(self, context):
@@ -40,44 +40,52 @@ def _sync_modifier(self, context):
 class TESSERA_PG_displacement(bpy.types.PropertyGroup):
     image: bpy.props.PointerProperty(name="Map", type=bpy.types.Image, description="Float image with the map",
                                      update=_sync_modifier)
-    mode: bpy.props.EnumProperty(name="Mode", items=MODE_ITEMS, default="HEIGHT", update=_sync_modifier)
-    space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL", update=_sync_modifier)
+    mode: bpy.props.EnumProperty(name="Mode", items=MODE_ITEMS, default="HEIGHT", update=_sync_modifier,
+                                 description="One height per texel, or an XYZ offset per texel")
+    space: bpy.props.EnumProperty(name="Space", items=SPACE_ITEMS, default="LOCAL", update=_sync_modifier,
+                                  description="The axes a vector map's X, Y and Z follow")
     uv_map: bpy.props.StringProperty(name="UV Map", description="UV map that places the map (empty: active)",
                                      update=_sync_modifier)
     mid_level: bpy.props.FloatProperty(name="Mid-Level", default=0.0, soft_min=0.0, soft_max=1.0,
                                        min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                       description="Map value that means no displacement", update=_sync_modifier)
+                                       description="The map value that means no displacement", update=_sync_modifier)
     strength: bpy.props.FloatProperty(name="Strength", default=1.0, soft_min=-10.0, soft_max=10.0, min=-MAX_FACTOR,
                                       max=MAX_FACTOR,
                                       description="Displacement per unit of map value", update=_sync_modifier)
     kernel_text: bpy.props.PointerProperty(name="Custom Kernel", type=bpy.types.Text,
                                            description="Text with an OpenCL body that edits `float4 image` at (x, y)")
     kernel_args: bpy.props.FloatVectorProperty(name="Arguments", size=16, default=(0.0,) * 16, min=-MAX_WORLD_VALUE,
-                                               max=MAX_WORLD_VALUE,
-                                               description="arg1..arg4 (four float4) of the custom kernel")
+                                               max=MAX_WORLD_VALUE, soft_min=-1000.0, soft_max=1000.0,
+                                               description="The custom kernel's four arguments arg1 to arg4, four "
+                                                           "numbers each")
 
 
 class TESSERA_PG_brush(bpy.types.PropertyGroup):
-    kind: bpy.props.EnumProperty(name="Brush", items=BRUSH_ITEMS, default="DRAW")
+    kind: bpy.props.EnumProperty(name="Brush", items=BRUSH_ITEMS, default="DRAW",
+                                 description="What a dab does to the map")
     radius: bpy.props.FloatProperty(name="Radius", default=24.0, min=0.5, max=MAX_PIXELS, soft_max=512.0,
                                     subtype="PIXEL",
                                     description="Brush radius in map texels")
     strength: bpy.props.FloatProperty(name="Strength", default=0.05, soft_min=-1.0, soft_max=1.0, min=-MAX_FACTOR,
                                       max=MAX_FACTOR,
                                       description="Change per dab (map units; smooth and flatten: the blend)")
-    falloff: bpy.props.EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default="SMOOTH")
+    falloff: bpy.props.EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default="SMOOTH",
+                                    description="How a dab fades from its centre to its edge")
     spacing: bpy.props.FloatProperty(name="Spacing", default=0.25, min=0.01, max=4.0, subtype="FACTOR",
                                      description="Distance between dabs, as a fraction of the radius")
-    use_pressure_strength: bpy.props.BoolProperty(name="Pressure Strength", default=True)
-    use_pressure_radius: bpy.props.BoolProperty(name="Pressure Radius", default=False)
+    use_pressure_strength: bpy.props.BoolProperty(name="Pressure Strength", default=True,
+                                                  description="Tablet pressure scales the strength")
+    use_pressure_radius: bpy.props.BoolProperty(name="Pressure Radius", default=False,
+                                                description="Tablet pressure scales the radius")
     mirror_x: bpy.props.BoolProperty(name="X Mirror", default=False,
                                      description="Mirror dabs across the map's vertical centre line (U = 0.5)")
     direction: bpy.props.FloatVectorProperty(name="Direction", size=3, default=(0.0, 0.0, 1.0), min=-MAX_FACTOR,
-                                             max=MAX_FACTOR,
+                                             max=MAX_FACTOR, soft_min=-10.0, soft_max=10.0, subtype="XYZ",
                                              description="Vector maps: the offset direction (height maps use Z)")
     noise_cell: bpy.props.FloatProperty(name="Noise Size", default=8.0, min=0.5, max=MAX_PIXELS, soft_max=256.0,
-                                        description="Noise lattice spacing in texels")
-    noise_seed: bpy.props.IntProperty(name="Seed", default=0, min=0)
+                                        subtype="PIXEL", description="Size of the noise's features, in map texels")
+    noise_seed: bpy.props.IntProperty(name="Seed", default=0, min=0, soft_max=10000,
+                                      description="Another seed gives another noise pattern")
 
 
 class TESSERA_PG_image(bpy.types.PropertyGroup):

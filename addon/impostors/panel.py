@@ -1,4 +1,5 @@
-"""Sidebar panel Tessera > Nailboard: the object's nailboard switch and its settings."""
+"""Sidebar panel Tessera › Impostors: the object's live nailboard (drawn from a board Cycles renders in the
+background) and the baked impostor card."""
 
 import bpy
 
@@ -7,20 +8,22 @@ from ..sidebar import Sidebar
 
 class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_impostors"
-    bl_label = "Nailboard"
+    bl_label = "Impostors"
     bl_options = {"DEFAULT_CLOSED"}
-
-    def draw_header(self, context):
-        self.layout.prop(context.active_object.tessera.nailboard, "enabled", text="")
 
     def draw(self, context):
         s = context.active_object.tessera.nailboard
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
+        layout.prop(s, "enabled", text="Live Nailboard")
         col = layout.column()
+        col.active = s.enabled
         for name in ("relief", "tolerance", "samples", "progressive", "lead"):
             col.prop(s, name)
+        row = layout.row()
+        row.scale_y = 1.4
+        row.operator("tessera.impostor_bake", icon="IMAGE_PLANE")
 
 
 classes = (TESSERA_PT_impostors,)

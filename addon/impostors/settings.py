@@ -1,4 +1,4 @@
-"""Nailboard settings: ``Object.tessera.nailboard`` (sidebar › Tessera › Nailboard)."""
+"""Live nailboard settings: ``Object.tessera.nailboard`` (Sidebar › Tessera › Impostors)."""
 
 import bpy
 
@@ -18,10 +18,11 @@ class TESSERA_PG_impostors(bpy.types.PropertyGroup):
     relief: bpy.props.BoolProperty(name="Relief Mapping", default=True, update=_changed,
                                    description="Pre-warp the board for the eye (parallax corrected, per-texel "
                                                "depth); off: a plain sprite, regenerated sooner")
-    tolerance: bpy.props.FloatProperty(name="Tolerance K", default=1.5, min=0.1, max=100.0, update=_changed,
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=1.5, min=0.1, max=100.0, soft_max=16.0,
+                                       subtype="PIXEL", update=_changed,
                                        description="How many screen pixels a board texel or its error may grow to "
-                                                   "before the board is made again (seed eq. 9)")
-    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, update=_changed,
+                                                   "before the board is made again")
+    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096, soft_max=1024, update=_changed,
                                    description="Cycles samples per board")
     progressive: bpy.props.BoolProperty(
         name="Preview First", default=True, update=_changed,

@@ -7,7 +7,7 @@ from ...kernels.subdivision.loop import MAX_LEVELS
 from ..viewport import invalidator, with_update
 
 BOUNDARY_ITEMS = (
-    ("EDGE_ONLY", "Smooth", "Open borders follow Loop's boundary rules: a uniform cubic B-spline along the border"),
+    ("EDGE_ONLY", "Smooth", "Open borders are smoothed along the border, like a curve through its vertices"),
     ("EDGE_AND_CORNER", "Keep Corners",
      "As Smooth, and border vertices with a single face (the corners of a plane) stay where they are"),
 )
@@ -21,14 +21,15 @@ class LoopOptions:
     levels: bpy.props.IntProperty(
         name="Levels", description="Times every triangle is split in four (faces grow by 4^levels; 0: the "
         "triangulated mesh as it is, with its baked lighting)", default=2, min=0, max=MAX_LEVELS, soft_max=4)
-    boundary: bpy.props.EnumProperty(name="Boundary", items=BOUNDARY_ITEMS, default="EDGE_ONLY")
+    boundary: bpy.props.EnumProperty(name="Boundary", items=BOUNDARY_ITEMS, default="EDGE_ONLY",
+                                     description="What happens at the open borders of the mesh")
     use_creases: bpy.props.BoolProperty(
         name="Creases", default=True,
         description="Edges marked sharp and edges with crease 1 stay sharp; smaller creases soften over the "
-                    "levels, as in OpenSubdiv and Blender's Subdivision Surface; vertex creases make corners")
+                    "levels, as in Blender's Subdivision Surface; vertex creases make corners")
     use_baked_lighting: bpy.props.BoolProperty(
         name="Baked Lighting", default=True,
-        description=f"Where the mesh has lighting baked by Bake Lighting to HCE, write it at the new level as the "
+        description=f"Where the mesh has lighting baked by Bake Lighting, write it at the new level as the "
                     f"colour attribute {BAKED_COLOUR!r}")
 
 

@@ -8,6 +8,7 @@ from them; `draw_surface_options` shows the chosen surface's parameters only.
 Adaptive curves: `CurveOptions`, made into the kernel's `CurveSampling` by `curve_sampling`."""
 
 import dataclasses
+import math
 
 import bpy
 
@@ -22,10 +23,10 @@ from ..viewport import invalidator, with_update
 
 #: (identifier, label, description) of each surface, in menu order.
 SURFACE_ITEMS = (
-    ("SPHERE", "Sphere", "The seed's sphere (eq. 2-1)"),
-    ("CONE", "Cone", "The seed's cone (eq. 2-2), open at its base"),
-    ("TORUS", "Torus", "The seed's torus (eq. 2-3)"),
-    ("STEINER", "Steiner's Roman Surface", "Eq. 2-4 as coded (the printed y is a typo): the projective plane"),
+    ("SPHERE", "Sphere", "A sphere, closed at its poles"),
+    ("CONE", "Cone", "A cone, open at its base"),
+    ("TORUS", "Torus", "A ring-shaped tube"),
+    ("STEINER", "Steiner's Roman Surface", "A closed surface that passes through itself (a projective plane)"),
     ("KLEIN", "Klein Bottle", "The figure-8 Klein bottle"),
     ("MOBIUS", "Möbius Band", "A band with a half twist"),
     ("TREFOIL", "Trefoil Knot Tube", "A tube around the trefoil knot"),
@@ -45,14 +46,18 @@ def _parameters():
 
 def _annotations():
     out = {
-        "surface": bpy.props.EnumProperty(name="Surface", items=SURFACE_ITEMS, default="TORUS"),
+        "surface": bpy.props.EnumProperty(name="Surface", items=SURFACE_ITEMS, default="TORUS",
+                                          description="Which surface to make"),
         "factor": bpy.props.IntProperty(name="Factor", default=32, min=1, max=MAX_FACTOR,
-                                        description="Quads along each side of the domain (2F² triangles, as a "
-                                                    "hardware tessellator makes them)"),
+                                        description="Quads along each side of the surface's grid (2 × Factor² "
+                                                    "triangles)"),
     }
     for name, _, f in _parameters():
-        out[name] = bpy.props.FloatProperty(name=f.name.replace("_", " ").title(), default=f.default,
-                                            min=1e-6, max=MAX_WORLD_VALUE, soft_max=10.0)
+        length = f.metadata.get("unit") == "LENGTH"
+        out[name] = bpy.props.FloatProperty(name=f.metadata["label"], description=f.metadata["description"],
+                                            default=f.default, min=1e-6, max=MAX_WORLD_VALUE, soft_max=10.0,
+                                            subtype="DISTANCE" if length else "NONE",
+                                            unit="LENGTH" if length else "NONE")
     return out
 
 
@@ -80,10 +85,12 @@ class TESSERA_PG_surfaces(bpy.types.PropertyGroup):
             description="A mesh whose vertices are control points: one surface at each (none: one surface at this "
                         "object's origin)"),
         "factor_mode": bpy.props.EnumProperty(name="Factor From", default="FIXED", update=_changed, items=(
-            ("FIXED", "Fixed", "Every instance at Factor"),
-            ("CAMERA", "Camera", "Each instance's factor from its size on screen (Edge Pixels a segment)"))),
+            ("FIXED", "Fixed", "Every copy at Factor"),
+            ("CAMERA", "Camera", "Each copy's factor from its size on screen (Edge Pixels a segment)")),
+            description="A fixed factor, or a factor per copy from how large it looks"),
         "edge_pixels": bpy.props.FloatProperty(name="Edge Pixels", default=8.0, min=0.5, max=MAX_PIXELS,
-                                               update=_changed, description="Segment length on screen"),
+                                               soft_max=100.0, subtype="PIXEL", update=_changed,
+                                               description="Target segment length on screen"),
     }
 
 
@@ -111,8 +118,8 @@ def draw_surface_options(layout, options):
 
 
 CURVE_MODE_ITEMS = (
-    ("CURVATURE", "Curvature", "Segments per Bézier segment from its control polygon's curvature (seed eq. 4.5: "
-                               "6 for a straight one, up to Max Segments)"),
+    ("CURVATURE", "Curvature", "Segments by how much each Bézier segment bends: 6 where straight, up to Max "
+                               "Segments"),
     ("TOLERANCE", "Tolerance", "As many segments as keep the polyline within Tolerance of the curve"),
     ("SCREEN", "Screen", "As many segments as keep the polyline within Pixels of the curve for the camera"),
 )
@@ -121,19 +128,25 @@ CURVE_MODE_ITEMS = (
 class CurveOptions:
     """The options of ``tessera.curve_adaptive`` (`kernels.common.bezier_curves.CurveSampling`)."""
 
-    mode: bpy.props.EnumProperty(name="Sampling", items=CURVE_MODE_ITEMS, default="CURVATURE")
-    max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024,
-                                        description="Most segments one Bézier segment gets (the seed's 32)")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=0.01, min=1e-9, max=MAX_WORLD_VALUE,
-                                       subtype="DISTANCE", description="Largest distance from the curve")
-    pixels: bpy.props.FloatProperty(name="Pixels", default=1.0, min=0.01, max=MAX_PIXELS,
-                                    description="Largest distance from the curve on screen")
-    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
-    copies: bpy.props.IntProperty(name="Copies", default=1, min=1, max=1000,
-                                  description="Polylines per spline, each moved by Copy Offset × k / Copies "
-                                              "(the seed's hair copies)")
+    mode: bpy.props.EnumProperty(name="Sampling", items=CURVE_MODE_ITEMS, default="CURVATURE",
+                                 description="What decides how many segments each Bézier segment gets")
+    max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024, soft_max=128,
+                                        description="Most segments one Bézier segment gets")
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=0.01, min=1e-9, max=MAX_WORLD_VALUE, soft_max=1.0,
+                                       subtype="DISTANCE", unit="LENGTH",
+                                       description="Largest distance between the polyline and the curve")
+    pixels: bpy.props.FloatProperty(name="Pixels", default=1.0, min=0.01, max=MAX_PIXELS, soft_max=16.0,
+                                    subtype="PIXEL",
+                                    description="Largest distance between the polyline and the curve on screen")
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
+                                          description="Whose view the Pixels are measured in")
+    copies: bpy.props.IntProperty(name="Copies", default=1, min=1, max=1000, soft_max=100,
+                                  description="Polylines per spline (hair-like strands), copy k moved by Copy Offset × "
+                                              "k / Copies")
     copy_offset: bpy.props.FloatVectorProperty(name="Copy Offset", default=(0.0, 0.0, 0.1), size=3,
-                                               min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE, subtype="TRANSLATION")
+                                               min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE, soft_min=-10.0,
+                                               soft_max=10.0, subtype="TRANSLATION", unit="LENGTH",
+                                               description="How far the last copy is moved from the first")
 
 
 def curve_sampling(options):
@@ -159,41 +172,51 @@ def draw_curve_options(layout, options):
 
 
 FIELD_ITEMS = (
-    ("ABC", "ABC Flow", "The Arnold-Beltrami-Childress flow on a slice of its periodic cube"),
+    ("ABC", "ABC Flow", "A classic swirling 3-D flow, seen on one slice"),
     ("VORTEX", "Vortex", "A smooth vortex round the centre"),
     ("MESH", "Grid Mesh", "Vectors of a point attribute on a grid mesh object (its x and y, over its area)"),
 )
 BACKEND_ITEMS = (
-    ("AUTO", "Auto", "The GPU where a GPU context can be made (a compute shader), else numpy"),
-    ("GPU", "GPU", "Blender's GPU module: advection by compute shader, additive point splats"),
-    ("CPU", "CPU", "The numpy reference"),
+    ("AUTO", "Auto", "The GPU where Blender can use one, else the CPU"),
+    ("GPU", "GPU", "The GPU (an error where Blender cannot use one)"),
+    ("CPU", "CPU", "The CPU"),
 )
 
 
 class FieldOptions:
     """The options of ``tessera.vector_field_texture``."""
 
-    field: bpy.props.EnumProperty(name="Field", items=FIELD_ITEMS, default="ABC")
+    field: bpy.props.EnumProperty(name="Field", items=FIELD_ITEMS, default="ABC",
+                                  description="The flow the texture follows")
     field_object: bpy.props.StringProperty(name="Grid Object", description="Mesh object whose grid holds the field")
     attribute: bpy.props.StringProperty(name="Attribute", default="velocity",
                                         description="Vector point attribute of the grid holding the field")
     slice_z: bpy.props.FloatProperty(name="Slice", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                     description="z of the ABC flow's slice (radians of its 2π-periodic cube)")
-    speed: bpy.props.FloatProperty(name="Speed", default=1.0, min=-1e6, max=1e6, description="Velocity factor")
-    width: bpy.props.IntProperty(name="Width", default=512, min=8, max=8192)
-    height: bpy.props.IntProperty(name="Height", default=512, min=8, max=8192)
-    seeds: bpy.props.IntProperty(name="Seeds", default=128, min=1, max=4096,
-                                 description="Seed points per side when the camera is far (up to 4 times more near)")
-    near: bpy.props.FloatProperty(name="Near", default=2.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE",
-                                  description="Camera distance at and below which the seeds are densest")
-    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE",
-                                 description="Camera distance at and beyond which the seeds are sparsest")
-    step: bpy.props.FloatProperty(name="Step", default=0.002, min=1e-6, max=1.0,
-                                  description="Euler step h (domain units: the texture is 1 across)")
-    steps: bpy.props.IntProperty(name="Steps", default=40, min=1, max=10000, description="Euler steps per seed")
-    noise_seed: bpy.props.IntProperty(name="Noise Seed", default=0, min=0, max=2**31 - 1)
-    backend: bpy.props.EnumProperty(name="Evaluate On", items=BACKEND_ITEMS, default="AUTO")
-
+                                     soft_min=0.0, soft_max=2.0 * math.pi, subtype="ANGLE",
+                                     description="Where the ABC flow is sliced (it repeats every full turn)")
+    speed: bpy.props.FloatProperty(name="Speed", default=1.0, min=-1e6, max=1e6, soft_min=-10.0, soft_max=10.0,
+                                   description="Multiplies the field's vectors: how far the streaks reach")
+    width: bpy.props.IntProperty(name="Width", default=512, min=8, max=8192, subtype="PIXEL",
+                                 description="Width of the texture")
+    height: bpy.props.IntProperty(name="Height", default=512, min=8, max=8192, subtype="PIXEL",
+                                  description="Height of the texture")
+    seeds: bpy.props.IntProperty(name="Seeds", default=128, min=1, max=4096, soft_max=1024,
+                                 description="Streak starting points per side when the camera is far (up to 4 times "
+                                             "more when near)")
+    near: bpy.props.FloatProperty(name="Near", default=2.0, min=0.0, max=MAX_WORLD_VALUE, soft_max=1000.0,
+                                  subtype="DISTANCE", unit="LENGTH",
+                                  description="Camera distance at and below which the streaks are densest")
+    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, soft_max=1000.0,
+                                 subtype="DISTANCE", unit="LENGTH",
+                                 description="Camera distance at and beyond which the streaks are sparsest")
+    step: bpy.props.FloatProperty(name="Step", default=0.002, min=1e-6, max=1.0, soft_max=0.05, precision=4,
+                                  description="How far a streak moves per step, as a fraction of the texture's width")
+    steps: bpy.props.IntProperty(name="Steps", default=40, min=1, max=10000, soft_max=500,
+                                 description="Steps per streak: its length is Steps × Step")
+    noise_seed: bpy.props.IntProperty(name="Noise Seed", default=0, min=0, max=2**31 - 1, soft_max=10000,
+                                      description="Another seed gives another pattern of streaks")
+    backend: bpy.props.EnumProperty(name="Evaluate On", items=BACKEND_ITEMS, default="AUTO",
+                                    description="Where the texture is computed")
 
 def draw_field_options(layout, options):
     layout.use_property_split = True
@@ -211,10 +234,10 @@ def draw_field_options(layout, options):
 
 
 PATCH_METRIC_ITEMS = (
-    ("CURVATURE", "Curvature", "From the control nets' curvature (seed eq. 4.5 on rows, columns, diagonals)"),
+    ("CURVATURE", "Curvature", "From how much each patch bends along its rows, columns and diagonals"),
     ("DISTANCE", "Distance", "From the camera distance: sides from their nearest control point, the inside from the "
-                             "net's centroid"),
-    ("EDGE_LENGTH", "Edge Length", "From each side's projected length for the camera, Edge Pixels a segment"),
+                             "patch's centre"),
+    ("EDGE_LENGTH", "Edge Length", "From each side's length on screen, Edge Pixels a segment"),
 )
 
 
@@ -224,22 +247,31 @@ class PatchOptions:
     metrics: bpy.props.EnumProperty(name="Metrics", items=PATCH_METRIC_ITEMS, default={"CURVATURE"},
                                     options={"ENUM_FLAG"}, description="Levels from these, the largest wins")
     max_level: bpy.props.IntProperty(name="Max Level", default=32, min=1, max=64,
-                                     description="Most segments on a side or inside (the seed's 32)")
+                                     description="Most segments on a side or inside a patch")
     inner_rows: bpy.props.EnumProperty(name="Inner Curvature", default="ALL", items=(
-        ("ALL", "All Rows", "Every row and column of the net (seed §4.1.2)"),
-        ("INTERIOR", "Interior Rows", "Only the net's two inner rows and columns (seed §5.3.3)")))
+        ("ALL", "All Rows", "Every row and column of the control net"),
+        ("INTERIOR", "Interior Rows", "Only the control net's two inner rows and columns")),
+        description="Which rows of a patch's control net set the level inside it")
     degenerate: bpy.props.EnumProperty(name="Collapsed Rows", default="CAP", items=(
-        ("CAP", "Cap", "A row of the net that is one point counts as the most curved (the seed's behaviour)"),
-        ("ZERO", "Flat", "Such a row counts as straight")))
-    near: bpy.props.FloatProperty(name="Near", default=1.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE")
-    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE")
+        ("CAP", "Cap", "A row of the net that is one point (a pole) counts as the most curved: poles get the most "
+                       "detail"),
+        ("ZERO", "Flat", "Such a row counts as straight")),
+        description="How a row of the control net that collapses to one point (a pole) counts")
+    near: bpy.props.FloatProperty(name="Near", default=1.0, min=0.0, max=MAX_WORLD_VALUE, soft_max=1000.0,
+                                  subtype="DISTANCE", unit="LENGTH",
+                                  description="Camera distance that gets Max Level")
+    far: bpy.props.FloatProperty(name="Far", default=20.0, min=1e-4, max=MAX_WORLD_VALUE, soft_max=1000.0,
+                                 subtype="DISTANCE", unit="LENGTH",
+                                 description="Camera distance beyond which the level is 1")
     mapping: bpy.props.EnumProperty(name="Distance Map", default="LINEAR", items=(
         ("LINEAR", "Linear", "Max Level at Near, falling linearly to 1 at Far"),
-        ("INVERSE", "Inverse", "Like a z-buffer: more levels near the camera")))
-    edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", default=10.0, min=0.5, max=MAX_PIXELS,
+        ("INVERSE", "Inverse", "Like a z-buffer: more levels near the camera")),
+        description="How the level falls from Near to Far")
+    edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", default=10.0, min=0.5, max=MAX_PIXELS, soft_max=100.0,
+                                         subtype="PIXEL",
                                          description="Segment length on screen for the Edge Length metric")
-    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
-
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
+                                          description="Whose view sets the levels")
 
 def patch_lod(options):
     if not options.metrics:

@@ -31,7 +31,7 @@ maps, and heights at the file's own precision (the group reads what Blender's im
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Terrain"
-VERSION = 1
+VERSION = 2
 #: The largest level (quads a tile side), the kernel's `kernels.common.partition.MAX_LEVEL`.
 MAX_LEVEL = 64
 _TILE = ("tessera_x0", "tessera_y0", "tessera_wx", "tessera_wy", "tessera_r", "tessera_bottom", "tessera_right",
@@ -43,18 +43,18 @@ def _interface(tree):
     socket(tree, "Geometry", "NodeSocketGeometry", description="Not used: the terrain replaces it")
     socket(tree, "Image", "NodeSocketImage", description="The height map (first channel; set its colour space "
                                                          "to Non-Color)")
-    socket(tree, "Texel Size", "NodeSocketFloat", default=1.0, min_value=1e-6,
+    socket(tree, "Texel Size", "NodeSocketFloat", default=1.0, min_value=1e-6, subtype="DISTANCE",
            description="Distance between neighbouring samples")
-    socket(tree, "Height Scale", "NodeSocketFloat", default=100.0,
+    socket(tree, "Height Scale", "NodeSocketFloat", default=100.0, subtype="DISTANCE",
            description="Height of a full-scale sample (1.0 in the image)")
-    socket(tree, "Tile Size", "NodeSocketInt", default=64, min_value=2, max_value=1024,
+    socket(tree, "Tile Size", "NodeSocketInt", default=64, min_value=2, max_value=1024, subtype="PIXEL",
            description="Texels per tile side")
     socket(tree, "Level Mode", "NodeSocketMenu",
-           description="Distance: finer near the scene's active camera (seed 000 §5.5, without the height "
-                       "analysis); Uniform: Max Level everywhere")
+           description="Distance: finer near the scene's active camera (without the roughness analysis of "
+                       "Bake Terrain); Uniform: Max Level everywhere")
     socket(tree, "Max Level", "NodeSocketInt", default=MAX_LEVEL, min_value=1, max_value=MAX_LEVEL,
            description="Quads per tile side at most (capped by the tile size)")
-    socket(tree, "Full-Detail Distance", "NodeSocketFloat", default=100.0, min_value=1e-6,
+    socket(tree, "Full-Detail Distance", "NodeSocketFloat", default=100.0, min_value=1e-6, subtype="DISTANCE",
            description="Distance from the camera within which tiles get Max Level; beyond, the level falls with "
                        "the square of the distance")
     socket(tree, "UV Map", "NodeSocketString", default="UVMap", description="Name of the UVs (X/(W-1), Y/(H-1))")
@@ -223,4 +223,6 @@ def _build(tree):
     tree.links.new(g.remove(mesh, (*_TILE, _BORDER, "tessera_texel")), b.go.inputs[0])
 
 
-SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Terrain"))
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Terrain",
+                                description="Build a crack-free terrain mesh from a height-map image, finer near "
+                                            "the camera"))

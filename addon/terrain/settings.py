@@ -10,66 +10,80 @@ from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator, with_update
 
 SOURCE_ITEMS = (
-    ("FILE", "File", "PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw r16/r32 read with OpenImageIO"),
-    ("IMAGE", "Image", "A Blender image (its first channel)"),
+    ("FILE", "File", "PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw .r16/.r32 files"),
+    ("IMAGE", "Image", "An image in this Blender file (its first channel)"),
 )
 MODE_ITEMS = (
-    ("OURS", "Adaptive", "Edge levels between T_min (screen-space error) and T_max (height acceleration)"),
-    ("DISTANCE", "Distance Only", "The distance law without T_max (refines flat ground too)"),
-    ("UNIFORM", "Uniform", "Maximum level everywhere (one quad per texel at level 64)"),
+    ("OURS", "Adaptive", "Detail where the ground is rough, as much as the screen error needs and no more"),
+    ("DISTANCE", "Distance Only", "Detail falls with camera distance alone (flat ground is refined too)"),
+    ("UNIFORM", "Uniform", "The most detail everywhere (one quad per texel)"),
 )
 G_ITEMS = (
-    ("SQRT", "Square Root", "T_max = k·sqrt(HAM max)"),
-    ("LOG", "Logarithm", "T_max = 1 + k·log2(1 + HAM max)"),
+    ("SQRT", "Square Root", "The most detail grows with the square root of the roughness"),
+    ("LOG", "Logarithm", "The most detail grows slowly, with the logarithm of the roughness"),
 )
 T_MIN_ITEMS = (
-    ("SEARCH", "Search", "Smallest power of two that brings each tile's peak within the error (seed Fig. 5.4)"),
-    ("LOG2", "log2(ĥ/ε)", "The corrected closed form"),
-    ("PRINTED", "log2(ε/ĥ) (as printed)", "Eq. 5-4 exactly as printed (it never refines: for comparison)"),
+    ("SEARCH", "Search", "The coarsest power-of-two grid that keeps each tile's peak within the error (exact)"),
+    ("LOG2", "Closed Form", "A formula from the peak's height and the error (faster, approximate)"),
+    ("PRINTED", "Reversed Closed Form", "The formula with its ratio reversed: never adds detail (for comparisons)"),
 )
 LEVEL_ITEMS = (
-    ("POW2", "Powers of Two", "Vertices land on texels and stay put as levels change (no 'wave')"),
+    ("POW2", "Powers of Two", "Vertices land on texels and stay put as levels change (no swimming)"),
     ("INTEGER", "Integer", "Whole levels"),
-    ("FRACTIONAL", "Fractional", "Continuous levels (fractional-even spacing): no popping while the camera moves"),
+    ("FRACTIONAL", "Fractional", "Continuous levels: the mesh changes smoothly, no popping while the camera moves"),
 )
 
 
 class TerrainOptions:
     """The terrain options, declared once: ``tessera.terrain_add`` inherits them as they are, and
     `TESSERA_PG_terrain` (``Object.tessera.terrain``) takes them with the preview's invalidation added
-    (`with_update`)."""
+    (`with_update`). The identifiers ``g`` and ``ham_scale`` (the roughness curve and scale) are stored in files."""
 
-    source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE")
-    filepath: bpy.props.StringProperty(name="Height Map", subtype="FILE_PATH")
+    source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE",
+                                   description="Read the heights from a file or from an image in this Blender file")
+    filepath: bpy.props.StringProperty(name="Height Map", subtype="FILE_PATH",
+                                       description="The height map file (PNG, TIFF, EXR, or raw .r16/.r32)")
     image_name: bpy.props.StringProperty(name="Image", description="Blender image with the heights")
-    raw_width: bpy.props.IntProperty(name="Raw Width", default=0, min=0, description="Samples per row (raw files)")
-    raw_height: bpy.props.IntProperty(name="Raw Height", default=0, min=0, description="Rows (raw files)")
+    raw_width: bpy.props.IntProperty(name="Raw Width", default=0, min=0, soft_max=65536, subtype="PIXEL",
+                                     description="Samples per row of a raw .r16/.r32 file")
+    raw_height: bpy.props.IntProperty(name="Raw Height", default=0, min=0, soft_max=65536, subtype="PIXEL",
+                                      description="Rows of a raw .r16/.r32 file")
     texel_size: bpy.props.FloatProperty(name="Texel Size", default=1.0, min=1e-6, max=MAX_WORLD_VALUE,
-                                        subtype="DISTANCE",
+                                        soft_max=100.0, subtype="DISTANCE", unit="LENGTH",
                                         description="Distance between neighbouring samples")
     height_scale: bpy.props.FloatProperty(name="Height Scale", default=100.0, min=-MAX_WORLD_VALUE,
-                                          max=MAX_WORLD_VALUE, subtype="DISTANCE",
+                                          max=MAX_WORLD_VALUE, soft_min=-10000.0, soft_max=10000.0,
+                                          subtype="DISTANCE", unit="LENGTH",
                                           description="Height of a full-scale integer sample (255 or 65535); "
                                           "the factor on float samples")
     height_offset: bpy.props.FloatProperty(name="Height Offset", default=0.0, min=-MAX_WORLD_VALUE,
-                                           max=MAX_WORLD_VALUE, subtype="DISTANCE")
-    tile_size: bpy.props.IntProperty(name="Tile Size", default=64, min=2, max=1024,
-                                     description="Texels per tile side (64: one quad per texel at level 64)")
-    mode: bpy.props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS")
-    g: bpy.props.EnumProperty(name="T_max From HAM", items=G_ITEMS, default="SQRT")
-    ham_scale: bpy.props.FloatProperty(name="HAM Scale", default=4.0, min=1e-3, max=MAX_FACTOR, soft_max=64.0,
-                                       description="k in the T_max function")
-    epsilon: bpy.props.FloatProperty(name="Error (px)", default=3.0, min=0.05, max=MAX_PIXELS, soft_max=32.0,
-                                     description="Allowed screen-space error of a tile's peak")
-    t_min_rule: bpy.props.EnumProperty(name="T_min Rule", items=T_MIN_ITEMS, default="SEARCH")
+                                           max=MAX_WORLD_VALUE, soft_min=-10000.0, soft_max=10000.0,
+                                           subtype="DISTANCE", unit="LENGTH", description="Added to every height")
+    tile_size: bpy.props.IntProperty(name="Tile Size", default=64, min=2, max=1024, subtype="PIXEL",
+                                     description="Texels per tile side (64: one quad per texel at the most detail)")
+    mode: bpy.props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS",
+                                 description="What decides how much detail each tile gets")
+    g: bpy.props.EnumProperty(name="Roughness Curve", items=G_ITEMS, default="SQRT",
+                              description="How a tile's most detail grows with its roughness (how sharply its slope "
+                                          "changes)")
+    ham_scale: bpy.props.FloatProperty(name="Roughness Scale", default=4.0, min=1e-3, max=MAX_FACTOR, soft_max=64.0,
+                                       description="How much detail roughness buys (a factor in the Roughness Curve)")
+    epsilon: bpy.props.FloatProperty(name="Screen Error", default=3.0, min=0.05, max=MAX_PIXELS, soft_max=32.0,
+                                     subtype="PIXEL",
+                                     description="Largest error allowed on screen: how far a tile's peak may be drawn "
+                                                 "from its true height")
+    t_min_rule: bpy.props.EnumProperty(name="Error Rule", items=T_MIN_ITEMS, default="SEARCH",
+                                       description="How the least detail that keeps the Screen Error is found")
     d_max: bpy.props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, max=MAX_WORLD_VALUE,
-                                   subtype="DISTANCE",
-                                   description="Below this distance tiles get T_max (0: where a texel spans "
-                                   "4 pixels)")
-    levels: bpy.props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2")
+                                   soft_max=10000.0, subtype="DISTANCE", unit="LENGTH",
+                                   description="Closer than this, tiles get their most detail (0: where a texel "
+                                   "spans 4 pixels)")
+    levels: bpy.props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2",
+                                   description="Which levels tiles may take")
     culling: bpy.props.BoolProperty(name="Frustum Culling", default=True,
                                     description="Drop tiles outside the camera's view")
-    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
+                                          description="Whose view sets the detail")
 
 
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.

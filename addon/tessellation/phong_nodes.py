@@ -16,13 +16,13 @@ from ..node_groups import Graph, GroupSpec, register_group
 from .surface_nodes import CORNER_NORMAL, set_shading, surface_interface
 
 GROUP_NAME = "Tessera Phong"
-VERSION = 4
+VERSION = 5
 
 
 def _build(tree):
     g = Graph(tree)
-    gi, go, coarse, normal = surface_interface(g, 0.75, "0: flat triangles; 1: full Phong tessellation (0.75 as "
-                                                        "in the paper); a field, so it can vary per vertex")
+    gi, go, coarse, normal = surface_interface(g, 0.75, "0: flat triangles; 1: fully rounded (0.75 by default); "
+                                                        "a field, so it can vary per vertex")
     position = g.node("GeometryNodeInputPosition").outputs[0]
     n = g.split(normal)
     diag = g.vec("MULTIPLY", normal, normal)  # (nx nx, ny ny, nz nz)
@@ -52,4 +52,6 @@ def _build(tree):
     tree.links.new(g.remove(shaded, (*names, CORNER_NORMAL)), go.inputs[0])
 
 
-SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation"))
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation",
+                                description="Smooth a mesh with Phong tessellation: finer faces that bulge toward "
+                                            "the vertex normals"))

@@ -17,7 +17,7 @@ from ..node_groups import Graph, GroupSpec, register_group
 from .surface_nodes import CORNER_NORMAL, set_shading, surface_interface
 
 GROUP_NAME = "Tessera PN Triangles"
-VERSION = 3
+VERSION = 4
 _CONTROL = [f"tessera_pn_{i}" for i in range(10)]  # order of cubic_basis: P1 P2 P3 b210 b120 b021 b012 b102 b201 b111
 _NORMAL_CONTROL = [f"tessera_pn_n{i}" for i in range(6)]  # order of quadratic_basis: N1 N2 N3 n110 n011 n101
 _BARY = "tessera_pn_bary"
@@ -106,4 +106,6 @@ def _product(g, factors):
     return out
 
 
-SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation"))
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tessellation",
+                                description="Smooth a mesh with PN triangles: finer faces on a cubic surface "
+                                            "shaped by the vertex normals"))

@@ -16,16 +16,16 @@ from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator
 
 METHOD_ITEMS = (
-    ("PN", "PN Triangles", "Cubic Bézier patches from positions and normals (smoothest; Vlachos et al.)"),
-    ("PHONG", "Phong", "Phong tessellation: quadratic, cheapest curved surface (Boubekeur and Alexa)"),
+    ("PN", "PN Triangles", "A smooth cubic surface through the corners, shaped by the vertex normals (smoothest)"),
+    ("PHONG", "Phong", "A rounded surface that bulges toward the vertex normals (fastest curved method)"),
     ("LINEAR", "Linear", "New vertices on the flat triangles: same shape, more vertices"),
 )
 LEVEL_MODE_ITEMS = (
     ("UNIFORM", "Uniform", "The same level on every edge"),
-    ("ADAPTIVE", "Adaptive", "Per-edge levels from the chosen metrics (crack-free)"),
+    ("ADAPTIVE", "Adaptive", "Each edge gets its own level from the chosen metrics; no cracks between levels"),
 )
 SPACING_ITEMS = (
-    ("EQUAL", "Equal", "Level rounded up to a whole number of equal segments"),
+    ("EQUAL", "Equal", "The level rounded up to a whole number of equal segments"),
     ("FRACTIONAL_EVEN", "Fractional Even", "Even segment counts; vertices slide continuously as the level changes"),
 )
 NORMAL_MODE_ITEMS = (
@@ -41,11 +41,11 @@ METRIC_ITEMS = (
     ("PROJECTED", "Edge Length", "Split edges longer than a number of pixels on screen"),
     ("DISTANCE", "Distance", "More levels near the camera"),
     ("SILHOUETTE", "Silhouette", "Refine edges on the silhouette seen from the camera"),
-    ("CURVATURE", "Curvature", "Refine where the PN control net bends (no camera needed)"),
+    ("CURVATURE", "Curvature", "Refine where the surface bends (no camera needed)"),
 )
 POWER_ITEMS = (
     ("NONE", "None", "Keep levels as computed"),
-    ("CEIL", "Up", "Round up to a power of two (fewer T-junction patterns, more triangles)"),
+    ("CEIL", "Up", "Round up to a power of two (fewer distinct patterns, more triangles)"),
     ("FLOOR", "Down", "Round down to a power of two"),
     ("NEAREST", "Nearest", "Round to the nearest power of two (in log scale)"),
 )
@@ -54,7 +54,7 @@ DISTANCE_MAP_ITEMS = (
     ("INVERSE", "Inverse", "Level falls like a z-buffer: most detail close to the camera"),
 )
 EVALUATE_ITEMS = (
-    ("CPU", "CPU", "Evaluate the surface with the numpy kernels"),
+    ("CPU", "CPU", "Evaluate the surface on the CPU"),
     ("GPU", "GPU", "Evaluate the surface with a compute shader (same surface; falls back to the CPU without a GPU)"),
 )
 OUTPUT_ITEMS = (
@@ -67,40 +67,54 @@ class TessellateOptions:
     """The tessellation options, declared once: the operator ``tessera.tessellate`` and `TESSERA_PG_tessellation`
     (``Object.tessera.tessellate``) both inherit them."""
 
-    method: bpy.props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN")
-    level_mode: bpy.props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM")
+    method: bpy.props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN",
+                                   description="How the new vertices are placed: on a curved surface or the flat "
+                                               "triangles")
+    level_mode: bpy.props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM",
+                                       description="One level everywhere, or a level per edge from what the camera "
+                                                   "sees and how the surface bends")
     level: bpy.props.FloatProperty(
         name="Level", description="Segments per edge (and inner level) for every triangle",
         default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2)
-    spacing: bpy.props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL")
+    spacing: bpy.props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL",
+                                    description="How a fractional level splits an edge")
     alpha: bpy.props.FloatProperty(
-        name="Shape Factor", description="Phong shape factor: 0 flat, 1 full projection (the seed), 0.75 default",
-        default=0.75, soft_min=0.0, soft_max=1.0, min=-1.0, max=2.0)
+        name="Shape Factor", description="How far the surface bulges toward the normals: 0 flat, 1 fully rounded",
+        default=0.75, soft_min=0.0, soft_max=1.0, min=-1.0, max=2.0, subtype="FACTOR")
     alpha_attribute: bpy.props.StringProperty(
         name="Shape Attribute", description="Float point attribute with a per-vertex shape factor (optional)")
-    normal_mode: bpy.props.EnumProperty(name="Sharp Edges", items=NORMAL_MODE_ITEMS, default="WATERTIGHT")
-    pn_normals: bpy.props.EnumProperty(name="PN Normals", items=PN_NORMAL_ITEMS, default="QUADRATIC")
+    normal_mode: bpy.props.EnumProperty(name="Sharp Edges", items=NORMAL_MODE_ITEMS, default="WATERTIGHT",
+                                        description="What the curved surface does at sharp edges and flat faces")
+    pn_normals: bpy.props.EnumProperty(name="PN Normals", items=PN_NORMAL_ITEMS, default="QUADRATIC",
+                                       description="How shading normals vary across each PN triangle")
     metrics: bpy.props.EnumProperty(name="Metrics", items=METRIC_ITEMS, options={"ENUM_FLAG"},
-                                    default={"PROJECTED"})
-    max_level: bpy.props.FloatProperty(name="Max Level", description="Cap for adaptive levels",
+                                    default={"PROJECTED"},
+                                    description="What sets each edge's level; with several, the highest level wins")
+    max_level: bpy.props.FloatProperty(name="Max Level", description="The highest level an edge can get",
                                        default=16.0, min=1.0, max=float(MAX_LEVEL))
-    power_of_two: bpy.props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE")
+    power_of_two: bpy.props.EnumProperty(name="Power of Two", items=POWER_ITEMS, default="NONE",
+                                         description="Round the levels to powers of two")
     edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", description="Target edge length on screen",
                                          default=10.0, min=0.5, max=MAX_PIXELS, soft_max=100.0, subtype="PIXEL")
-    distance_map: bpy.props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR")
-    near: bpy.props.FloatProperty(name="Near", description="Distance that gets the maximum level",
-                                  default=1.0, min=1e-4, max=MAX_WORLD_VALUE, subtype="DISTANCE", unit="LENGTH")
-    far: bpy.props.FloatProperty(name="Far", description="Distance beyond which the level is 1",
-                                 default=20.0, min=1e-3, max=MAX_WORLD_VALUE, subtype="DISTANCE", unit="LENGTH")
+    distance_map: bpy.props.EnumProperty(name="Distance Map", items=DISTANCE_MAP_ITEMS, default="LINEAR",
+                                         description="How the level falls from Near to Far")
+    near: bpy.props.FloatProperty(name="Near", description="Camera distance that gets the maximum level",
+                                  default=1.0, min=1e-4, max=MAX_WORLD_VALUE, soft_max=1000.0, subtype="DISTANCE",
+                                  unit="LENGTH")
+    far: bpy.props.FloatProperty(name="Far", description="Camera distance beyond which the level is 1",
+                                 default=20.0, min=1e-3, max=MAX_WORLD_VALUE, soft_max=1000.0, subtype="DISTANCE",
+                                 unit="LENGTH")
     silhouette_beta: bpy.props.FloatProperty(
-        name="Silhouette Ramp", description="How far inside a silhouette triangle extra levels reach (beta)",
-        default=0.25, min=1e-4, max=1.0)
+        name="Silhouette Ramp", description="How far into a triangle on the silhouette the extra detail reaches",
+        default=0.25, min=1e-4, max=1.0, subtype="FACTOR")
     curvature_gain: bpy.props.FloatProperty(name="Curvature Gain", description="Levels per unit of curvature",
                                             default=10.0, min=0.0, max=MAX_FACTOR, soft_max=50.0)
-    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
-    evaluate_on: bpy.props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU")
-    output: bpy.props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT")
-
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
+                                          description="Whose view sets the levels")
+    evaluate_on: bpy.props.EnumProperty(name="Evaluate On", items=EVALUATE_ITEMS, default="CPU",
+                                        description="Where the surface is computed (the same surface either way)")
+    output: bpy.props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT",
+                                   description="Make a new object, or replace this object's mesh")
 
 SETTING_NAMES = tuple(TessellateOptions.__annotations__)
 

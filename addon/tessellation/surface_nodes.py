@@ -38,6 +38,7 @@ def surface_interface(g, shape_default, shape_description):
     socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
            description="Subdivision levels of every face (Subdivide Mesh)")
     socket(tree, "Shape Factor", "NodeSocketFloat", default=shape_default, min_value=0.0, max_value=1.0,
+           subtype="FACTOR",
            description=shape_description)
     socket(tree, "Sharp Edges", "NodeSocketMenu",
            description="Watertight: one averaged normal per vertex, the mesh stays closed (shading stays sharp). "

@@ -23,25 +23,25 @@ from ..compat import set_node_mode
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Tubes"
-VERSION = 2
+VERSION = 3
 _TEMP = ("tessera_u", "tessera_pole")
 
 
 def _interface(tree):
     socket(tree, "Curve", "NodeSocketGeometry", description="The curves to sweep (Bezier and NURBS curves are "
                                                              "evaluated at their resolution first)")
-    socket(tree, "Radius", "NodeSocketFloat", default=0.05, min_value=0.0,
+    socket(tree, "Radius", "NodeSocketFloat", default=0.05, min_value=0.0, subtype="DISTANCE",
            description="Tube radius, multiplied by each point's curve radius (a field)")
     socket(tree, "Sides", "NodeSocketInt", default=8, min_value=3, max_value=1024,
            description="Vertices around each ring")
     socket(tree, "Caps", "NodeSocketMenu", description="How open tubes end: none, a flat n-gon or a hemisphere")
     socket(tree, "Pixel Clamp", "NodeSocketBool", default=False,
            description="Keep every tube at least one pixel thick for the scene's active camera (anti-aliasing)")
-    socket(tree, "Field of View", "NodeSocketFloat", default=math.radians(39.6), min_value=1e-4,
+    socket(tree, "Field of View", "NodeSocketFloat", default=math.radians(39.6), min_value=1e-4, subtype="ANGLE",
            max_value=math.pi - 1e-4, description="The camera's horizontal field of view, for the pixel clamp")
-    socket(tree, "Image Width", "NodeSocketInt", default=1920, min_value=1,
+    socket(tree, "Image Width", "NodeSocketInt", default=1920, min_value=1, subtype="PIXEL",
            description="Rendered image width in pixels, for the pixel clamp")
-    socket(tree, "Max Radius", "NodeSocketFloat", default=0.0, min_value=0.0,
+    socket(tree, "Max Radius", "NodeSocketFloat", default=0.0, min_value=0.0, subtype="DISTANCE",
            description="Largest radius the pixel clamp may inflate a tube to (0: no limit)")
     socket(tree, "UV Map", "NodeSocketString", default="UVMap",
            description="Name of the corner UVs to write (u along the curve, v around); empty: no UVs (faster)")
@@ -266,4 +266,5 @@ def _quad_uv(g, sides):
     return g.xyz(u, v, 0.0)
 
 
-SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tubes"))
+SPEC = register_group(GroupSpec(GROUP_NAME, VERSION, _build, catalog="Tessera/Tubes",
+                                description="Sweep curves into tube meshes with twist-free rings, caps and UVs"))

@@ -26,8 +26,8 @@ CAP_ITEMS = (
     ("ROUND", "Round", "A hemisphere on each end (closed, manifold)"),
 )
 REFINE_ITEMS = (
-    ("CENTRIPETAL", "Centripetal", "Catmull-Rom with centripetal knots: no cusps or loops inside a segment"),
-    ("UNIFORM", "Uniform", "Catmull-Rom with uniform knots (the classic spline)"),
+    ("CENTRIPETAL", "Centripetal", "Follows the points without cusps or loops inside a segment"),
+    ("UNIFORM", "Uniform", "The classic Catmull-Rom spline (can overshoot between uneven points)"),
 )
 
 
@@ -35,33 +35,44 @@ class TubeOptions:
     """The tube options, declared once: the operator ``tessera.tubes`` inherits them as they are, and
     `TESSERA_PG_tubes` (``Object.tessera.tubes``) takes them with the preview's invalidation added (`with_update`)."""
 
-    radius_source: bpy.props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT")
+    radius_source: bpy.props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT",
+                                          description="Where each point's tube radius comes from")
     radius: bpy.props.FloatProperty(name="Radius", description="Radius, or the factor on curve point radii",
-                                    default=0.05, min=0.0, max=MAX_WORLD_VALUE, soft_max=10.0, subtype="DISTANCE")
+                                    default=0.05, min=0.0, max=MAX_WORLD_VALUE, soft_max=10.0, subtype="DISTANCE",
+                                    unit="LENGTH")
     attribute: bpy.props.StringProperty(name="Attribute", description="Float point attribute with the radius",
                                         default="radius")
-    caps: bpy.props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT")
-    sides_mode: bpy.props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED")
-    sides: bpy.props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64)
-    min_sides: bpy.props.IntProperty(name="Min Sides", default=3, min=3, max=1024)
-    max_sides: bpy.props.IntProperty(name="Max Sides", default=32, min=3, max=1024)
-    edge_pixels: bpy.props.FloatProperty(name="Side Length (px)", description="Target length of a side on screen",
-                                         default=8.0, min=0.5, max=MAX_PIXELS, soft_max=64.0)
-    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE")
+    caps: bpy.props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT",
+                                 description="How the ends of open tubes are closed")
+    sides_mode: bpy.props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED",
+                                       description="A fixed number of sides, or fewer sides the smaller a tube looks")
+    sides: bpy.props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64,
+                                 description="Faces around every tube")
+    min_sides: bpy.props.IntProperty(name="Min Sides", default=3, min=3, max=1024, soft_max=64,
+                                     description="Fewest faces around a tube, however small it looks")
+    max_sides: bpy.props.IntProperty(name="Max Sides", default=32, min=3, max=1024, soft_max=64,
+                                     description="Most faces around a tube, however close it is")
+    edge_pixels: bpy.props.FloatProperty(name="Side Length", description="Target width of one side on screen",
+                                         default=8.0, min=0.5, max=MAX_PIXELS, soft_max=64.0, subtype="PIXEL")
+    camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
+                                          description="Whose view sets the sides and the pixel clamp")
     aa_clamp: bpy.props.BoolProperty(name="Pixel Clamp", default=False, description="Keep every tube at least "
                                      "one pixel in radius for the camera (thin tubes stay visible far away)")
     max_radius: bpy.props.FloatProperty(name="Max Clamp Radius", description="Cap of the clamp's inflation "
-                                        "(0: none)", default=0.0, min=0.0, max=MAX_WORLD_VALUE, subtype="DISTANCE")
-    refine: bpy.props.IntProperty(name="Refine", description="Catmull-Rom segments per input segment (1: off)",
-                                  default=1, min=1, max=64)
-    refine_kind: bpy.props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL")
+                                        "(0: none)", default=0.0, min=0.0, max=MAX_WORLD_VALUE, soft_max=10.0,
+                                        subtype="DISTANCE", unit="LENGTH")
+    refine: bpy.props.IntProperty(name="Refine", default=1, min=1, max=64,
+                                  description="Smooth sparse points: spline segments per input segment (1: off)")
+    refine_kind: bpy.props.EnumProperty(name="Spline", items=REFINE_ITEMS, default="CENTRIPETAL",
+                                         description="The spline through the points when Refine is above 1")
     select_angle: bpy.props.FloatProperty(name="Angle Tolerance", subtype="ANGLE", default=0.0, min=0.0,
                                           max=math.pi / 2, description="Keep a point only where the tangent has "
                                           "turned this much (0: keep all points)")
     uvs: bpy.props.BoolProperty(name="UVs", default=True, description="UV map: U along the tube, V around it")
-    curve_sampling: bpy.props.EnumProperty(name="Curve Sampling", default="RESOLUTION", items=(
+    curve_sampling: bpy.props.EnumProperty(name="Curve Sampling", default="RESOLUTION",
+                                           description="Where rings go along curve objects", items=(
         ("RESOLUTION", "Resolution", "Curve objects at Blender's own resolution (every segment the same)"),
-        ("CURVATURE", "Curvature", "Bézier segments from their curvature (seed eq. 4.5): 6 where straight, up to "
+        ("CURVATURE", "Curvature", "Bézier segments by how much they bend: 6 where straight, up to "
                                    "Max Segments in a bend")))
     max_segments: bpy.props.IntProperty(name="Max Segments", default=32, min=6, max=1024,
                                         description="Most segments a Bézier segment gets by curvature")

@@ -49,15 +49,16 @@ class HceTree:
         node) and the shapes agree."""
         k = len(self.subdivided)
         if k != 1 + 4 * int(np.count_nonzero(self.subdivided)):
-            raise InvalidInputError(f"An HCE tree with {np.count_nonzero(self.subdivided)} subdivided node(s) has "
-                                    f"{1 + 4 * np.count_nonzero(self.subdivided)} nodes, not {k}")
+            split = int(np.count_nonzero(self.subdivided))
+            raise InvalidInputError(f"A baked-lighting tree with {split} subdivided node(s) has {1 + 4 * split} "
+                                    f"nodes, not {k}")
         if self.colours.shape[:2] != (k, len(self.normals) + 1):
-            raise InvalidInputError(f"HCE colours have shape {self.colours.shape}; expected ({k}, "
+            raise InvalidInputError(f"Baked-lighting colours have shape {self.colours.shape}; expected ({k}, "
                                     f"{len(self.normals) + 1}, C)")
         # breadth first: the children ranges 1 + 4 q .. 4 + 4 q tile nodes 1..K-1; each must follow its parent
         fc = self.first_child()
         if np.any((fc >= 0) & (fc <= np.arange(k))):
-            raise InvalidInputError("HCE nodes are not in breadth-first order")
+            raise InvalidInputError("Baked-lighting nodes are not in breadth-first order")
         return self
 
 
@@ -66,7 +67,7 @@ def encode(tree):
     tree.validate()
     m = len(tree.normals)
     if m > 255:
-        raise InvalidInputError(f"An HCE root has at most 255 extra normals; got {m}")
+        raise InvalidInputError(f"Baked lighting holds at most 255 extra normals per triangle; got {m}")
     parts = [np.array([int(tree.subdivided[0]), m], np.uint8).tobytes(),
              np.ascontiguousarray(tree.normals, "<f4").tobytes()]
     fc = tree.first_child()
@@ -83,14 +84,14 @@ def decode(stream, channels):
     stream that is short, long or inconsistent."""
     buf = memoryview(bytes(stream))
     if len(buf) < 2:
-        raise InvalidInputError("An HCE stream needs at least its s and m bytes")
+        raise InvalidInputError("The baked-lighting data is too short: it needs at least its two header bytes")
     s, m = buf[0], buf[1]
     if s > 1:
-        raise InvalidInputError(f"HCE start bit s must be 0 or 1; got {s}")
+        raise InvalidInputError(f"The baked-lighting data is damaged: its start bit is {s}, not 0 or 1")
     at = 2
     need = 12 * m
     if len(buf) < at + need:
-        raise InvalidInputError("The HCE stream ends inside its normals")
+        raise InvalidInputError("The baked-lighting data ends inside its normals")
     normals = np.frombuffer(buf[at : at + need], "<f4").reshape(m, 3).astype(np.float32)
     at += need
     size = 4 * (m + 1) * channels
@@ -98,20 +99,21 @@ def decode(stream, channels):
     node = 0
     while node < len(subdivided):
         if len(buf) < at + size:
-            raise InvalidInputError(f"The HCE stream ends inside node {node}")
+            raise InvalidInputError(f"The baked-lighting data ends inside node {node}")
         colours.append(np.frombuffer(buf[at : at + size], "<f4").reshape(m + 1, channels))
         at += size
         if subdivided[node]:
             if len(buf) < at + 1:
-                raise InvalidInputError(f"The HCE stream ends before node {node}'s child bits")
+                raise InvalidInputError(f"The baked-lighting data ends before node {node}'s child bits")
             bits = buf[at]
             if bits > 15:
-                raise InvalidInputError(f"HCE child bits must fit T, L, C, R; got {bits}")
+                raise InvalidInputError(f"The baked-lighting data is damaged: child bits {bits} do not fit four "
+                                        "children")
             subdivided += [bool(bits >> 3 & 1), bool(bits >> 2 & 1), bool(bits >> 1 & 1), bool(bits & 1)]
             at += 1
         node += 1
     if at != len(buf):
-        raise InvalidInputError(f"The HCE stream has {len(buf) - at} byte(s) after its last node")
+        raise InvalidInputError(f"The baked-lighting data has {len(buf) - at} byte(s) after its last node")
     return HceTree(normals, np.array(colours, np.float32).reshape(-1, m + 1, channels), np.array(subdivided))
 
 
@@ -134,7 +136,7 @@ class HceMesh:
     def pack(cls, trees):
         trees = [t.validate() for t in trees]
         if not trees:
-            raise InvalidInputError("An HCE mesh needs at least one coarse triangle")
+            raise InvalidInputError("Baked lighting needs at least one triangle")
         m_max = max(len(t.normals) for t in trees)
         channels = trees[0].colours.shape[2]
         counts = np.array([len(t.subdivided) for t in trees], np.int64)
@@ -223,7 +225,7 @@ def encode_samples(leaf_colours, leaf_normals, root_normals, m=4, tolerance=1.0 
     n_f, n_leaves, channels = colours.shape
     depth = int(round(np.log(n_leaves) / np.log(4)))
     if 4**depth != n_leaves:
-        raise InvalidInputError(f"HCE samples need 4^D sub-triangles per coarse triangle; got {n_leaves}")
+        raise InvalidInputError(f"Baked-lighting samples need 4^Depth sub-triangles per triangle; got {n_leaves}")
     extra, counts = pick_normals(normals, np.asarray(root_normals, np.float64), m, cos_spread)
     cand = np.concatenate([np.asarray(root_normals, np.float64)[:, None], extra.astype(np.float64)], axis=1)
     dots = np.einsum("fkc,flc->flk", cand, normals)
@@ -287,7 +289,8 @@ def unpack_container(blob, triangles):
     blob = bytes(blob)
     head = len(MAGIC) + 8 + 16
     if len(blob) < head or not blob.startswith(MAGIC):
-        raise InvalidInputError("The stored baked lighting is not an HCE (or was written by a newer Tessera)")
+        raise InvalidInputError("The stored baked lighting is not in a format this Tessera reads (or was written by a "
+                                "newer Tessera)")
     channels, n_faces = (int(x) for x in np.frombuffer(blob[len(MAGIC) : len(MAGIC) + 8], "<u4"))
     if n_faces != len(triangles) or blob[len(MAGIC) + 8 : head] != topology_key(triangles):
         raise InvalidInputError("The baked lighting belongs to other faces than these (the mesh was edited after "

@@ -11,7 +11,7 @@ surfaces come out with outward normals.
 The seed's debug colour is ``normalize(p) + 0.6`` for the sphere and ``+ 0.4`` for the others (`debug_colour`).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,6 +32,12 @@ class Closure:
     flip: bool = False
 
 
+def parameter(default, label, description, unit="LENGTH"):
+    """A shape parameter: a dataclass field whose metadata says how settings show it (``label``, ``description``,
+    ``unit``: "LENGTH" for a size in scene units, "NONE" for a plain number such as an exponent)."""
+    return field(default=default, metadata={"label": label, "description": description, "unit": unit})
+
+
 def _stack(x, y, z):
     return np.stack(np.broadcast_arrays(x, y, z), axis=-1).astype(np.float64)
 
@@ -46,7 +52,7 @@ def _positive(**values):
 class Sphere:
     """Eq. 2-1 as coded: φ = π u (from the +z pole), θ = 2π v."""
 
-    radius: float = 1.0
+    radius: float = parameter(1.0, "Radius", "Radius of the sphere")
     closure = Closure(v=PERIODIC, collapse=("u0", "u1"))
     colour_offset = 0.6
 
@@ -62,8 +68,8 @@ class Cone:
     """Eq. 2-2 as coded: θ = 2π u, s = v from the base circle (z = 0, radius R) to the apex (z = H). Open at the
     base."""
 
-    radius: float = 0.5
-    height: float = 1.5
+    radius: float = parameter(0.5, "Radius", "Radius of the base circle")
+    height: float = parameter(1.5, "Height", "Height of the apex above the base")
     closure = Closure(u=PERIODIC, collapse=("v1",))
     colour_offset = 0.4
 
@@ -79,8 +85,8 @@ class Cone:
 class Torus:
     """Eq. 2-3 as coded: s = 2π u around z, t = 2π v around the tube; M the ring radius, N the tube radius."""
 
-    major: float = 1.0
-    minor: float = 0.5
+    major: float = parameter(1.0, "Ring Radius", "Distance from the centre to the middle of the tube")
+    minor: float = parameter(0.5, "Tube Radius", "Radius of the tube")
     closure = Closure(u=PERIODIC, v=PERIODIC)
     colour_offset = 0.4
 
@@ -96,7 +102,7 @@ class Steiner:
     """Steiner's Roman surface, eq. 2-4 as coded (errata 1: y = a² sin u sin 2v / 2, not sin u sin v), u = π u,
     v = π v. Closes as the projective plane: v = 0 meets v = 1, and u = 0 at v meets u = 1 at 1 - v."""
 
-    a: float = 1.0
+    a: float = parameter(1.0, "Size", "Size of the surface: it reaches half the square of this from its centre")
     closure = Closure(u=TWISTED, v=PERIODIC)
     colour_offset = 0.4
     #: The surface point is (AB, BC, AC) a² of the hemisphere point (A, B, C) = (cos u cos v, sin u cos v, sin v),
@@ -116,7 +122,7 @@ class Steiner:
 class KleinBottle:
     """The figure-8 Klein bottle: θ = 2π u around z, φ = 2π v along the figure 8 of half-width 1 at radius r."""
 
-    radius: float = 2.0
+    radius: float = parameter(2.0, "Radius", "Radius of the circle the figure-8 cross-section sweeps along")
     closure = Closure(u=TWISTED, v=PERIODIC)
     colour_offset = 0.4
 
@@ -131,8 +137,8 @@ class KleinBottle:
 class MobiusBand:
     """A Möbius band of ring radius 1 (times ``radius``) and the given width: t = 2π u, s = width (v - 1/2)."""
 
-    radius: float = 1.0
-    width: float = 0.8
+    radius: float = parameter(1.0, "Radius", "Radius of the band's middle circle")
+    width: float = parameter(0.8, "Width", "Width of the band")
     closure = Closure(u=TWISTED)
     colour_offset = 0.4
 
@@ -148,8 +154,8 @@ class TrefoilTube:
     """A tube of radius ``tube`` around the trefoil knot c(t) = (sin t + 2 sin 2t, cos t - 2 cos 2t, -sin 3t) ×
     ``scale``, t = 2π u, on its Frenet frame (periodic: the trefoil's curvature never vanishes), φ = 2π v."""
 
-    scale: float = 0.3
-    tube: float = 0.12
+    scale: float = parameter(0.3, "Knot Size", "Size of the knot's path (its loops reach about three times this)")
+    tube: float = parameter(0.12, "Tube Radius", "Radius of the tube around the knot")
     closure = Closure(u=PERIODIC, v=PERIODIC, flip=True)
     colour_offset = 0.4
 
@@ -184,9 +190,9 @@ class Superellipsoid:
     from the +z pole, ω = 2π v. e1 = e2 = 1 is the sphere; small exponents tend to a cube, 2 to an octahedron.
     Angles go through `cos_sin_turns`, so the poles and the four meridians' zeros are exact (GPU likewise)."""
 
-    size: float = 1.0
-    e1: float = 0.5
-    e2: float = 0.5
+    size: float = parameter(1.0, "Size", "Half the height and width of the shape")
+    e1: float = parameter(0.5, "Vertical Shape", "Top to bottom: 1 round, toward 0 square, 2 pointed", "NONE")
+    e2: float = parameter(0.5, "Horizontal Shape", "Around the middle: 1 round, toward 0 square, 2 pointed", "NONE")
     closure = Closure(v=PERIODIC, collapse=("u0", "u1"))
     colour_offset = 0.4
 

@@ -94,7 +94,7 @@ def seed_points(per_side, seed=0):
     the pixels and bands), and a noise value each: points (N, 2) float32, values (N,) float32 in [0, 1) (white
     noise). Both from ``seed``."""
     if per_side < 1:
-        raise InvalidInputError("The seed lattice needs at least one point per side")
+        raise InvalidInputError("Seeds: at least one streak per side is needed")
     rng = np.random.default_rng(seed)
     i, j = np.meshgrid(np.arange(per_side), np.arange(per_side))
     cells = np.stack([i.ravel(), j.ravel()], 1)

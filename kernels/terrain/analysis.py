@@ -70,7 +70,7 @@ def ham(heights):
     """The height acceleration map of (H, W) heights in texel units: (H, W) float32."""
     h = np.asarray(heights, np.float32)
     if h.ndim != 2 or min(h.shape) < 2:
-        raise InvalidInputError("The HAM needs a 2-D height array of at least 2x2 samples")
+        raise InvalidInputError("The terrain analysis needs a 2-D height array of at least 2x2 samples")
     return ham_rows(lambda idx: h[idx], h.shape[0], 0, h.shape[0] - 1)
 
 

@@ -2,9 +2,18 @@
 disable, never a duplicate; the .blend holds every group as an asset in Tessera's catalogs; nothing is left in
 the open file; groups flagged as modifiers; `tessera.node_group_add`."""
 
+import re
+
 import pytest
+from ui_rules import description_problems, jargon
 
 pytestmark = pytest.mark.blender
+
+#: Group inputs whose names read like a length, an angle or a factor, and the subtype that shows their unit.
+SOCKET_SUBTYPES = ((re.compile(r"Tile Size|Width"), ("PIXEL", "NONE")),  # 4.2 has no PIXEL sockets
+                   (re.compile(r"Radius|Distance|Size|Height Scale"), ("DISTANCE",)),
+                   (re.compile(r"Field of View"), ("ANGLE",)),
+                   (re.compile(r"Shape Factor"), ("FACTOR",)))
 
 
 def entries(bpy):
@@ -38,6 +47,43 @@ def test_library_registered_once_and_removed_on_disable(clean_scene, bpy_module,
         addon_utils.enable(name, default_set=True)
     addon_utils.enable(name, default_set=True)
     assert len(entries(bpy)) == 1 and entries(bpy)[0].path == directory
+
+
+def test_the_assets_describe_themselves(clean_scene, bpy_module, addon, addon_module):
+    """Every group in the library: a one-sentence description (its tooltip and its asset's), the asset's author,
+    license and copyright from the manifest, a catalog under Tessera, flagged for Add Modifier; every socket with a
+    tooltip in plain words and the subtype of its unit."""
+    bpy = bpy_module
+    lib = addon_module("addon.node_library")
+    manifest = addon_module("addon.manifest").manifest()
+    blend = lib.library_file(entries(bpy)[0].path)
+    catalogs = (blend.parent / lib.CATALOG_FILE).read_text()
+    with bpy.data.libraries.load(str(blend), assets_only=True) as (src, dst):
+        dst.node_groups = list(src.node_groups)
+    try:
+        assert len(dst.node_groups) >= 5
+        for tree in dst.node_groups:
+            assert not description_problems(tree.description) and not jargon(tree.description), tree.name
+            asset = tree.asset_data
+            assert asset.description == tree.description
+            assert asset.author == manifest["maintainer"] and asset.license == "GPL-3.0-or-later"
+            assert asset.copyright == manifest["copyright"][0]
+            assert f"{asset.catalog_id}:Tessera/" in catalogs, tree.name
+            assert tree.is_modifier, tree.name
+            for item in tree.interface.items_tree:
+                if item.item_type != "SOCKET":
+                    continue
+                where = f"{tree.name} › {item.name}"
+                assert item.description and not jargon(item.description), where
+                if item.in_out != "INPUT" or item.socket_type not in ("NodeSocketFloat", "NodeSocketInt"):
+                    continue
+                for pattern, subtypes in SOCKET_SUBTYPES:
+                    if pattern.search(item.name):
+                        assert item.subtype in subtypes, f"{where}: {item.subtype}"
+                        break
+    finally:
+        for tree in dst.node_groups:
+            bpy.data.node_groups.remove(tree)
 
 
 def test_node_group_add_puts_the_group_on_the_selection(clean_scene, bpy_module, addon_module):

@@ -194,5 +194,5 @@ def test_container_round_trip_and_stale_topology():
         unpack_container(blob, f[::-1])
     with pytest.raises(InvalidInputError, match="truncated"):
         unpack_container(blob[:-1], f)
-    with pytest.raises(InvalidInputError, match="not an HCE"):
+    with pytest.raises(InvalidInputError, match="not in a format this Tessera reads"):
         unpack_container(b"junk", f)

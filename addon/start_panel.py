@@ -1,0 +1,44 @@
+"""Sidebar › Tessera › Start Here: the panel that keeps the Tessera tab in the sidebar when nothing Tessera works on
+is active, with the creators (Add › Tessera), what to select for the other tools, and a link to the manual."""
+
+import bpy
+
+from .manifest import website
+from .menus import ADD_MENU, ICONS
+from .sidebar import Sidebar
+
+#: What to select for each of Tessera's tools (shown when nothing fitting is active).
+SELECT_HINTS = (
+    ("MESH_DATA", "A mesh: Tessellate, Loop Subdivision, Displacement Map, Impostors"),
+    ("CURVE_DATA", "A curve, hair or wire mesh: Tubes"),
+    ("SURFACE_DATA", "A NURBS surface: Object › Tessera › Tessellate Surface"),
+)
+
+
+class TESSERA_PT_start(Sidebar, bpy.types.Panel):
+    bl_idname = "TESSERA_PT_start"
+    bl_label = "Start Here"
+
+    @classmethod
+    def poll(cls, context):
+        """Shown exactly when no other Tessera sidebar panel is: the tab is always there."""
+        return not any(panel.poll(context) for panel in Sidebar.__subclasses__()
+                       if panel is not cls and getattr(panel, "is_registered", False))
+
+    def draw(self, context):
+        layout = self.layout
+        col = layout.column(align=True)
+        col.label(text="Add something new:")
+        col.operator_context = "INVOKE_REGION_WIN"
+        for idname in ADD_MENU:
+            col.operator(idname, icon=ICONS[idname])
+        col = layout.column(align=True)
+        col.label(text="Or select an object to work on:")
+        for icon, text in SELECT_HINTS:
+            col.label(text=text, icon=icon)
+        if website():
+            layout.operator("wm.url_open", text="Manual", icon="HELP").url = website()
+
+
+classes = (TESSERA_PT_start,)
+register, unregister = bpy.utils.register_classes_factory(classes)
