@@ -10,7 +10,7 @@ Per size, in the same run:
 - ``mesh_draw_ms``: drawing the applied mesh already on the GPU; ``mesh_upload_draw_ms``: uploading it (a batch
   of positions, normals and indices, as a mesh edit or a re-tessellation must) and drawing it.
 - bytes: ``preview_control_bytes`` once per mesh edit, ``preview_level_bytes`` per level change, against
-  ``mesh_bytes`` (float32 positions and normals, int32 indices): the seed's Tables 2.2 / 4.2 argument.
+  ``mesh_bytes`` (float32 positions and normals, int32 indices): [Nunes 2011]'s Tables 2.2 / 4.2 argument.
 
 Frame times end with a one-pixel read back, so they include the GPU's work. The renderer string is recorded
 (Mesa llvmpipe on CPU-only machines: a software rasteriser, so absolute times are not a GPU's).

@@ -1,4 +1,4 @@
-"""Nailboards (seed 003 §B.7, digest §B.11 R1 and the lifetime claim), in one run on this machine (llvmpipe):
+"""Nailboards ([Clua et al., §6] and its lifetime claim), in one run on this machine (llvmpipe):
 
 - ``lifetime``: a sphere's board rendered by the Cycles worker for an eye O1; the camera then strafes sideways (and,
   separately, dollies in). Each frame the board is drawn relief-mapped (pre-warped for the current eye) and as a
@@ -7,7 +7,7 @@
   outline, in pixels). Lifetime: frames until that error passes 1 px. Reported for both, and their ratio: the
   seed's claim that relief-mapped boards stay valid longer.
 - ``r1``: the longest and the mean draw of the board (pre-warp + upload + draw, what the viewport callback does per
-  frame) while the worker renders another board, against the same with the worker idle (the seed: 171 vs 171 fps).
+  frame) while the worker renders another board, against the same with the worker idle ([Clua et al.]: 171 vs 171 fps).
 - ``r1_request_pause``: the main thread's pause to ask for a board in a scene that also holds a 4M-triangle mesh,
   against saving a copy of the file (what the request did before it wrote only the object, its lights and world).
 - ``resampled_board_frame``: the per-frame CPU share (pre-warp + hole filling) of a 1024² sphere board against the

@@ -1,4 +1,4 @@
-"""Loop subdivision (seed 002 §A.9, B3 and B6) against OpenSubdiv, VTK, trimesh and Blender, in one run.
+"""Loop subdivision ([Concheiro et al.]) against OpenSubdiv, VTK, trimesh and Blender, in one run.
 
 Cases (Suzanne, 968 triangles, smooth, except where said):
 - ``kernel_<backend>_level_<L>`` for L = 1..6 (B3, time against output triangles): `kernels.subdivision.loop.
@@ -8,7 +8,7 @@ Cases (Suzanne, 968 triangles, smooth, except where said):
   faster.
 - ``vtk_level_<L>``: the kernel (OpenCL) against VTK's vtkLoopSubdivisionFilter (the Update call only), L = 3..5.
 - ``trimesh_level_<L>``: the kernel (OpenCL) against trimesh.remesh.subdivide_loop at L = 3..5.
-- ``recompute_level_<L>`` (B4): the seed's recomputation model, every coarse triangle subdivided from its own
+- ``recompute_level_<L>`` (B4): [Concheiro et al.]'s recomputation model, every coarse triangle subdivided from its own
   1-ring (`kernels.subdivision.loop_recompute`, numpy, one patch at a time), against the shared-vertex numpy
   reference at the same level (the same bits out), L = 2, 3.
 - ``stencils_opencl_level_<L>`` (B4 on a device): one OpenCL work item per coarse triangle evaluating its stencil

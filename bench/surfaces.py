@@ -1,4 +1,4 @@
-"""One-point parametric surfaces: the seed's Tables 2.1 / 2.2 (seed 000 §2.4), here.
+"""One-point parametric surfaces: [Nunes 2011]'s Tables 2.1 / 2.2 ([Nunes 2011, §2.4]), here.
 
 N tori of 8,192 triangles (factor 64, integer partitioning: 2F²), scattered in a cube, drawn into a 256x256
 offscreen with depth test, in the same run:
@@ -6,10 +6,10 @@ offscreen with depth test, in the same run:
 - ``one_point``: the GPU path: N control points (one RGBA32F texel each) and the factor-64 pattern, the torus
   evaluated in the vertex shader, one instanced draw;
 - ``mesh``: the same tori computed on the CPU (`kernels.surfaces.domain_mesh.instance_positions`) and uploaded as
-  one vertex buffer, drawn in one call. As in the seed, non-indexed float3 positions: every triangle's three
-  corners (the seed's "CPU tori in one vertex buffer"); what is uploaded is measured from the arrays handed to the
-  batch (positions, and the constant normals the flat-mesh shader takes: twice the seed's 12 bytes a vertex).
-  Both are drawn unlit, a flat colour, as the seed's position-only vertices (the one-point shader then skips its
+  one vertex buffer, drawn in one call. As in [Nunes 2011], non-indexed float3 positions: every triangle's three
+  corners ([Nunes 2011]'s "CPU tori in one vertex buffer"); what is uploaded is measured from the arrays handed to the
+  batch (positions, and the constant normals the flat-mesh shader takes: twice [Nunes 2011]'s 12 bytes a vertex).
+  Both are drawn unlit, a flat colour, as [Nunes 2011]'s position-only vertices (the one-point shader then skips its
   four extra evaluations for the normal). Built while it fits the memory of this machine (``MESH_LIMIT_BYTES``);
   beyond, only the analytic bytes.
 

@@ -1,7 +1,7 @@
 """Terrain level of detail: triangles along a camera path, selection time, HAM throughput, out-of-core memory.
 
 - ``path``: a 12-frame flight over a 4097² synthetic map (texel 1 m, 600 m relief, tiles of 64, ε = 3 px at
-  1280x720). Per mode of the seed's Fig. 5.6 (full grid, uniform 64, distance LOD without T_max, ours, ours with
+  1280x720). Per mode of [Nunes 2011]'s Fig. 5.6 (full grid, uniform 64, distance LOD without T_max, ours, ours with
   frustum culling): mean and max triangles per frame, and the ratio to the full grid (one quad per texel: the
   mesh with no screen-space error at all). Ours bounds each tile's peak error by ε.
 - ``select``: level selection per frame (numpy) on the 4097² map and on a 16385² map (65,536 tiles), against a

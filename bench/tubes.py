@@ -19,7 +19,7 @@ Scene: 100,000 strands x 32 points (random walks), 8 sides, no caps -> 25.6 M ve
   the add-on is enabled) has made the runtime and built the programs.
 - ``preview_bytes``: what the GPU preview uploads (section texture: 48 B per section; patch tables: 16 B per
   patch of up to 63 segments) against uploading the tube mesh for drawing (position + normal per vertex,
-  two triangles of 32-bit indices per quad): the seed's Table 4.2 argument.
+  two triangles of 32-bit indices per quad): [Nunes 2011]'s Table 4.2 argument.
 - ``memory``: peak resident memory of a fresh process building 1 M strands x 32 points with 3 sides,
   against the size of the output arrays.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/tubes.py

@@ -1,6 +1,6 @@
-"""``tessera.loop_subdivide``: Loop subdivision of the active mesh (seed 002 §A.3), creases kept, baked lighting
+"""``tessera.loop_subdivide``: Loop subdivision of the active mesh ([Concheiro et al.]), creases kept, baked lighting
 carried as a colour attribute; ``tessera.bake_lighting_hce``: the light on the mesh, baked by Cycles and stored
-per coarse triangle as an HCE (seed 002 §A.2)."""
+per coarse triangle as an HCE ([Concheiro et al.])."""
 
 import time
 

@@ -1,7 +1,7 @@
-"""``tessera.parametric_surface_add``: a one-point parametric surface (seed 000 §2.3) baked into a mesh at the 3D
+"""``tessera.parametric_surface_add``: a one-point parametric surface ([Nunes 2011, §2.3]) baked into a mesh at the 3D
 cursor: welded where it closes, with its domain coordinates as UVs. ``tessera.curve_adaptive``: a curve's Bézier
-splines as polylines sampled where they bend (digest 001 §5.5.2). ``tessera.vector_field_texture``: a steady
-field's line-integral-convolution image (digest 001 §5.5.4)."""
+splines as polylines sampled where they bend ([Nellmedin 2014, §5.5.2]). ``tessera.vector_field_texture``: a steady
+field's line-integral-convolution image ([Nellmedin 2014, §5.5.4])."""
 
 import bpy
 import numpy as np

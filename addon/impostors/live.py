@@ -1,4 +1,4 @@
-"""Live nailboards (seed 003 §B.5–B.6): which board an object is drawn from, and when a new one is asked for.
+"""Live nailboards ([Clua et al., §5]–B.6): which board an object is drawn from, and when a new one is asked for.
 
 `NailboardManager.update(ob, eye, ...)` is called by the viewport every frame and never waits:
 - a finished render is swapped in (double buffer: the old board is drawn until the new one is there); a job that

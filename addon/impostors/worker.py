@@ -1,4 +1,4 @@
-"""The renderer side of nailboards (seed 003 §B.5): a board is rendered by a separate Blender process (niced where
+"""The renderer side of nailboards ([Clua et al., §5]): a board is rendered by a separate Blender process (niced where
 the OS allows), so the viewport never waits for it. `request_board` writes what the render needs (`write_job`: the
 object and what it depends on, the scene's lights and world, nothing else), starts the process on
 `worker_script.py` and returns at once a `BoardJob`; `BoardJob.done()` polls without blocking and, once the process
@@ -81,7 +81,7 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
 
 def start_worker(job_file, log_path):
     """Start the worker on a job file (`write_job`), its output going to ``log_path`` (a file, not a pipe: a chatty
-    worker never stalls), below the viewport's priority (the seed's "low-priority thread": nice 10 on POSIX, below
+    worker never stalls), below the viewport's priority ([Clua et al.]'s "low-priority thread": nice 10 on POSIX, below
     normal on Windows). Returns the `subprocess.Popen`. The priority is lowered after the start rather than in the
     child before it, so Python can spawn without copying this (large) process's page tables (no ``preexec_fn``)."""
     kwargs = {}

@@ -1,2 +1,2 @@
 """Tessellation in Blender: `settings` (the options shared by the operator and ``Object.tessera.tessellate``),
-`preview` (the live GPU preview, seed 001 §5 done with instanced patterns) and `panel`."""
+`preview` (the live GPU preview, [Nellmedin 2014, §5] done with instanced patterns) and `panel`."""

@@ -1,5 +1,5 @@
-"""The geometry-nodes group "Tessera Phong": Phong tessellation (Boubekeur & Alexa 2008, seed 001) in the modifier
-stack, with no add-on needed to evaluate it. Numpy reference: `kernels.tessellation.patches.phong_control`.
+"""The geometry-nodes group "Tessera Phong": Phong tessellation (Boubekeur & Alexa 2008, [Nellmedin 2014]) in the
+modifier stack, with no add-on needed to evaluate it. Numpy reference: `kernels.tessellation.patches.phong_control`.
 
 Subdivide Mesh splits every triangle (linearly: UVs and attributes are interpolated as the kernel does). Each
 new point p lies on a coarse triangle with barycentric coordinates b, and Phong's point is

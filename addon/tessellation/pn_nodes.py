@@ -1,4 +1,4 @@
-"""The geometry-nodes group "Tessera PN Triangles": curved PN triangles (Vlachos et al. 2001, seed 001) in the
+"""The geometry-nodes group "Tessera PN Triangles": curved PN triangles (Vlachos et al. 2001, [Nellmedin 2014]) in the
 modifier stack, no add-on needed to evaluate it. Numpy reference: `kernels.tessellation.patches.pn_control` with
 `cubic_basis`.
 

@@ -1,4 +1,4 @@
-"""The geometry-nodes group "Tessera Tubes": tubes around curves (seed 000 §4) in the modifier stack, no add-on
+"""The geometry-nodes group "Tessera Tubes": tubes around curves ([Nunes 2011, §4]) in the modifier stack, no add-on
 needed to evaluate it. Numpy reference: `kernels.tubes.builder.build_tubes` with
 `kernels.tubes.frames.rotation_minimizing_frames` (the double-reflection method, Wang et al. 2008).
 

@@ -1,4 +1,4 @@
-"""A nailboard on the GPU (seed 003 §B.4.1, digest §B.11 items 4 and 5): the board is one quad on its plane; the
+"""A nailboard on the GPU ([Clua et al., §4.1]): the board is one quad on its plane; the
 fragment shader reads the offset map (the CPU pre-warp, `kernels.impostors.prewarp.forward_splat`) at its texel,
 fetches the source texel's colour (a dependent lookup, nearest) and writes the depth of that texel's relief point,
 so the board composites per texel with the rest of the scene (it intersects and occludes as the object would)."""

@@ -1,4 +1,4 @@
-"""One-point parametric surfaces drawn on the GPU (seed 000 §2.3–2.4), with no mesh uploaded.
+"""One-point parametric surfaces drawn on the GPU ([Nunes 2011, §2.3–2.4]), with no mesh uploaded.
 
 The factor-F quad-domain pattern (`kernels.surfaces.domain_mesh.domain_pattern`: (F + 1)² domain coordinates and
 2F² triangles) is one batch, shared by every surface and instance. The control points are one RGBA32F texture

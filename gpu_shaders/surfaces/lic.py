@@ -1,4 +1,4 @@
-"""Vector-field textures on the GPU (digest 001 §5.5.4): the seed points advected by a compute shader (explicit
+"""Vector-field textures on the GPU ([Nellmedin 2014, §5.5.4]): the seed points advected by a compute shader (explicit
 Euler, one dispatch a step, ping-pong between two RGBA32F textures) and splatted after every step as one-pixel
 points with additive blending into a float offscreen (red: the sum of values, green: how many), the numpy
 reference being `kernels.surfaces.vector_field` (`advect`, `splat`)."""

@@ -1,4 +1,4 @@
-"""Terrain drawn on the GPU from its height map (seed 000 §5.6): no terrain mesh is uploaded.
+"""Terrain drawn on the GPU from its height map ([Nunes 2011, §5.6]): no terrain mesh is uploaded.
 
 The height map goes up once as an R32F texture (at most `MAX_TEXTURE` texels a side: larger maps are
 strided for the preview). Per view, `TerrainDrawData.set_selection` uploads 48 bytes per visible tile (its

@@ -1,4 +1,4 @@
-/* Terrain preview (seed 000 §5.6, without a tessellation stage): one instanced pattern per tile class
+/* Terrain preview ([Nunes 2011, §5.6], without a tessellation stage): one instanced pattern per tile class
  * (four edge segment counts `edge_counts` and the inner count `inner_count`), one instance per tile.
  * Instance t reads texels 3t..3t+2 of `tiles`: (x0, y0, x1, y1) in samples, the four edge levels, (inner
  * level, 0, 0, 0). Pattern vertex `code` = (kind, a, b): 0 corner (a, b); 1-4 point a of side BOTTOM, RIGHT,

@@ -1,4 +1,4 @@
-"""Tubes drawn on the GPU from section data (seed 000 §4.4 and §4.6): no tube mesh is uploaded.
+"""Tubes drawn on the GPU from section data ([Nunes 2011, §4.4] and §4.6): no tube mesh is uploaded.
 
 `TubeDrawData` turns polylines plus their frames into two kinds of RGBA32F textures: the sections (centre,
 radius, N, B: 48 bytes per point, uploaded when the curves change) and, per side count, a patch table (16

@@ -1,4 +1,4 @@
-/* Tube preview (seed 000 §4.4, without a tessellation stage): one instance per patch of up to 63 segments,
+/* Tube preview ([Nunes 2011, §4.4], without a tessellation stage): one instance per patch of up to 63 segments,
  * one instanced ring pattern per side count. Section s occupies texels 3s..3s+2 of `sections` (row-major,
  * `tex_width` wide): (centre, radius), (N, 0), (B, 0). Patch p is texel p of `patches`: (first section,
  * segments, 0, 0). Pattern vertex `ij` = (section within the patch, side). */
@@ -20,7 +20,7 @@ void main()
   vec3 radial = cos(theta) * N + sin(theta) * B;
   float radius = centre.w;
   if (clamp_radius.x > 0.0) {
-    /* world size of one pixel at the centre's depth (seed eq. 4-3..4-5), kept as the ring's inscribed radius */
+    /* world size of one pixel at the centre's depth ([Nunes 2011] eq. 4-3..4-5), kept as the ring's inscribed radius */
     vec4 clip = view_projection * vec4(centre.xyz, 1.0);
     if (clip.w > 0.0) {
       float z = clip.z / clip.w;

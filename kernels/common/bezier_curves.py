@@ -1,4 +1,4 @@
-"""Cubic Bézier splines sampled where they bend (digest 001 §4.3 eq. 4.5, §5.5.2 and §11.4): each segment gets its
+"""Cubic Bézier splines sampled where they bend ([Nellmedin 2014, §4.3 eq. 4.5, §5.5.2]): each segment gets its
 own count of equal parameter steps, from the curvature of its control polygon (``max(6, min(32, 10 κ_max))``,
 rounded up) or from a tolerance (world units, or pixels for a camera). Shared by the adaptive polyline operator
 and the tubes.
@@ -8,7 +8,7 @@ i + 1 (that point's left handle); a cyclic spline adds the segment from the last
 of consecutive segments share their end points, so the polyline is continuous and closes exactly on cyclic splines.
 
 `adaptive_spline` samples a whole spline by a `CurveSampling` (curvature, world tolerance or pixels), with radius and
-tilt interpolated along each segment and the seed's "copies" (OL0, §5.5.2): N offset copies, for hair.
+tilt interpolated along each segment and [Nellmedin 2014]'s "copies" (OL0, §5.5.2): N offset copies, for hair.
 """
 
 from dataclasses import dataclass
@@ -111,15 +111,15 @@ def sample(control, counts, cyclic):
 
 
 def offset_copies(points, copies, offset):
-    """The seed's OL0 (§5.5.2): ``copies`` polylines, copy k moved by ``offset * k / copies`` (k = 0 .. copies - 1:
-    the first is the curve itself). points: (n, 3) -> (copies, n, 3)."""
+    """[Nellmedin 2014]'s OL0 (§5.5.2): ``copies`` polylines, copy k moved by ``offset * k / copies`` (k = 0 .. copies -
+    1: the first is the curve itself). points: (n, 3) -> (copies, n, 3)."""
     if int(copies) != copies or copies < 1:
         raise InvalidInputError(f"Copies must be a whole number of at least 1; got {copies!r}")
     k = np.arange(int(copies), dtype=np.float64)[:, None, None] / copies
     return np.asarray(points, np.float64)[None] + k * np.asarray(offset, np.float64).reshape(1, 1, 3)
 
 
-# --- whole splines: the sampling options, radius and tilt along, the seed's copies ---------------------------
+# --- whole splines: the sampling options, radius and tilt along, [Nellmedin 2014]'s copies ---------------------------
 
 MODES = ("CURVATURE", "TOLERANCE", "SCREEN")
 
@@ -127,7 +127,7 @@ MODES = ("CURVATURE", "TOLERANCE", "SCREEN")
 @dataclass(frozen=True)
 class CurveSampling:
     """mode: CURVATURE (eq. 4.5: max(6, min(max_segments, 10 κ))), TOLERANCE (world units) or SCREEN (pixels, needs
-    a camera); copies and offset: the seed's OL0 (copy k moved by offset k / copies)."""
+    a camera); copies and offset: [Nellmedin 2014]'s OL0 (copy k moved by offset k / copies)."""
 
     mode: str = "CURVATURE"
     max_segments: int = MAX_SEGMENTS

@@ -1,6 +1,6 @@
-"""Level metrics every capability shares (digest 001 §4): the camera-distance map (eqs. 4.1-4.3), the projected
-size of a sphere (§4.4, the projected-edge metric's core) and the curvature of control polygons (§4.3, eqs. 4.4 and
-4.5; scale-invariant: scaling a control polygon leaves its κ⁺ unchanged). Used by the curved triangle patches
+"""Level metrics every capability shares ([Nellmedin 2014, ch. 4]): the camera-distance map (eqs. 4.1-4.3), the
+projected size of a sphere (§4.4, the projected-edge metric's core) and the curvature of control polygons (§4.3, eqs.
+4.4 and 4.5; scale-invariant: scaling a control polygon leaves its κ⁺ unchanged). Used by the curved triangle patches
 (`kernels.tessellation.adaptive`), the adaptive curves and the Bézier surface patches."""
 
 import numpy as np
@@ -18,7 +18,7 @@ def curve_kappa(control):
     """Eq. 4.4: the largest ``|p_i - (p_{i-1} + p_{i+1}) / 2| / |p_{i+1} - p_{i-1}|`` over interior points.
 
     control: (..., n, d) control polygons, n >= 3. Degenerate chords (zero denominator) count as the
-    cap (``inf``) when the numerator is non-zero, 0 otherwise (digest 001 §10 item 5). Returns (...).
+    cap (``inf``) when the numerator is non-zero, 0 otherwise ([Nellmedin 2014, correction 4]). Returns (...).
     """
     c = np.asarray(control, np.float64)
     if c.shape[-2] < 3:
@@ -60,10 +60,10 @@ def distance_level(d, d_min, d_max, t_max, mapping="LINEAR"):
 
 
 def projected_sphere_levels(m, d, projection, height, e_max, t_max):
-    """Pixels a sphere of diameter ``d`` at eye-space point ``m`` spans on screen, over ``e_max`` (digest 001 §4.4,
-    corrected): ``m`` and ``m + (0, d, 0)`` are projected, so the result does not depend on which way the measured
-    thing points. m: (..., 3) eye space (looking down -z); d: (...); projection: (4, 4) row-major; height: viewport
-    height in pixels. A sphere reaching behind the eye plane gets ``t_max``; one entirely behind gets 1.
+    """Pixels a sphere of diameter ``d`` at eye-space point ``m`` spans on screen, over ``e_max`` ([Nellmedin 2014,
+    §4.4], corrected): ``m`` and ``m + (0, d, 0)`` are projected, so the result does not depend on which way the
+    measured thing points. m: (..., 3) eye space (looking down -z); d: (...); projection: (4, 4) row-major; height:
+    viewport height in pixels. A sphere reaching behind the eye plane gets ``t_max``; one entirely behind gets 1.
     Returns (...) float64 in ``[1, t_max]``."""
     if e_max <= 0:
         raise InvalidInputError("The target edge length in pixels must be positive")

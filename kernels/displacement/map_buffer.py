@@ -1,4 +1,4 @@
-"""A displacement map kept on an OpenCL device between dabs (seed 004 §5.2, the interoperability layer).
+"""A displacement map kept on an OpenCL device between dabs ([Andrade 2012, §5.2], the interoperability layer).
 
 `MapBuffer(runtime, map)` uploads the (H, W, C) float32 host map once. Each dab then runs on the device copy and
 only its footprint rectangle comes back (`pull`), so a dab costs its footprint, not the map. The host array stays

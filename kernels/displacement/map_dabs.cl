@@ -1,8 +1,8 @@
-// Displacement-map edits (seed 004 §5), one work item per texel of the dab's footprint tile.
+// Displacement-map edits ([Andrade 2012, §5]), one work item per texel of the dab's footprint tile.
 // The footprint is w x h texels from map texel (x0, y0). Its memory starts at element `base` of `map` with rows
 // `mem_w` texels apart: the whole map kept on the device (base = (y0 * W + x0) * C, mem_w = W) or an uploaded
 // tile (base = 0, mem_w = w). Texel (x, y) of a (H, W, C) float32 map sits at map[y, x].
-// Distances are to integer texel coordinates (seed M6). float4 operands map onto the channels: C = 4: xyzw,
+// Distances are to integer texel coordinates ([Andrade 2012, correction 1]). float4 operands map onto the channels: C = 4: xyzw,
 // C = 3: xyz, C = 1: z (the height). Every kernel has a numpy reference in kernels/map_dabs.py that computes
 // in the same float32 operations (contraction off), so results agree to the last bit in practice.
 #pragma OPENCL FP_CONTRACT OFF
@@ -82,7 +82,7 @@ __kernel void contact(TILE_ARGS, const float2 pos, const float depth, const floa
 inline void force_texel(__global float *t, const int x, const int y, const int channels, const float2 pos,
                         const float4 f, const float area)
 {
-  const float dissipation = (area - texel_distance(pos, x, y)) / area;  // = 1 - d / R, exact at the seed's values
+  const float dissipation = (area - texel_distance(pos, x, y)) / area;  // = 1 - d / R, exact at [Andrade 2012]'s values
   if (dissipation > 0.0f) {
     for (int c = 0; c < channels; ++c) {
       t[c] += operand(f, c, channels) * dissipation;

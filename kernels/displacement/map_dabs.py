@@ -1,9 +1,10 @@
-"""Displacement-map edits in numpy: the reference for every kernel of ``map_dabs.cl`` (seed 004 §5, §10.3).
+"""Displacement-map edits in numpy: the reference for every kernel of ``map_dabs.cl`` ([Andrade 2012, ch. 5] and its
+test values).
 
-A map is (H, W, C) float32 with C = 1 (height) or 3 (vector, xyz) or 4 (the seed's float4 texels); texel
-(x, y) is ``map[y, x]`` and distances run to integer texel coordinates (seed M6). A float4 operand (force,
-the test kernel's "normal", a brush direction) maps onto the channels as xyzw / xyz / z. Each function edits
-only ``tile`` = the footprint rows ``y0:y0+h`` and columns ``x0:x0+w`` (a view or copy of the map there),
+A map is (H, W, C) float32 with C = 1 (height) or 3 (vector, xyz) or 4 ([Andrade 2012]'s float4 texels); texel
+(x, y) is ``map[y, x]`` and distances run to integer texel coordinates ([Andrade 2012, correction 1]). A float4
+operand (force, the test kernel's "normal", a brush direction) maps onto the channels as xyzw / xyz / z. Each function
+edits only ``tile`` = the footprint rows ``y0:y0+h`` and columns ``x0:x0+w`` (a view or copy of the map there),
 in the same float32 operations as the OpenCL kernel, so the two agree to the last bit in practice.
 
 Faithful kernels: `contact` (hard disc, z -= depth), `force` (linear cone of radius |f.xyz|·f.w on all
@@ -61,7 +62,7 @@ def contact(tile, x0, y0, pos, depth, radius):
 
 
 def force_area(f):
-    """R = |f.xyz| * f.w in float32 (the seed's CONSTANT travels in f.w)."""
+    """R = |f.xyz| * f.w in float32 ([Andrade 2012]'s CONSTANT travels in f.w)."""
     f = np.asarray(f, F32)
     return np.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) * f[3]
 
@@ -70,7 +71,7 @@ def force(tile, x0, y0, pos, f):
     """Seed force kernel: where 1 - d/R > 0, every channel += f * (1 - d/R) (w gets f.w too)."""
     h, w, c = tile.shape
     area = force_area(f)
-    dissipation = (area - texel_distance(x0, y0, w, h, pos)) / area  # 1 - d/R, exact at the seed's test values
+    dissipation = (area - texel_distance(x0, y0, w, h, pos)) / area  # 1 - d/R, exact at [Andrade 2012]'s test values
     inside = dissipation > 0
     tile[inside] += operand(f, c)[None, :] * dissipation[inside][:, None]
 

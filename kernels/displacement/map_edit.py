@@ -6,7 +6,7 @@ dab's footprint (a tile: the bounding box of the disc, clipped to the map), and 
 wrong channel count) and NaN inside the footprint raise `InvalidInputError` before anything is written, so
 the map is unchanged. OpenCL (``map_dabs.cl``) and numpy (`map_dabs`) give the same result.
 
-`compile_custom` builds a user kernel body into the seed's custom template; compiler errors come back as
+`compile_custom` builds a user kernel body into [Andrade 2012]'s custom template; compiler errors come back as
 `TesseraError` with the compiler log.
 """
 
@@ -81,7 +81,7 @@ class DabParams:
     depth (CONTACT); force: float4, radius |f.xyz| * f.w (FORCE); vector: float4 offset direction (DRAW, NOISE,
     default (0, 0, 1, 0)); cell, seed: noise lattice size (default 8) and seed (NOISE); target: float4 height or
     vector to flatten toward (FLATTEN, default the mean under the brush); stamp: (h, w, C) array, scale (default
-    1) and angle (default 0) (STAMP); arg1..arg4: the seed's test kernel's four float4 (TEST, default 0).
+    1) and angle (default 0) (STAMP); arg1..arg4: [Andrade 2012]'s test kernel's four float4 (TEST, default 0).
     """
 
     pos: tuple | None = None
@@ -523,7 +523,7 @@ __kernel void custom(__global float *map, const long base, const int mem_w, cons
 
 
 def compile_custom(runtime, body):
-    """Build a custom kernel: ``body`` edits ``float4 image`` at texel (x, y) with arg1..arg4 (seed §5.7).
+    """Build a custom kernel: ``body`` edits ``float4 image`` at texel (x, y) with arg1..arg4 ([Andrade 2012] §5.7).
 
     Raises `TesseraError` with the compiler log on a compile error. Returns the kernel.
     """

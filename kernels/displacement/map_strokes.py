@@ -1,4 +1,4 @@
-"""Strokes on a displacement map: dab spacing along the path, pressure, X-mirror, and tile undo (seed 004 §10.3 K17).
+"""Strokes on a displacement map: dab spacing along the path, pressure, X-mirror, and tile undo ([Andrade 2012]).
 
 A stroke is a polyline of samples ``(x, y, pressure)`` in map texels (x right, y down the rows). `stroke_dabs`
 places dabs every ``spacing * radius`` texels of arc length, with pressure interpolated, the same way every time

@@ -1,6 +1,7 @@
-"""Nailboards: relief-mapped, depth-correct impostors (seed 003, digest Part B).
+"""Nailboards: relief-mapped, depth-correct impostors ([Clua et al.]).
 
-`prewarp` is the relief-texture pre-warp (eq. 7 in the corrected convention of digest §B.4) with the
+`prewarp` is the relief-texture pre-warp (eq. 7 in the convention of [Clua et al., correction 1]) with the
 occlusion-compatible traversal, the offset map and two-pass 1-D hole filling; `validity` the sprite resolution
-(eq. 8) and the tests that say when a board must be regenerated (§B.6: approach, parallax, resolution eq. 9).
+(eq. 8) and the tests that say when a board must be regenerated ([Clua et al., §5.1]: approach, parallax, resolution eq.
+9).
 """

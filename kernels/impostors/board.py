@@ -1,4 +1,4 @@
-"""Where a nailboard is and how it is rendered (seed 003 §B.5–B.6): the board's plane, texel axes and resolution
+"""Where a nailboard is and how it is rendered ([Clua et al., §5]–B.6): the board's plane, texel axes and resolution
 for an object's bounding box seen from an eye, and the orthographic camera that renders its source images.
 
 The board faces the eye (f = unit(eye - centre)); it lies at the back of the box's bounding sphere, so every point of

@@ -1,6 +1,6 @@
-"""The relief-texture pre-warp (Oliveira, Bishop & McAllister 2000; seed 003 §B.4, eq. 7 with the digest's fixes).
+"""The relief-texture pre-warp (Oliveira, Bishop & McAllister 2000; [Clua et al.], eq. 7 with its correction 1).
 
-Convention (digest §B.4, "corrected form"): the source is a parallel-projection image with depth. Texel (u, v)
+Convention ([Clua et al., correction 1]): the source is a parallel-projection image with depth. Texel (u, v)
 with orthogonal displacement d is the point ``x = C_s + u a + v b + d f``: a and b the texel axes (their lengths
 the texel size), f the unit normal towards the displaced side. With c = C_s - C_d (C_d the destination centre of
 projection)::
@@ -9,17 +9,17 @@ projection)::
     u_i = (u + k1 d) / (1 + k3 d),  v_i = (v + k2 d) / (1 + k3 d)
 
 is where the ray from C_d through x meets the source plane (the printed eq. 7's minus signs and its u_f in the v
-numerator are the report's errata 1). Where 1 + k3 d → 0 the ray runs parallel to the plane (C_d level with the
+numerator are [Clua et al., correction 1]). Where 1 + k3 d → 0 the ray runs parallel to the plane (C_d level with the
 displaced texel): such texels are marked invalid, never divided.
 
-Occlusion-compatible order (§B.4, errata 3): the epipole is where the line through C_d along f meets the plane; the
-image is split into four quadrants there and each is traversed from its edges towards the epipole. Painting in that
-order, a later texel is never farther from C_d than an earlier one landing on the same point: the higher texel wins
-a collision, with no depth buffer. The digest's rule reverses the order when C_d is behind; that is McMillan's rule
-for a *perspective* source, whose centre of projection an eye can be behind. A relief texture is a parallel
-projection, its centre at infinity along f: with C_d behind the plane the texels move towards the epipole instead of
-away from it, and the one nearer C_d is still the one nearer the epipole, so the order stays edges to epipole. The
-depth-buffered oracle agrees on both sides (tests), the reversed order does not (83% on the same case).
+Occlusion-compatible order ([McMillan 1997]; [Clua et al., correction 2]): the epipole is where the line through C_d
+along f meets the plane; the image is split into four quadrants there and each is traversed from its edges towards the
+epipole. Painting in that order, a later texel is never farther from C_d than an earlier one landing on the same point:
+the higher texel wins a collision, with no depth buffer. A rule read from the paper's text reverses the order when C_d
+is behind; that is McMillan's rule for a *perspective* source, whose centre of projection an eye can be behind. A relief
+texture is a parallel projection, its centre at infinity along f: with C_d behind the plane the texels move towards the
+epipole instead of away from it, and the one nearer C_d is still the one nearer the epipole, so the order stays edges to
+epipole. The depth-buffered oracle agrees on both sides (tests), the reversed order does not (83% on the same case).
 `forward_splat` paints colours and source addresses (the offset map) that way;
 `zbuffer_splat` is the oracle that keeps the nearest texel per destination by depth.
 """
@@ -98,7 +98,7 @@ def traversal_rank(width, height, frame, eye):
     """Each texel's place in the occlusion-compatible painting order: (H, W) int64, 0 painted first.
 
     Texels are ranked by their distance to the epipole in rows (v), then in columns (u), farthest first (edges
-    towards the epipole); within each of the four quadrants that is the seed's row-by-row traversal, and across
+    towards the epipole); within each of the four quadrants that is [Clua et al.]'s row-by-row traversal, and across
     quadrants it is consistent (they never overlap). The order is the same with the eye behind the plane: see the
     module docstring."""
     ue, ve, _ = epipole(frame, eye)
@@ -204,7 +204,7 @@ def _fill_rows(source, max_gap=None):
 
 
 def fill_holes(splat, max_gap=None):
-    """Two 1-D passes (the seed leaves the method open, errata 9; §B.4 suggests 1-D passes): holes take the nearest
+    """Two 1-D passes ([Clua et al., correction 7]: the paper leaves the method open): holes take the nearest
     painted texel of their row, then what is left the nearest of its column. ``max_gap`` (texels): fill only runs of
     holes enclosed on both sides and at most that long, so an object's outline stays where it is (None: every hole
     of a row or column with something painted). A new `Splat`."""

@@ -1,4 +1,4 @@
-"""A rendered board resampled to another resolution (seed 003 §B.5: a cached board "reused or resampled").
+"""A rendered board resampled to another resolution ([Clua et al., §5]: a cached board "reused or resampled").
 
 A board finer than the eye needs (the camera moved away) is still valid, but every frame pre-warps all its texels;
 resampled to what eq. 8 asks for, it costs what a board rendered for this distance would. Each output texel is the

@@ -1,9 +1,9 @@
-"""When a nailboard must be made again (seed 003 §B.6, with the digest's implementable formulation).
+"""When a nailboard must be made again ([Clua et al., §5.1], formulated as its corrections 3-6 say).
 
 - Sprite resolution (eq. 8): ``res = res_screen * size / (2 * distance * tan(FOV / 2))``, rounded up (`ceil`) or
   to the next power of two (`POW2`): 88.68 -> 89 (or 128) for 1024 px, size 1, distance 10, FOV 60°.
 - The size of a screen pixel ``b_tela = 2 tan(FOV / 2) / res_screen`` (at unit distance, on the view's centre
-  line). The report's FOV / res is smaller by tan(x) / x: with it a board just made by eq. 8 would already fail
+  line). The paper's FOV / res is smaller by tan(x) / x: with it a board just made by eq. 8 would already fail
   eq. 9 (by 10% at 60°); this one is eq. 8's own measure, so a new board passes at K = 1.
 - Approach (b_transV) and parallax (b_transH): a bounding-box corner P and its image P' on the board's plane seen
   from the viewpoint O1 the board was made for; from the current viewpoint O2 the error is the angle between
@@ -11,11 +11,11 @@
   the two box extremes that were one behind the other from O1 (the nearest and farthest corner along O1's ray to
   the centre): a pure dolly along that ray keeps them in line (b_transH = 0), a strafe separates them.
 - Resolution (eq. 9): ``b_nailboard > K * b_tela`` with b_nailboard the board's size over its current distance
-  (errata 5: what it subtends now, not the camera's FOV), over its resolution: its texels grew larger than K
-  screen pixels. The size is the box's diagonal, for eq. 8 and here alike.
+  ([Clua et al., correction 3]: what it subtends now, not the camera's FOV), over its resolution: its texels grew larger
+  than K screen pixels. The size is the box's diagonal, for eq. 8 and here alike.
 - A relief-mapped board corrects most of the parallax, so its parallax test runs on the residual: the report leaves
-  it open (errata 7), our choice is ``relief_factor`` times the plain board's error (an assumption; K and the
-  factor are user parameters, measured by the bench).
+  it open ([Clua et al., correction 6]), our choice is ``relief_factor`` times the plain board's error (an assumption; K
+  and the factor are user parameters, measured by the bench).
 """
 
 from dataclasses import dataclass

@@ -1,22 +1,22 @@
-"""Hierarchical Colour Encoding (HCE) of seed 002 §A.2: several colours per coarse triangle, one per normal, in a
+"""Hierarchical Colour Encoding (HCE) of [Concheiro et al.]: several colours per coarse triangle, one per normal, in a
 quadtree that follows Loop's 1 -> 4 split, and their transfer to a Loop-subdivided mesh at any level.
 
 Per coarse triangle: ``m`` extra normals N (the triangle's own normal n0 is not stored: it comes from the
 geometry) and a tree of nodes in breadth-first order, each with ``m + 1`` colours E (one per normal). A node's
 children are its sub-triangles in the T/L/C/R order of `loop_topology` (T = (a, m_ab, m_ca), L = (m_ab, b, m_bc),
 C = (m_ab, m_bc, m_ca), R = (m_ca, m_bc, c)); the children of subdivided node x are nodes
-``1 + 4 q(x) + slot``, q(x) the number of subdivided nodes before x (digest §A.2.3, checked by the tests).
+``1 + 4 q(x) + slot``, q(x) the number of subdivided nodes before x ([Concheiro et al.], checked by the tests).
 
-Stream layout (the digest's list J; erratum 5 decided: a node carries its child bits only when it is
+Stream layout ([Concheiro et al., correction 3]: a node carries its child bits only when it is
 subdivided, which its parent's bit, or s for the root, already says):
 
     J = s:u8  m:u8  N:(m, 3) f32  then per node, breadth first: E:(m + 1, C) f32  [bits:u8 if subdivided]
 
-with bits = T << 3 | L << 2 | C << 1 | R. Colour selection (§A.2.4, erratum 4 fixed): a sub-triangle with unit
+with bits = T << 3 | L << 2 | C << 1 | R. Colour selection ([Concheiro et al., correction 2]): a sub-triangle with unit
 normal n takes E[k*] of the node on its T/L/C/R path (clamped to the deepest node there is), k* =
 argmax_k n_k . n over the root's normals (n0 first, so ties keep the triangle's own normal). Vertex colours are
-the mean of the colours of every sub-triangle around the vertex (§A.2.5, uniform weights; the subdivided mesh
-is welded, so both sides of a coarse edge share each vertex's colour: no seam).
+the mean of the colours of every sub-triangle around the vertex ([Concheiro et al., correction 5], uniform weights; the
+subdivided mesh is welded, so both sides of a coarse edge share each vertex's colour: no seam).
 """
 
 import hashlib

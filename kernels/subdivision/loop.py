@@ -1,4 +1,4 @@
-"""Loop subdivision in the factored form (seed 002 §A.3): the numpy reference, float64 inside, float32 out.
+"""Loop subdivision in the factored form ([Concheiro et al.]): the numpy reference, float64 inside, float32 out.
 
 Each level is linear subdivision -> averaging -> correction factor (`loop_rules`), applied to vertex data of any
 width (positions and point attributes side by side), with OpenSubdiv's boundary and crease rules. Every

@@ -1,8 +1,8 @@
-"""The seed's recomputation model (002 §A.1, §A.3.3): every coarse triangle subdivided on its own from its 1-ring
-alone, with no sharing between triangles, the shared vertices recomputed by each triangle that touches them.
+"""[Concheiro et al.]'s recomputation model: every coarse triangle subdivided on its own from its
+1-ring alone, with no sharing between triangles, the shared vertices recomputed by each triangle that touches them.
 
 A triangle's patch is every coarse triangle sharing a vertex with it (n0 + n1 + n2 - 6 of them in a closed mesh,
-digest §A.3.3), renumbered in the order of the global ids. The patch is subdivided with `loop.loop_step`; Loop's
+[Concheiro et al.]), renumbered in the order of the global ids. The patch is subdivided with `loop.loop_step`; Loop's
 support keeps the triangle's own sub-triangles exact although the patch's outer ring has no neighbours. The
 renumbering keeps every sum in the order the whole-mesh reference uses (edges by id, opposite vertices by id),
 so a vertex on a shared coarse edge comes out bit for bit the same from both triangles, and the same as the

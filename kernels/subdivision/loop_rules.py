@@ -1,9 +1,10 @@
-"""Weights of Loop subdivision in the factored form (digest §A.3.1-A.3.2) and OpenSubdiv's crease arithmetic.
+"""Weights of Loop subdivision in the factored form ([Concheiro et al.], [Warren 2004]) and OpenSubdiv's crease
+arithmetic.
 
 One iteration is linear subdivision (a midpoint on every edge), averaging (each vertex moves to
 ``1/4 v + 3/(4n) * sum of its n neighbours in the linearly subdivided mesh``) and a correction
 ``v + cf(n) (v' - v)`` with ``cf(n) = 5/3 - 8/3 (3/8 + 1/4 cos(2 pi / n))^2``. That equals Loop's rule with
-``beta(n) = (5/8 - (3/8 + 1/4 cos(2 pi / n))^2) / n`` (digest §A.3.2).
+``beta(n) = (5/8 - (3/8 + 1/4 cos(2 pi / n))^2) / n`` ([Loop 1987]'s weights: [Concheiro et al., correction 1]).
 
 Creases follow OpenSubdiv's uniform rule: sharpness ``s`` (10 = infinitely sharp) drops by 1 per level; an
 edge with ``s >= 1`` takes the crease rule (the midpoint), ``0 < s < 1`` blends ``s * crease + (1 - s) *

@@ -1,4 +1,4 @@
-// Loop subdivision as the seed runs it: one invocation per coarse triangle, from its packed 1-ring alone, no
+// Loop subdivision as [Concheiro et al.] runs it: one invocation per coarse triangle, from its packed 1-ring alone, no
 // communication between invocations (kernels/subdivision/loop_stencils.py builds the tables; its `apply` is the
 // numpy reference). Every invocation writes all vertices of its own sub-triangles; a vertex shared with a
 // neighbour gets the same bits from both (same weights, same order), so the writes agree.

@@ -1,5 +1,5 @@
-"""Per-coarse-triangle Loop stencils: the seed's recomputation model made data-parallel (one invocation per coarse
-triangle, no communication between invocations, digest §A.4-A.5 with a modern data layout).
+"""Per-coarse-triangle Loop stencils: [Concheiro et al.]'s recomputation model made data-parallel (one invocation per
+coarse triangle, no communication between invocations, as in [Concheiro et al.], with a modern data layout).
 
 Loop subdivision is linear in the control points, and a coarse triangle's sub-triangles depend only on its 1-ring
 (`loop_recompute`). So each coarse triangle's level-L vertices are a fixed matrix (its *stencil*) times its 1-ring's

@@ -2,8 +2,8 @@
 
 Local edge ``k`` of a triangle runs from corner ``k`` to corner ``k + 1``. A level's vertices are the previous
 level's vertices (same ids) followed by one vertex per edge (id ``V + e``). Triangle ``t = (a, b, c)`` with edge
-vertices ``m0 = m_ab, m1 = m_bc, m2 = m_ca`` has four children, numbered ``4 t + slot`` in the seed's T/L/C/R
-order (digest §A.2.3; HCE paths index the same slots):
+vertices ``m0 = m_ab, m1 = m_bc, m2 = m_ca`` has four children, numbered ``4 t + slot`` in [Concheiro et al.]'s T/L/C/R
+order ([Concheiro et al., correction 4]; the colour encoding's paths index the same slots):
 
     T = (a, m0, m2)    L = (m0, b, m1)    C = (m0, m1, m2)    R = (m2, m1, c)
 

@@ -1,5 +1,5 @@
-"""Bicubic Bézier patches tessellated with per-patch, per-boundary levels, welded with no T-junction (digest 001
-§4.3, §5.5.3, §11.3; the Utah teapot's kind of model).
+"""Bicubic Bézier patches tessellated with per-patch, per-boundary levels, welded with no T-junction ([Nellmedin 2014,
+§4.3, §5.5.3]; the Utah teapot's kind of model).
 
 A patch is its 4 x 4 control net ``P[i, j]`` (i along u, j along v), ``P(u, v) = Σ B_i(u) B_j(v) P[i, j]``.
 Sides, in the pattern's order (`kernels.common.quad_pattern.pattern`): BOTTOM v = 0 (u from 0 to 1), RIGHT u = 1 (v
@@ -9,14 +9,14 @@ level computed once from them and its points evaluated once, in that direction; 
 backwards. Corners are control points. Shared boundaries are therefore one set of vertices (welded by
 construction) and no crack or T-junction can appear. A boundary that collapses to a point (the teapot's lid top
 and bottom centre) gives the same point L + 1 times: such points are merged and the triangles they flatten
-dropped. Such a collapsed row has κ⁺ = 0/0: it counts as the cap by default, as the seed's GPU did (digest 001 §10
-item 5; `PatchLod.degenerate`), which with the knob's fold is what makes the teapot's knob and base its finest
+dropped. Such a collapsed row has κ⁺ = 0/0: it counts as the cap by default, as [Nellmedin 2014]'s GPU did ([Nellmedin
+2014, item 5; `PatchLod.degenerate`), which with the knob's fold is what makes the teapot's knob and base its finest
 patches.
 
 Levels (`patch_levels`):
 - curvature: a side's level from its own control polygon (eq. 4.5, min 6, max Max Level); the inner levels from
-  the rows (u) and the columns (v) of the net (``inner_rows`` ALL, the seed's §4.1.2, or INTERIOR, its §5.3.3:
-  digest ambiguity 4) and the 9 cells' diagonal κ× (eq. 4.6): if the largest κ× exceeds both, it sets both;
+  the rows (u) and the columns (v) of the net (``inner_rows`` ALL, [Nellmedin 2014]'s §4.1.2, or INTERIOR, its §5.3.3:
+  [Nellmedin 2014, correction 3]) and the 9 cells' diagonal κ× (eq. 4.6): if the largest κ× exceeds both, it sets both;
 - distance: a side from the smallest distance of its 4 control points to the eye, the inner from the net's
   centroid, through the linear (or inverse) map between Near and Far;
 - projected edge length (§4.4): a side as a sphere as wide as its control polygon is long, at its centroid, over
@@ -50,8 +50,9 @@ class PatchLod:
     """How levels are chosen: metrics, some of CURVATURE, DISTANCE, EDGE_LENGTH (combined by maximum); max_level
     (≤ 64, the curvature metric's cap t_tessmax); inner_rows ALL or INTERIOR; near, far, mapping (LINEAR or
     INVERSE): the distance map; edge_pixels: the projected-edge metric's segment length on screen; degenerate:
-    what a row of the net that collapses to one point (κ⁺ = 0/0) counts for the inner levels: CAP (the seed's GPU,
-    and what makes the teapot's knob and base its finest patches; digest 001 §10 item 5) or ZERO (no bend)."""
+    what a row of the net that collapses to one point (κ⁺ = 0/0) counts for the inner levels: CAP ([Nellmedin 2014]'s
+    GPU, and what makes the teapot's knob and base its finest patches; [Nellmedin 2014, correction 4]) or ZERO (no
+    bend)."""
 
     metrics: tuple = ("CURVATURE",)
     max_level: int = 32

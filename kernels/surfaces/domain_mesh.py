@@ -1,8 +1,8 @@
-"""The quad domain of a one-point surface and the meshes made from it (seed 000 §2.3–2.4, §9.1).
+"""The quad domain of a one-point surface and the meshes made from it ([Nunes 2011, §2.3–2.4]).
 
 A patch of factor F is the unit square split into F x F quads (integer partitioning: the hardware
 tessellator's count, (F + 1)² domain vertices and 2F² triangles; 8192 at F = 64, where `fractional_odd` would
-clamp to 63 and give 7938, seed errata 6). `domain_pattern` is that pattern, the same for every surface and
+clamp to 63 and give 7938, [Nunes 2011, correction 4]). `domain_pattern` is that pattern, the same for every surface and
 every instance: the GPU path draws it once per control point and evaluates the formula per vertex.
 
 `surface_mesh` bakes one surface into a welded triangle mesh: the domain's vertices are identified by the
@@ -11,7 +11,7 @@ also the middle row, see `Steiner`), never by comparing positions, so self-inter
 sheets apart. Triangles that a collapse makes degenerate are dropped; corner UVs are the domain coordinates, so
 the UV map has its seams where the surface closes.
 
-`instance_positions` is the other path of the seed's experiment: every instance's vertices computed on the CPU
+`instance_positions` is the other path of [Nunes 2011]'s experiment: every instance's vertices computed on the CPU
 and uploaded as one buffer; `upload_bytes` the memory accounting of Table 2.2.
 """
 
@@ -25,7 +25,7 @@ from .parametric import PERIODIC, TWISTED
 
 #: Highest factor, as the hardware tessellator's.
 MAX_FACTOR = 64
-#: Bytes of one vertex in the seed's accounting (a float3 position).
+#: Bytes of one vertex in [Nunes 2011]'s accounting (a float3 position).
 VERTEX_BYTES = 12
 
 
@@ -159,7 +159,7 @@ def bounding_radius(surface, factor=32):
 
 
 def camera_factors(surface, control_points, camera, edge_pixels=8.0):
-    """A factor per instance from the camera (the seed's "level from the camera"): its bounding sphere's radius in
+    """A factor per instance from the camera ([Nunes 2011]'s "level from the camera"): its bounding sphere's radius in
     pixels r_px, and ``ceil(2π r_px / edge_pixels)`` segments around, in [1, MAX_FACTOR]. camera: a
     `kernels.common.camera.Camera` in the control points' space; instances behind the eye get factor 1.
     Returns (N,) int64."""

@@ -1,4 +1,4 @@
-"""Parametric surfaces over the unit square (seed 000 §2.3, the coded versions of eqs. 2-1 … 2-4, and §9.1).
+"""Parametric surfaces over the unit square ([Nunes 2011, §2.3], the coded versions of eqs. 2-1 … 2-4).
 
 Each surface is a frozen dataclass of its shape parameters with ``point(u, v) -> (..., 3) float64`` for domain
 coordinates ``u, v`` in [0, 1] (any matching shapes), and a `Closure` saying how its domain's edges meet:
@@ -8,7 +8,7 @@ by these rules, never by comparing positions, so self-intersecting surfaces (Kle
 sheets apart. ``flip`` is set where the formula's (du, dv) orientation points inward, so closed orientable
 surfaces come out with outward normals.
 
-The seed's debug colour is ``normalize(p) + 0.6`` for the sphere and ``+ 0.4`` for the others (`debug_colour`).
+[Nunes 2011]'s debug colour is ``normalize(p) + 0.6`` for the sphere and ``+ 0.4`` for the others (`debug_colour`).
 """
 
 from dataclasses import dataclass, field
@@ -99,8 +99,8 @@ class Torus:
 
 @dataclass(frozen=True)
 class Steiner:
-    """Steiner's Roman surface, eq. 2-4 as coded (errata 1: y = a² sin u sin 2v / 2, not sin u sin v), u = π u,
-    v = π v. Closes as the projective plane: v = 0 meets v = 1, and u = 0 at v meets u = 1 at 1 - v."""
+    """Steiner's Roman surface, eq. 2-4 as coded ([Nunes 2011, correction 1]: y = a² sin u sin 2v / 2, not sin u sin v),
+    u = π u, v = π v. Closes as the projective plane: v = 0 meets v = 1, and u = 0 at v meets u = 1 at 1 - v."""
 
     a: float = parameter(1.0, "Size", "Size of the surface: it reaches half the square of this from its centre")
     closure = Closure(u=TWISTED, v=PERIODIC)
@@ -214,7 +214,7 @@ SURFACES = {"SPHERE": Sphere, "CONE": Cone, "TORUS": Torus, "STEINER": Steiner, 
 
 
 def debug_colour(surface, points):
-    """The seed's debug colour: normalize(p) + 0.6 (sphere) or + 0.4 (the others): (..., 3) float64."""
+    """[Nunes 2011]'s debug colour: normalize(p) + 0.6 (sphere) or + 0.4 (the others): (..., 3) float64."""
     p = np.asarray(points, np.float64)
     length = np.linalg.norm(p, axis=-1, keepdims=True)
     unit = np.divide(p, length, out=np.zeros_like(p), where=length > 0)

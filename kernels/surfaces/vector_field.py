@@ -1,10 +1,11 @@
-"""Vector-field textures by line integral convolution with explicit Euler advection (digest 001 §5.5.4).
+"""Vector-field textures by line integral convolution with explicit Euler advection ([Nellmedin 2014, §5.5.4], [Cabral
+1993]).
 
 A steady 2-D field over the unit square (an analytic preset, or vectors sampled on a W x H grid) is drawn by
 advecting seed points laid on a regular lattice: every point carries a noise value, moves by explicit Euler
 (x ← x + h f(x), eq. 5.1) for a number of steps, and splats its value into the pixel it is in after each step; the
 image is the mean of the values splatted into each pixel, so streaks follow the streamlines. The seed lattice (one
-jittered seed per cell) is denser when the camera is nearer (the seed's distance metric per point, a linear map
+jittered seed per cell) is denser when the camera is nearer ([Nellmedin 2014]'s distance metric per point, a linear map
 between Near and Far).
 
 `advect` and `splat` are the numpy reference of the GPU path (`gpu_shaders.surfaces.lic`: a compute shader steps
@@ -82,7 +83,7 @@ class GridField:
 
 def seeds_per_side(base, distance, near, far, max_factor=4.0):
     """Seed lattice points per side: ``base`` times a factor that is ``max_factor`` at ``near`` or closer, 1 at
-    ``far`` or beyond, linear between (the seed's linear distance map), at most `MAX_SEEDS_PER_SIDE`."""
+    ``far`` or beyond, linear between ([Nellmedin 2014]'s linear distance map), at most `MAX_SEEDS_PER_SIDE`."""
     if not (0 <= near < far) or not np.isfinite(distance):
         raise InvalidInputError(f"Near and Far must satisfy 0 <= near < far; got {near!r}, {far!r}")
     t = np.clip((far - distance) / (far - near), 0.0, 1.0)

@@ -1,4 +1,4 @@
-"""Height-map analysis (seed 000 §5.4, §5.6): the height acceleration map (HAM) and the per-tile table.
+"""Height-map analysis ([Nunes 2011, §5.4], §5.6): the height acceleration map (HAM) and the per-tile table.
 
     M   = |Sobel(H)|     D_x = [-1 -2 -1; 0 0 0; 1 2 1] * H,  D_y = its transpose,  |D| = sqrt(D_x² + D_y²)
     HAM = |Sobel(M)|
@@ -10,7 +10,7 @@ measures how fast that slope changes (64 × the change of slope per texel, on a 
 Tiles split the sample grid into squares of ``tile_size`` intervals; tile (ty, tx) covers the samples
 ``x in [tx·ts, min((tx+1)·ts, W-1)]`` and the same for y (both ends included: neighbours share a row). The
 tile table holds, per tile, the HAM maximum, the height range and the position of the highest sample (the
-first in row-major order among equals), the seed's RGBA tile texture plus ``h_min`` for culling.
+first in row-major order among equals), [Nunes 2011]'s RGBA tile texture plus ``h_min`` for culling.
 
 Everything runs on bands of tile rows, so a memory-mapped map of any size is analysed with memory bounded
 by a few bands (`tile_table`), and an edit re-analyses only the tiles it can reach (`update_tiles`).
@@ -102,7 +102,7 @@ class TileTable:
         return self.ham_max.shape[1], self.ham_max.shape[0]
 
     def rgba(self):
-        """The seed's tile texture: (nty, ntx, 4) float32 = (HAM_max, h_max, x of h_max, y of h_max)."""
+        """[Nunes 2011]'s tile texture: (nty, ntx, 4) float32 = (HAM_max, h_max, x of h_max, y of h_max)."""
         return np.stack([self.ham_max, self.h_max, self.peak_x.astype(np.float32),
                          self.peak_y.astype(np.float32)], axis=-1)
 

@@ -1,17 +1,17 @@
-"""View-dependent terrain levels (seed 000 §5.5, errata §8 items 12-13): per-tile edge and inner levels.
+"""View-dependent terrain levels ([Nunes 2011, §5.5, corrections 6 and 7]): per-tile edge and inner levels.
 
 Per tile, from the `terrain_analysis.TileTable`:
 
 - ``T_max = clamp(g(HAM_max), 1, L)``, ``g = k·sqrt(HAM)`` (SQRT) or ``1 + k·log2(1 + HAM)`` (LOG): a flat tile
   (HAM_max = 0) gets 1 and is never subdivided.
 - ``T_min`` from the allowed screen-space error ε (pixels) and ĥ, the projected distance between the tile's
-  highest sample and the coarse tile below it: SEARCH (default) is the seed's process of Fig. 5.4, the
+  highest sample and the coarse tile below it: SEARCH (default) is [Nunes 2011]'s process of Fig. 5.4, the
   smallest power of two whose grid brings the peak within ε pixels; LOG2 is the corrected closed form
   ``log2(ĥ/ε)``; PRINTED is (5-4) as printed, ``log2(ε/ĥ)``. Clamped to ``[1, T_max]``.
 - the distance law (5-5..5-7): ``T = T_max`` below ``d_max``, ``T_max·d_max²/d²`` up to
   ``d_min = d_max·sqrt(T_max/T_min)``, ``T_min`` beyond; i.e. ``clamp(T_max·d_max²/d², T_min, T_max)``.
 
-Levels never exceed the tile size in texels (a quad always covers at least a texel, seed §5.4.2), nor, per
+Levels never exceed the tile size in texels (a quad always covers at least a texel, [Nunes 2011] §5.4.2), nor, per
 side, that side's length in texels (the last, partial tiles; a map smaller than one tile).
 Edge levels use the edge's midpoint (on the terrain surface) and ``max`` of the two tiles' T_max and T_min;
 every input is the same for both tiles, and only +, -, ×, / and sqrt touch it, so both tiles compute the
@@ -41,7 +41,7 @@ SIDES = ("BOTTOM", "RIGHT", "TOP", "LEFT")
 class TerrainLod:
     """Level-selection settings.
 
-    mode: OURS (T_max and T_min), DISTANCE (distance law without T_max: the seed's "straight view-dependent
+    mode: OURS (T_max and T_min), DISTANCE (distance law without T_max: [Nunes 2011]'s "straight view-dependent
     LOD"), UNIFORM (max_level everywhere). epsilon: allowed error in pixels. d_max: near distance in world
     units, 0 = automatic (a texel spans ``quad_pixels`` pixels there). levels: FRACTIONAL (continuous,
     fractional-even spacing), INTEGER (ceil) or POW2 (ceil to a power of two: vertices land on texels).
@@ -311,7 +311,7 @@ def select(hm, table, camera, settings=TerrainLod()):
         raise InvalidInputError("The tile table was made for a different height map; analyse the map again")
     ntx, nty = table.counts
     ts = table.tile_size
-    # "a quad always covers a texel" (seed §5.4.2): no level above the tile's size in texels
+    # "a quad always covers a texel" ([Nunes 2011] §5.4.2): no level above the tile's size in texels
     settings = replace(settings, max_level=min(settings.max_level, ts))
     xb = tile_bounds(np.arange(ntx), ts, hm.width)
     yb = tile_bounds(np.arange(nty), ts, hm.height)

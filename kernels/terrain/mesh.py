@@ -133,7 +133,7 @@ def bake(hm, table, selection):
 
 
 def full_grid(hm):
-    """The full-resolution grid (one quad per texel, the seed's "no LOD" reference): `TerrainMesh`."""
+    """The full-resolution grid (one quad per texel, [Nunes 2011]'s "no LOD" reference): `TerrainMesh`."""
     h, w = hm.height, hm.width
     gy, gx = np.meshgrid(np.arange(h, dtype=np.float64), np.arange(w, dtype=np.float64), indexing="ij")
     samples = np.stack([gx.ravel(), gy.ravel()], 1)

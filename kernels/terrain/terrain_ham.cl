@@ -1,4 +1,4 @@
-// Height acceleration map (seed 000 §5.6.1) and the per-tile table (§5.6.2). Same operation order as the
+// Height acceleration map ([Nunes 2011, §5.6.1]) and the per-tile table (§5.6.2). Same operation order as the
 // numpy reference in terrain/analysis.py: M = |Sobel(H)|, HAM = |Sobel(M)|, clamp-to-edge borders. Contraction is
 // off (a + 2b would become one fma, and gx * gx + gy * gy another), so the device gives the reference's bits.
 #pragma OPENCL FP_CONTRACT OFF

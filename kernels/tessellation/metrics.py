@@ -1,4 +1,4 @@
-"""Adaptive tessellation metrics as pure functions (digest 001 §4, with its corrections).
+"""Adaptive tessellation metrics as pure functions ([Nellmedin 2014, ch. 4], with its corrections).
 
 Each metric maps per-edge data to a level, so the two triangles of a shared edge compute the same
 value bit for bit (the crack-free rule): every edge function is symmetric in its two endpoints
@@ -53,7 +53,7 @@ def to_eye(points, view):
 
 
 def projected_edge_levels(a, b, view, projection, height, e_max, t_max=MAX_LEVEL):
-    """Largest projected length of each edge in pixels over ``e_max`` (digest 001 §4.4, corrected).
+    """Largest projected length of each edge in pixels over ``e_max`` ([Nellmedin 2014, §4.4, correction 2]).
 
     The edge is treated as a sphere of diameter ``|b - a|`` at its midpoint: the midpoint ``m`` and
     ``m + (0, |b - a|, 0)`` are taken in **eye space** and projected, so the result does not depend on
@@ -121,8 +121,8 @@ def pn_inner_kappa(control):
 def clamp_and_round(levels, t_max=MAX_LEVEL, power_of_two="NONE"):
     """Clamp to ``[1, t_max]`` (``t_max <= 64``) and optionally round to a power of two.
 
-    ``CEIL`` is the digest's default (18 and 20 -> 32); ``FLOOR`` and ``NEAREST`` (nearest in log2) are
-    options. A rounded level never exceeds the largest power of two ``<= t_max``.
+    ``CEIL`` is the default ([Nellmedin 2014, correction 1]) (18 and 20 -> 32); ``FLOOR`` and ``NEAREST`` (nearest in
+    log2) are options. A rounded level never exceeds the largest power of two ``<= t_max``.
     """
     if not 1 <= t_max <= MAX_LEVEL:
         raise InvalidInputError(f"The maximum level must lie in [1, {MAX_LEVEL}]; got {t_max}")

@@ -1,7 +1,7 @@
 """Curved triangle patches: PN triangles (Vlachos et al. 2001) and Phong tessellation (Boubekeur & Alexa 2008).
 
 Every surface here is a polynomial in the barycentric coordinates ``b = (b0, b1, b2)`` of a triangle
-(corner ``i`` at ``b_i = 1``; in the seed's notation ``w = b0``, ``u = b1``, ``v = b2``, so corner 0 is
+(corner ``i`` at ``b_i = 1``; in [Nunes 2011]'s notation ``w = b0``, ``u = b1``, ``v = b2``, so corner 0 is
 P1 / b300, corner 1 is P2 / b030, corner 2 is P3 / b003). A patch is a control array ``(..., K, C)``
 and a basis ``(P, K)`` evaluated at points; the value is ``basis @ control``. Bases carry their
 multinomial coefficients, so controls are the textbook control points.
@@ -16,11 +16,11 @@ Bases (columns, in order):
 
 Edges: the restriction of a patch to an edge depends only on that edge's two endpoints and normals.
 ``*_edge_control`` builds it per mesh edge, in the canonical direction, so the points of a shared edge
-are computed once and are bit-identical for both triangles (digest 000 §7.2). Edge bases take the
+are computed once and are bit-identical for both triangles ([Nunes 2011, ch. 3]). Edge bases take the
 parameter ``t`` from the first endpoint ``a`` to the second ``b``.
 
-Errata applied (digest 000 §8): the v_ij denominator is ``(Pj - Pi)·(Pj - Pi)``; the B201 weight is
-``3 w^2 v``. Degenerate input (zero-length edges, opposite normals) gives finite values, never NaN.
+Corrections applied ([Nunes 2011, corrections 2 and 3]): the v_ij denominator is ``(Pj - Pi)·(Pj - Pi)``; the B201
+weight is ``3 w^2 v``. Degenerate input (zero-length edges, opposite normals) gives finite values, never NaN.
 """
 
 import numpy as np
@@ -178,7 +178,7 @@ def phong_control(positions, normals, alpha=0.75):
 
     ``p*_a = (1 - a) p + a sum_i b_i pi_i(p)`` with ``pi_i(q) = q - ((q - p_i)·n_i) n_i`` expands to the
     quadratic controls ``c_ii = P_i`` and ``c_ij = P_i + P_j - a (d_ij N_i + d_ji N_j)`` exactly. ``alpha``:
-    a constant shape factor (0: linear, 1: the seed). For per-vertex factors see `phong_offset_control`.
+    a constant shape factor (0: linear, 1: [Nunes 2011]). For per-vertex factors see `phong_offset_control`.
     """
     p, n = _as64(positions, normals)
     a = float(alpha)
@@ -225,7 +225,7 @@ def project_to_plane(q, point, normal):
 
 
 def phong_direct(positions, normals, bary, alpha=1.0):
-    """Phong tessellation evaluated literally from the seed's projections (3-25), for checking.
+    """Phong tessellation evaluated literally from [Nunes 2011]'s projections (3-25), for checking.
 
     positions, normals: (3, 3) one triangle; bary: (P, 3). Returns (P, 3) float64.
     """

@@ -37,7 +37,7 @@ NORMAL_FIELDS = ("QUADRATIC", "LINEAR")
 class SurfaceOptions:
     """How the curved methods shape the surface.
 
-    alpha: Phong shape factor (0 flat, 1 the seed, 0.75 the paper's default); alpha_attribute: name of a
+    alpha: Phong shape factor (0 flat, 1 [Nunes 2011], 0.75 the paper's default); alpha_attribute: name of a
     float point attribute holding a per-vertex factor instead (or None); normal_mode: one of
     `kernels.tessellation.normals.NORMAL_MODES`; pn_normals: ``QUADRATIC`` (Vlachos's normal patch) or ``LINEAR``.
     """

@@ -1,11 +1,11 @@
-"""Tubes around polylines (seed 000 §4): rings on rotation-minimising frames, LOD, anti-aliasing clamp, caps.
+"""Tubes around polylines ([Nunes 2011, §4]): rings on rotation-minimising frames, LOD, anti-aliasing clamp, caps.
 
 Ring ``k`` of a tube with ``n`` sides has vertices ``P_k + r_k (cos θ_j N_k + sin θ_j B_k)``, θ_j = 2πj/n,
-with radial unit normals (seed eq. 4-2, 4-8). Rings are welded around (no duplicate seam vertex; the UV seam
+with radial unit normals ([Nunes 2011] eq. 4-2, 4-8). Rings are welded around (no duplicate seam vertex; the UV seam
 is carried by corner UVs) and along the tube; closed curves join their last ring to the first. Faces are
 quads (outward, counter-clockwise), caps are n-gons (FLAT) or hemispheres (ROUND).
 
-The seed's anti-aliasing clamp keeps a tube at least one pixel in radius: r_eff = max(r, s_pix), where
+[Nunes 2011]'s anti-aliasing clamp keeps a tube at least one pixel in radius: r_eff = max(r, s_pix), where
 s_pix is the world size of one pixel at the point's depth, found by unprojecting NDC offsets (eq. 4-5).
 Here the clamp is applied to the polygon's inscribed radius (s_pix / cos(π/n)), so the tessellated tube,
 not only the ideal cylinder, covers two pixels; an optional maximum caps the inflation.
@@ -214,7 +214,7 @@ class CurveRun:
 
 
 def pixel_world_size(points, camera):
-    """World length of one pixel at each point's depth (seed eq. 4-3..4-5): (P,) float64; inf behind the eye.
+    """World length of one pixel at each point's depth ([Nunes 2011] eq. 4-3..4-5): (P,) float64; inf behind the eye.
 
     Unprojects NDC (0, 0, z) and (2 / width, 0, z) at the point's NDC depth through ViewProjection⁻¹.
     """

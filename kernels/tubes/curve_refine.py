@@ -1,4 +1,4 @@
-"""Preparing tube centre lines (seed 000 §4.3.1): Catmull-Rom refinement and tolerance-based point selection.
+"""Preparing tube centre lines ([Nunes 2011, §4.3.1]): Catmull-Rom refinement and tolerance-based point selection.
 
 Both work on all curves at once. Refinement turns sparse control points ("the bad case": a path the tube
 must pass through) into a dense centre line; selection keeps a point only where the tangent has turned by

@@ -19,7 +19,7 @@ def params(level, spacing):
      (4.5, "FRACTIONAL_EVEN", 6), (63.1, "FRACTIONAL_EVEN", 64), (100, "FRACTIONAL_EVEN", 64)],
 )
 def test_rounding_rules(level, spacing, n):
-    # digest 001 §2.3.4 / §11.1: equal rounds up in [1, 64]; even clamps to [2, 64], rounds up to even.
+    # [Nellmedin 2014, §2.3.4], [Khronos]: equal rounds up in [1, 64]; even clamps to [2, 64], rounds up to even.
     assert segment_counts([level], spacing)[0] == n
 
 
@@ -33,7 +33,7 @@ def test_equal_params_are_equal_segments():
      (4.5, [0.5 / 12, 0.5 / 12] + [(1 - 1 / 12) / 4] * 4), (1.0, [0.5, 0.5])],
 )
 def test_fractional_segment_lengths_match_llvmpipe(level, lengths):
-    # digest 001 §2.3.4 [V]: the multiset of segment lengths llvmpipe produces (positions differ by vendor).
+    # [Nellmedin 2014, §2.3.4]: the multiset of segment lengths llvmpipe produces (positions differ by vendor).
     assert np.allclose(np.sort(np.diff(params(level, "FRACTIONAL_EVEN"))), np.sort(lengths), atol=1e-12)
 
 

@@ -1,4 +1,5 @@
-"""Displacement-map kernels, numpy reference (seed 004 §10.3 test vectors; kernels.displacement.map_dabs / map_edit)."""
+"""Displacement-map kernels, numpy reference ([Andrade 2012]'s test values; kernels.displacement.map_dabs /
+map_edit)."""
 
 import numpy as np
 import pytest

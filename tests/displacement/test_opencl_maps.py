@@ -154,7 +154,7 @@ def test_custom_kernel_identity_reproduction_and_compile_errors(opencl):
     apply_custom(m, compile_custom(opencl, body), opencl, args=args)
     expected = before.copy()
     apply_dab(expected, "TEST", backend="numpy", arg1=args[0], arg2=args[1], arg3=args[2])
-    assert np.allclose(m, expected, atol=FLOAT32_PATH_ATOL)  # the seed's test kernel written as a custom body
+    assert np.allclose(m, expected, atol=FLOAT32_PATH_ATOL)  # [Andrade 2012]'s test kernel written as a custom body
     with pytest.raises(TesseraError, match="failed to compile") as err:
         compile_custom(opencl, "image += ;")
     assert "error" in str(err.value).lower()

@@ -1,4 +1,4 @@
-"""When a live nailboard asks for a new board (seed 003 §B.6, digest §B.11 items 7, 10 and 11), on scripted camera
+"""When a live nailboard asks for a new board ([Clua et al., §5 and §5.1]), on scripted camera
 paths (tier: blender): a static camera never; a dolly-in from the approach and resolution tests only; a strafe from
 parallax; an object move at once; a return to an earlier viewpoint from the cache; prediction asks ahead. The
 renderer here finishes at once (the real one, a separate process, is tested in test_blender_worker.py)."""

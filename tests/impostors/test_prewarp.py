@@ -1,4 +1,4 @@
-"""The relief-texture pre-warp (seed 003 §B.4, digest §B.11 items 1, 2 and 4): eq. 7 in the corrected convention
+"""The relief-texture pre-warp ([Clua et al.], eq. 7; [Oliveira 2000]): eq. 7 in the corrected convention
 against ray-plane intersection, the parallel guard, the epipole and the occlusion-compatible order (the collision
 case, and agreement with a depth-buffered splat), the offset map."""
 
@@ -43,8 +43,8 @@ def test_the_parallel_guard():
 
 
 def test_the_collision_keeps_the_higher_texel():
-    """Digest §B.4: source plane z = 0, C_d at height h in front: (u = 1, d = h/2) and (u = 2, d = 0) both land on
-    u_i = 2; the higher one, nearer C_d, must win."""
+    """The collision case of [Clua et al., correction 2]: source plane z = 0, C_d at height h in front: (u = 1, d = h/2)
+    and (u = 2, d = 0) both land on u_i = 2; the higher one, nearer C_d, must win."""
     h = 4.0
     frame = pw.ReliefFrame(np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0]))
     eye = np.array([0.0, 0.0, h])

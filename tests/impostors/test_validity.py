@@ -1,4 +1,4 @@
-"""When a nailboard is made again (seed 003 §B.6, digest §B.11 items 6 and 7): eq. 8, and the approach, parallax
+"""When a nailboard is made again ([Clua et al., §5.1]): eq. 8, and the approach, parallax
 and resolution tests on scripted camera paths."""
 
 import numpy as np

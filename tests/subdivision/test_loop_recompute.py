@@ -1,4 +1,4 @@
-"""The recomputation model (seed 002 §A.3.3, §A.9 items 3 and 5): each coarse triangle subdivided from its 1-ring
+"""The recomputation model ([Concheiro et al.]): each coarse triangle subdivided from its 1-ring
 alone gives, bit for bit, what its neighbours give on shared vertices and what the whole-mesh reference gives,
 whatever the order the triangles are taken in."""
 
@@ -41,7 +41,7 @@ def test_creases_and_any_dispatch_order():
 
 
 def test_the_patch_is_the_one_ring():
-    """n0 + n1 + n2 - 6 triangles around each triangle of a closed mesh (digest §A.3.3), and nothing else moves
+    """n0 + n1 + n2 - 6 triangles around each triangle of a closed mesh ([Concheiro et al.]), and nothing else moves
     a triangle's sub-triangles."""
     v, f = random_irregular_closed(3)
     valence = np.bincount(f.ravel())

@@ -1,5 +1,5 @@
-"""Per-coarse-triangle stencils (the seed's one-invocation-per-triangle model): numpy and OpenCL evaluations equal
-the reference, every triangle writes the shared vertices with the same bits, and the weights do not depend on
+"""Per-coarse-triangle stencils ([Concheiro et al.]'s one-invocation-per-triangle model): numpy and OpenCL evaluations
+equal the reference, every triangle writes the shared vertices with the same bits, and the weights do not depend on
 positions."""
 
 import numpy as np

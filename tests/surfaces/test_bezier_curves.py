@@ -1,4 +1,4 @@
-"""Cubic Bézier splines sampled where they bend (digest 001 §4.3 eq. 4.5, §5.5.2, §11.4)."""
+"""Cubic Bézier splines sampled where they bend ([Nellmedin 2014, §4.3 eq. 4.5, §5.5.2])."""
 
 import numpy as np
 import pytest

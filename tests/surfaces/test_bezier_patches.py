@@ -1,4 +1,4 @@
-"""Bicubic Bézier patches with per-boundary levels (digest 001 §4.3, §5.5.3, §11.3, §11.4) on the teapot's body of
+"""Bicubic Bézier patches with per-boundary levels ([Nellmedin 2014, §4.3, §5.5.3]) on the teapot's body of
 revolution: welded with no crack or T-junction at any levels, every vertex on its patch, the curvature levels
 highest at the knob and the base, distance levels high near and low far."""
 
@@ -68,7 +68,7 @@ def test_curvature_levels_are_highest_at_the_knob_and_the_base():
     top_two = sorted(by, key=by.get, reverse=True)[:2]
     assert set(top_two) == {"lid_top", "bottom"}, by
     assert el.min() >= 6 and el.max() <= 32 and inner.max() == 32
-    # without the seed's cap for collapsed rows the base is an ordinary patch; the knob still folds
+    # without [Nellmedin 2014]'s cap for collapsed rows the base is an ordinary patch; the knob still folds
     _, geometric = bp.patch_levels(patches, edges, bp.PatchLod(metrics=("CURVATURE",), degenerate="ZERO"))
     assert geometric[names == "lid_top"].max() > geometric[names != "lid_top"].max()
     assert geometric[names == "bottom"].max() < inner[names == "bottom"].max()

@@ -1,4 +1,4 @@
-"""One-point parametric surfaces (seed 000 §2.3, §9.1): the coded equations' identities, the pattern counts, the
+"""One-point parametric surfaces ([Nunes 2011, §2.3]): the coded equations' identities, the pattern counts, the
 welded meshes' topology (closed where the surface closes, the Euler characteristic of its topology, outward
 orientation), the many-instances path and Table 2.2's accounting."""
 
@@ -26,7 +26,8 @@ def test_the_coded_equations_satisfy_their_identities():
 
 
 def test_the_printed_steiner_equation_is_the_typo():
-    """Errata 1: the printed y = a² sin u sin v / 2 does not satisfy the implicit equation; the coded one does."""
+    """[Nunes 2011, correction 1]: the printed y = a² sin u sin v / 2 does not satisfy the implicit equation; the coded
+    one does."""
     u, v = random_uv(1)
     uu, vv = np.pi * u, np.pi * v
     x, z = np.cos(vv) ** 2 * np.sin(2 * uu) / 2, np.cos(uu) * np.sin(2 * vv) / 2
@@ -42,7 +43,7 @@ def test_a_patch_of_factor_f_has_2f2_triangles(factor):
     a, b = uv[tris[:, 1]] - uv[tris[:, 0]], uv[tris[:, 2]] - uv[tris[:, 0]]
     area = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     assert np.allclose(area, 1.0 / factor ** 2)  # counter-clockwise, the square tiled exactly
-    assert domain_mesh.pattern_counts(64)[1] == 8192  # the seed's torus
+    assert domain_mesh.pattern_counts(64)[1] == 8192  # [Nunes 2011]'s torus
 
 
 def edge_uses(tris):
@@ -122,7 +123,7 @@ def test_many_instances_and_table_2_2():
     # Table 2.2: 20000 tori of 8192 triangles: 5898.24 MB as a non-indexed buffer, 0.24 MB as control points
     mesh_bytes, point_bytes = domain_mesh.upload_bytes(20000, 64)
     assert (mesh_bytes, point_bytes) == (5_898_240_000, 240_000)
-    assert domain_mesh.upload_bytes(5000, 64)[0] == 1_474_560_000  # errata 5: 1474.56, not 1479.56
+    assert domain_mesh.upload_bytes(5000, 64)[0] == 1_474_560_000  # [Nunes 2011, correction 5]: 1474.56, not 1479.56
 
 
 def test_debug_colour():

@@ -1,4 +1,4 @@
-"""Vector-field textures (digest 001 §5.5.4): the fields, Euler advection, splatting, the camera's density."""
+"""Vector-field textures ([Nellmedin 2014, §5.5.4]): the fields, Euler advection, splatting, the camera's density."""
 
 import numpy as np
 import pytest

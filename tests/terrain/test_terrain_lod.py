@@ -1,4 +1,4 @@
-"""Terrain levels and meshes: the seed's rules, crack-free edges from random cameras, holes, culling, peaks."""
+"""Terrain levels and meshes: [Nunes 2011]'s rules, crack-free edges from random cameras, holes, culling, peaks."""
 
 import numpy as np
 import pytest

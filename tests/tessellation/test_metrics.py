@@ -1,4 +1,4 @@
-"""Adaptive metrics: the test vectors of digest 001 §4 and §11.2."""
+"""Adaptive metrics: worked values of [Nellmedin 2014, ch. 4]."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,5 @@
-"""PN triangles and Phong tessellation: the checklists of digest 000 §9.2 and §9.3."""
+"""PN triangles and Phong tessellation: the properties [Vlachos 2001] and [Boubekeur 2008] state ([Nunes 2011, ch.
+3])."""
 
 import numpy as np
 import pytest
@@ -43,7 +44,7 @@ def phong_eval(p, n, bary, alpha):
 seeds = st.integers(0, 2**32 - 1)
 
 
-# -- PN triangles (§9.2) --------------------------------------------------------------------------------
+# -- PN triangles ---------------------------------------------------------------------------------------
 
 @given(seeds)
 def test_pn_interpolates_corners_positions_and_normals(seed):
@@ -141,7 +142,7 @@ def test_degenerate_inputs_stay_finite():
         assert np.all(np.isfinite(control))
 
 
-# -- Phong tessellation (§9.3) --------------------------------------------------------------------------
+# -- Phong tessellation ---------------------------------------------------------------------------------
 
 @given(seeds)
 def test_projection_lies_on_the_plane_and_is_idempotent(seed):

@@ -93,7 +93,7 @@ def test_inner_levels_may_differ_from_edges():
     v, f = octahedron()
     edges, _, _ = triangle_edges(f)
     ref = refine(f, len(v), np.ones(len(edges)), inner_levels=np.full(len(f), 5.0))
-    assert len(ref.triangles) == 8 * 25  # digest: outer (1,1,1), inner 5 -> 25 triangles
+    assert len(ref.triangles) == 8 * 25  # [Khronos]: outer (1,1,1), inner 5 -> 25 triangles
     assert is_closed_oriented_manifold(ref.triangles)
 
 

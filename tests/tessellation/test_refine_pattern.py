@@ -1,4 +1,5 @@
-"""One-triangle patterns against the hardware tessellator's counts (digest 001 §11.1, measured on llvmpipe)."""
+"""One-triangle patterns against the hardware tessellator's counts ([Nellmedin 2014, ch. 2], [Khronos]; measured on
+llvmpipe)."""
 
 import numpy as np
 import pytest
@@ -53,7 +54,7 @@ def test_uniform_level_gives_floor_three_n_squared_over_two(n):
 
 @pytest.mark.parametrize("outer, inner, n_tris", [((4, 4, 4), 3, 24), ((5, 5, 5), 5, 54)])
 def test_fractional_even_counts(outer, inner, n_tris):
-    # digest 001 Fig. 2.13 [V], "Even" column.
+    # [Nellmedin 2014, Fig. 2.13], "Even" column (measured on llvmpipe).
     assert len(pattern(outer, inner, "FRACTIONAL_EVEN").triangles) == n_tris
 
 
@@ -74,7 +75,7 @@ def test_pattern_tiles_the_triangle(a, b, c, inner, spacing):
 
 
 def test_levels_map_to_opengl_edges():
-    # OL0 is the edge v1-v2, OL1 is v2-v0, OL2 is v0-v1 (digest 001 §11.3).
+    # OL0 is the edge v1-v2, OL1 is v2-v0, OL2 is v0-v1 ([Nellmedin 2014, §5.5.3]).
     ref = pattern((5, 1, 1), 1)
     on_edge = ref.edges[ref.edge_point_edge]
     assert len(on_edge) == 4 and np.all(on_edge == [1, 2])

@@ -1,4 +1,4 @@
-"""Tube kernels: frames, refinement, selection, rings, caps, LOD and the anti-aliasing clamp (seed 000 §4, §9.4)."""
+"""Tube kernels: frames, refinement, selection, rings, caps, LOD and the anti-aliasing clamp ([Nunes 2011, ch. 4])."""
 
 import numpy as np
 import pytest
