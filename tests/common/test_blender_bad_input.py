@@ -330,7 +330,7 @@ def test_nan_in_object_and_brush_settings_is_refused_by_name(clean_scene, bpy_mo
     assert bpy.ops.tessera.terrain_add(source="IMAGE", image_name="hm", culling=False) == {"FINISHED"}
     terrain = bpy.context.active_object
     terrain.tessera.terrain.epsilon = float("nan")
-    refused(bpy, bpy.ops.tessera.terrain_bake, ["Error (px)", "between 0.05 and 100000"])
+    refused(bpy, bpy.ops.tessera.terrain_bake, ["Screen Error", "between 0.05 and 100000"])
     bpy.ops.mesh.primitive_monkey_add()
     monkey = bpy.context.active_object
     monkey.tessera.tessellate.near = float("nan")
