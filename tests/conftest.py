@@ -11,6 +11,7 @@ extension repository the ``blender`` tier enables the add-on from.
 
 import importlib
 import os
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -133,3 +134,21 @@ def opencl():
         tier_unavailable(str(err))
     yield runtime
     opencl_runtime.configure()
+
+
+@pytest.fixture(scope="session")
+def built_zips(bpy_module, tmp_root):
+    """The extension zips: those in $TESSERA_ZIP_DIR when set (`make test-all` builds them once for every Blender),
+    else built once for this session (`tools/build_extension.py`, what `make build` runs)."""
+    given = os.environ.get("TESSERA_ZIP_DIR")
+    if given:
+        zips = sorted(Path(given).glob("tessera-*.zip"))
+        assert zips, f"TESSERA_ZIP_DIR={given} holds no tessera-*.zip"
+        return zips
+    out = tmp_root / "dist"
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_root / "build_user"))
+    proc = subprocess.run([sys.executable, str(ROOT / "tools" / "build_extension.py"), "--out", str(out),
+                           "--wheels", str(tmp_root / "wheels")], capture_output=True, text=True, env=env,
+                          timeout=900)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    return sorted(out.glob("tessera-*.zip"))

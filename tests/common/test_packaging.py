@@ -101,23 +101,6 @@ def _minimal_extension_exit_code(tmp_root):
     return proc.returncode
 
 
-@pytest.fixture(scope="module")
-def built_zips(bpy_module, tmp_root):
-    """The zips in $TESSERA_ZIP_DIR when set (`make test-all` builds them once for every Blender), else new ones."""
-    given = os.environ.get("TESSERA_ZIP_DIR")
-    if given:
-        zips = sorted(Path(given).glob("tessera-*.zip"))
-        assert zips, f"TESSERA_ZIP_DIR={given} holds no tessera-*.zip"
-        return zips
-    out = tmp_root / "dist"
-    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_root / "build_user"))
-    proc = subprocess.run([sys.executable, str(ROOT / "tools" / "build_extension.py"), "--out", str(out),
-                           "--wheels", str(tmp_root / "wheels")], capture_output=True, text=True, env=env,
-                          timeout=900)
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    return sorted(out.glob("tessera-*.zip"))
-
-
 def linux_builder_version(built_zips):
     """(major, minor) of the Blender that built the zips' node library, from its catalog file's header line."""
     import re

@@ -73,7 +73,8 @@ def test_round_trip_and_child_index(seed):
 @pytest.mark.parametrize("stream, words", [
     (b"", ["two header bytes"]), (bytes([2, 0]) + bytes(12), ["start bit"]), (bytes([0, 1]) + bytes(8), ["normals"]),
     (bytes([0, 0]) + bytes(8), ["node 0"]), (bytes([1, 0]) + bytes(12), ["child bits"]),
-    (bytes([1, 0]) + bytes(12) + bytes([16]), ["do not fit four children"]), (bytes([0, 0]) + bytes(13), ["after its last node"]),
+    (bytes([1, 0]) + bytes(12) + bytes([16]), ["do not fit four children"]),
+    (bytes([0, 0]) + bytes(13), ["after its last node"]),
 ])
 def test_bad_streams_are_refused(stream, words):
     with pytest.raises(InvalidInputError) as err:

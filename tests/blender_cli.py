@@ -1,0 +1,91 @@
+"""The ``blender`` command line, run by the ``bpy`` module, for the README's shell snippets: the machines that test
+Tessera have the ``bpy`` wheel of each supported Blender but no Blender executable.
+
+Handled, in Blender's own order (arguments act as they come): ``-b``/``--background``, ``--factory-startup``,
+``--command``/``-c extension ...`` (Blender's own extension command-line handler, as ``blender -c extension`` runs it),
+a ``.blend`` to open, ``--python FILE``, ``-o``/``--render-output``, ``-E``/``--engine``, ``-f``/``--render-frame``
+and ``-a``/``--render-anim``. As Blender does at startup, the user's preferences are loaded and the add-ons they
+enable are enabled (unless ``--factory-startup``). Anything else is refused, so a snippet that uses an option this
+stand-in does not know fails instead of passing unchecked.
+
+Usage: python tests/blender_cli.py ARGS...   (the test puts a ``blender`` script that runs this first on PATH)
+"""
+
+import os
+import runpy
+import sys
+
+
+def _startup(factory):
+    import addon_utils
+    import bpy
+
+    if not factory:
+        bpy.ops.wm.read_userpref()
+        addon_utils.reset_all()  # what Blender's startup does with the add-ons the preferences enable
+
+
+def _render(frames):
+    import bpy
+
+    scene = bpy.context.scene
+    for frame in frames:
+        scene.frame_set(frame)
+        path = scene.render.frame_path(frame=frame)
+        scene.render.filepath, kept = path, scene.render.filepath
+        try:
+            bpy.ops.render.render(write_still=True)
+        finally:
+            scene.render.filepath = kept
+        print(f"Saved: '{path}'")
+
+
+def main(argv):
+    if argv[:1] in (["--command"], ["-c"]):
+        if argv[1:2] != ["extension"]:
+            raise SystemExit(f"blender_cli: no command {argv[1:2]} here (only 'extension')")
+        import bpy  # noqa: F401 (bl_pkg needs Blender's modules)
+        from bl_pkg import bl_extension_cli
+
+        return bl_extension_cli.cli_extension_handler(argv[2:])
+    factory = "--factory-startup" in argv
+    started = False
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg in ("-b", "--background", "--factory-startup"):
+            i += 1
+            continue
+        if not started:
+            import bpy
+
+            _startup(factory)
+            started = True
+        import bpy
+
+        if arg.endswith(".blend"):
+            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(arg), load_ui=False)
+            i += 1
+        elif arg in ("--python", "-P"):
+            runpy.run_path(os.path.abspath(argv[i + 1]), run_name="__main__")
+            i += 2
+        elif arg in ("-o", "--render-output"):
+            bpy.context.scene.render.filepath = argv[i + 1]
+            i += 2
+        elif arg in ("-E", "--engine"):
+            bpy.context.scene.render.engine = argv[i + 1]
+            i += 2
+        elif arg in ("-f", "--render-frame"):
+            _render([int(f) for f in argv[i + 1].split(",")])
+            i += 2
+        elif arg in ("-a", "--render-anim"):
+            scene = bpy.context.scene
+            _render(range(scene.frame_start, scene.frame_end + 1, scene.frame_step))
+            i += 1
+        else:
+            raise SystemExit(f"blender_cli: the stand-in does not know the argument {arg!r}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
