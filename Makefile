@@ -28,7 +28,7 @@ build: setup
 
 bench: setup
 	$(PY) -m pip install -q -r requirements/bench.txt
-	@for f in bench/*.py; do $(PY) $$f || exit 1; done
+	$(PY) tools/bench_report.py --run
 
 clean:
 	rm -rf out dist wheels .pytest_cache .ruff_cache

@@ -5,7 +5,7 @@
   plain sprite (the image as made, pre-warped for O1), and compared with the sphere mesh drawn from the same eye:
   the measured error is the area where they differ over the true outline's length (the mean displacement of the
   outline, in pixels). Lifetime: frames until that error passes 1 px. Reported for both, and their ratio: the
-  seed's claim that relief-mapped boards stay valid longer.
+  paper's claim that relief-mapped boards stay valid longer.
 - ``r1``: the longest and the mean draw of the board (pre-warp + upload + draw, what the viewport callback does per
   frame) while the worker renders another board, against the same with the worker idle ([Clua et al.]: 171 vs 171 fps).
 - ``r1_request_pause``: the main thread's pause to ask for a board in a scene that also holds a 4M-triangle mesh,

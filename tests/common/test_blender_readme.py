@@ -35,16 +35,6 @@ def readme_blocks():
     return [(m.group(1), m.group(2)) for m in FENCE.finditer((ROOT / "README.md").read_text(encoding="utf-8"))]
 
 
-def test_the_readme_is_a_front_door():
-    """At most 12 KB, and it links only to files that exist."""
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert len(text.encode()) <= 12 * 1024
-    links = re.findall(r"\]\(([^)#\s]+)", text)
-    assert len(links) >= 20
-    missing = [link for link in links if not link.startswith("http") and not (ROOT / link).exists()]
-    assert not missing, missing
-
-
 def _make_block(code):
     targets = set(re.findall(r"(?m)^([\w-]+):", (ROOT / "Makefile").read_text(encoding="utf-8")))
     lines = [line.split("#")[0].split() for line in code.splitlines() if line.strip()]

@@ -1,0 +1,46 @@
+"""The README is a front door and the manual is whole (no Blender needed): the README at most 12 KB; a page per
+capability plus the general pages; every relative link and anchor of the README and docs/ resolves. The README's code
+blocks are run by ``test_blender_readme.py``; the menu paths the docs name are resolved by ``test_blender_ui_text.py``.
+"""
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_the_readme_is_a_front_door():
+    """At most 12 KB, and it links only to files that exist."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.encode()) <= 12 * 1024
+    links = re.findall(r"\]\(([^)#\s]+)", text)
+    assert len(links) >= 20
+    missing = [link for link in links if not link.startswith("http") and not (ROOT / link).exists()]
+    assert not missing, missing
+
+
+def test_the_manual_has_a_page_per_capability_and_its_links_resolve():
+    """docs/ holds a page per capability (the layers' capability packages) plus batch use, preferences, performance,
+    architecture, development and references; every relative link of the README and the manual points at a file that
+    exists, and every anchor at a heading or an anchor of that page."""
+    capabilities = sorted(p.name for p in (ROOT / "kernels").iterdir() if p.is_dir() and p.name not in ("common",
+                                                                                                       "__pycache__"))
+    assert len(capabilities) >= 7
+    pages = {p.stem for p in (ROOT / "docs").glob("*.md")}
+    assert set(capabilities) | {"index", "batch", "preferences", "performance", "architecture", "development",
+                                "references", "node_groups"} <= pages
+    bad = []
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for target, anchor in re.findall(r"\]\(([^)#\s]*)(?:#([\w-]+))?\)", page.read_text(encoding="utf-8")):
+            if target.startswith("http"):
+                continue
+            path = (page.parent / target).resolve() if target else page
+            if not path.exists():
+                bad.append(f"{page.name}: {target}")
+            elif anchor and path.suffix == ".md":
+                text = path.read_text(encoding="utf-8")
+                headings = {re.sub(r"[^\w\- ]", "", h).strip().lower().replace(" ", "-")
+                            for h in re.findall(r"(?m)^#+ (.*)$", text)}
+                if anchor not in headings and f'id="{anchor}"' not in text:
+                    bad.append(f"{page.name}: {target}#{anchor}")
+    assert not bad, bad
