@@ -5,6 +5,10 @@
 - ``Scene.tessera``: ``brush`` (the displacement brush shared by the tool and stroke replays);
 - ``Image.tessera``: ``serial`` (strokes applied to a map image, for undo).
 
+The stored names (``tessellate``, ``loop``, ``surface``, ``nailboard``) are older than the capability names
+(tessellation, subdivision, surfaces, impostors) and stay: saved files hold the settings under them
+(docs/architecture.md, "Capabilities and their names").
+
 `register` registers the capabilities' property groups first (a pointer needs its type registered), then the
 roots, then the pointers, so the order is written here and nowhere else.
 """
@@ -24,17 +28,24 @@ _SETTINGS = (tessellation_settings, tubes_settings, displacement_settings, terra
 
 
 class TESSERA_PG_object(bpy.types.PropertyGroup):
-    tessellate: bpy.props.PointerProperty(type=tessellation_settings.TESSERA_PG_tessellation)
-    tubes: bpy.props.PointerProperty(type=tubes_settings.TESSERA_PG_tubes)
-    displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement)
-    terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain)
-    loop: bpy.props.PointerProperty(type=subdivision_settings.TESSERA_PG_subdivision)
-    surface: bpy.props.PointerProperty(type=surfaces_settings.TESSERA_PG_surfaces)
-    nailboard: bpy.props.PointerProperty(type=impostors_settings.TESSERA_PG_impostors)
+    tessellate: bpy.props.PointerProperty(type=tessellation_settings.TESSERA_PG_tessellation,
+                                          description="Tessellation settings of this object")
+    tubes: bpy.props.PointerProperty(type=tubes_settings.TESSERA_PG_tubes, description="Tube settings of this object")
+    displacement: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_displacement,
+                                            description="This object's displacement map and how it is applied")
+    terrain: bpy.props.PointerProperty(type=terrain_settings.TESSERA_PG_terrain,
+                                       description="Terrain settings of this object")
+    loop: bpy.props.PointerProperty(type=subdivision_settings.TESSERA_PG_subdivision,
+                                    description="Loop subdivision settings of this object")
+    surface: bpy.props.PointerProperty(type=surfaces_settings.TESSERA_PG_surfaces,
+                                       description="Live parametric surface settings of this object")
+    nailboard: bpy.props.PointerProperty(type=impostors_settings.TESSERA_PG_impostors,
+                                         description="Live nailboard settings of this object")
 
 
 class TESSERA_PG_scene(bpy.types.PropertyGroup):
-    brush: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_brush)
+    brush: bpy.props.PointerProperty(type=displacement_settings.TESSERA_PG_brush,
+                                     description="The displacement brush (shared by the tool and stroke replays)")
 
 
 classes = (TESSERA_PG_object, TESSERA_PG_scene)
@@ -48,7 +59,7 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     for id_type, group in _ROOTS:
-        id_type.tessera = bpy.props.PointerProperty(type=group)
+        id_type.tessera = bpy.props.PointerProperty(type=group, description="Tessera's settings")
 
 
 def unregister():
