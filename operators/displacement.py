@@ -16,12 +16,11 @@ from ..addon import bridge
 from ..addon.compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
-from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS
+from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS, map_value_property
 from ..addon.guarded import check_numbers, guarded
 from ..addon.preferences import get_preferences
 from ..kernels.common.errors import InvalidInputError, TesseraError
 from ..kernels.common.image_io import image_size
-from ..kernels.common.limits import MAX_WORLD_VALUE
 from ..kernels.displacement.map_edit import check_map_budget
 from ..kernels.displacement.map_io import read_map, write_map
 from ..kernels.displacement.map_strokes import Brush
@@ -86,12 +85,8 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
                                   description="The axes a vector map's X, Y and Z follow")
     filepath: bpy.props.StringProperty(name="From File", subtype="FILE_PATH",
                                        description="Read the map from this file instead (EXR, PNG, TIFF)")
-    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                 soft_min=-100.0, soft_max=100.0,
-                                 description="Map value of a black texel in 8- or 16-bit files")
-    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                  soft_min=-100.0, soft_max=100.0,
-                                  description="Map value of a white texel in 8- or 16-bit files")
+    low: map_value_property("16-bit Low", 0.0, "Map value of a black texel in 8- or 16-bit files")
+    high: map_value_property("16-bit High", 1.0, "Map value of a white texel in 8- or 16-bit files")
 
     @classmethod
     def poll(cls, context):
@@ -147,13 +142,10 @@ class TESSERA_OT_displacement_export(bpy.types.Operator):
 
     filepath: bpy.props.StringProperty(name="File", subtype="FILE_PATH",
                                        description="The file to write: .exr, .png or .tif")
-    low: bpy.props.FloatProperty(name="16-bit Low", default=0.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                 soft_min=-100.0, soft_max=100.0,
-                                 description="Map value written as black in a 16-bit file (lower values are clipped)")
-    high: bpy.props.FloatProperty(name="16-bit High", default=1.0, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
-                                  soft_min=-100.0, soft_max=100.0,
-                                  description="Map value written as white in a 16-bit file (higher values are "
-                                              "clipped)")
+    low: map_value_property("16-bit Low", 0.0, "Map value written as black in a 16-bit file (lower values are "
+                            "clipped)")
+    high: map_value_property("16-bit High", 1.0, "Map value written as white in a 16-bit file (higher values are "
+                             "clipped)")
 
     @classmethod
     def poll(cls, context):

@@ -28,6 +28,12 @@ BRUSH_ITEMS = (
     ("FORCE", "Force", "Push in a cone of depth Strength as wide as the brush"),
     ("TEST", "Offset Disc", "Add the brush direction times Strength inside a hard-edged disc"),
 )
+def map_value_property(name, default, description):
+    """A map value for 8- and 16-bit files (what black or white stands for): a float property, any finite value."""
+    return bpy.props.FloatProperty(name=name, default=default, min=-MAX_WORLD_VALUE, max=MAX_WORLD_VALUE,
+                                   soft_min=-100.0, soft_max=100.0, description=description)
+
+
 FALLOFF_ITEMS = tuple((f, f.title(), f"{f.title()} falloff curve, as in Blender's brushes") for f in FALLOFFS)
 
 
