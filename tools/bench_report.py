@@ -89,6 +89,8 @@ def machine():
 
 
 def _cell(value):
+    if value is None:
+        return "–"
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, float):
