@@ -23,8 +23,10 @@
 Run: .venv/bin/python bench/impostors.py (``--r3``: the R3 rows only)
 """
 
+import atexit
 import importlib
 import json
+import shutil
 import sys
 import time
 
@@ -234,6 +236,7 @@ def request_pause_case(bpy, worker, ball, eye, fov, repeat=3):
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=1414, y_subdivisions=1414, location=(20, 0, 0))
     heavy = bpy.context.active_object
     folder = tempfile.mkdtemp(prefix="tessera-bench-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
     ours, saves = [], []
     for _ in range(repeat):
         t = time.perf_counter()

@@ -12,8 +12,10 @@
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/terrain.py
 """
 
+import atexit
 import json
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -112,6 +114,7 @@ def main():
 def out_of_core(size, heights):
     """Write a size² r16 file by tiling the small map (mirrored, so it stays continuous), analyse it mapped."""
     folder = tempfile.mkdtemp(prefix="tessera-terrain-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
     path = os.path.join(folder, "big.r16")
     small = np.round(heights / 600.0 * 65535).astype("<u2")
     tile = np.block([[small, small[:, ::-1]], [small[::-1], small[::-1, ::-1]]])

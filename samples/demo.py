@@ -32,7 +32,9 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
+import atexit
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -51,6 +53,7 @@ def enable_addon():
     import addon_utils
 
     repo = Path(tempfile.mkdtemp(prefix="tessera-demo-repo-"))
+    atexit.register(shutil.rmtree, repo, ignore_errors=True)
     (repo / "tessera").symlink_to(ROOT, target_is_directory=True)
     bpy.context.preferences.extensions.repos.new(name="tessera_demo", module="tessera_demo",
                                                  custom_directory=str(repo), source="USER")

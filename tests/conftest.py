@@ -9,8 +9,10 @@ The source tree is importable as the package ``tessera`` through a symlink, whic
 extension repository the ``blender`` tier enables the add-on from.
 """
 
+import atexit
 import importlib
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -21,6 +23,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 CI = os.environ.get("CI", "").strip().lower() in ("1", "true", "yes")
 _TMP = Path(tempfile.mkdtemp(prefix="tessera-tests-"))
+atexit.register(shutil.rmtree, _TMP, ignore_errors=True)  # nothing left in the temp folder
 REPO_DIR = _TMP / "repo"  # holds the symlink "tessera" -> source tree
 REPO_DIR.mkdir()
 (REPO_DIR / "tessera").symlink_to(ROOT, target_is_directory=True)

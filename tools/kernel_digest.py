@@ -6,8 +6,10 @@ when two environments disagree: the kernels must give the same bytes whatever Nu
 Usage: python tools/kernel_digest.py   (prints one JSON object: family -> hex digest)
 """
 
+import atexit
 import hashlib
 import json
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -20,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _import_tessera():
     """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
     sys.path.insert(0, str(folder))
 

@@ -9,7 +9,9 @@ Usage: TESSERA_OPENCL=require [TESSERA_OPENCL_DEVICE=name] python tools/opencl_a
 Prints one JSON object per (build, path): differing values, values compared, the largest difference in ulps.
 """
 
+import atexit
 import json
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -22,6 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _import_tessera():
     """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
     folder = Path(tempfile.mkdtemp(prefix="tessera-agreement-"))
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
     (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
     sys.path.insert(0, str(folder))
 
