@@ -1,9 +1,7 @@
 """Make the source tree importable as the package ``tessera`` (a symlink in a temporary folder), and
 enable it in Blender the way an installed extension is (a local extension repository on that folder)."""
 
-import atexit
 import os
-import shutil
 import sys
 import tempfile
 import time
@@ -17,9 +15,11 @@ def import_path():
     global _FOLDER
     if _FOLDER is None:
         _FOLDER = Path(tempfile.mkdtemp(prefix="tessera-bench-"))
-        atexit.register(shutil.rmtree, _FOLDER, ignore_errors=True)
         (_FOLDER / "tessera").symlink_to(ROOT, target_is_directory=True)
         sys.path.insert(0, str(_FOLDER))
+        from tessera.tools.temp_folders import remove_at_exit
+
+        remove_at_exit(_FOLDER)  # Blender writes its user folder here as it exits
         os.environ.setdefault("BLENDER_USER_RESOURCES", str(_FOLDER / "blender_user"))
     return _FOLDER
 

@@ -9,10 +9,8 @@ The source tree is importable as the package ``tessera`` through a symlink, whic
 extension repository the ``blender`` tier enables the add-on from.
 """
 
-import atexit
 import importlib
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -23,11 +21,13 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 CI = os.environ.get("CI", "").strip().lower() in ("1", "true", "yes")
 _TMP = Path(tempfile.mkdtemp(prefix="tessera-tests-"))
-atexit.register(shutil.rmtree, _TMP, ignore_errors=True)  # nothing left in the temp folder
 REPO_DIR = _TMP / "repo"  # holds the symlink "tessera" -> source tree
 REPO_DIR.mkdir()
 (REPO_DIR / "tessera").symlink_to(ROOT, target_is_directory=True)
 sys.path.insert(0, str(REPO_DIR))
+from tessera.tools.temp_folders import remove_at_exit  # noqa: E402
+
+remove_at_exit(_TMP)  # nothing left in the temp folder, Blender's caches included
 os.environ["BLENDER_USER_RESOURCES"] = str(_TMP / "blender_user")
 os.environ["XDG_CACHE_HOME"] = str(_TMP / "cache")
 os.environ["TESSERA_CACHE_DIR"] = str(_TMP / "cache" / "tessera")
