@@ -5,8 +5,9 @@ Handled, in Blender's own order (arguments act as they come): ``-b``/``--backgro
 ``--command``/``-c extension ...`` (Blender's own extension command-line handler, as ``blender -c extension`` runs it),
 a ``.blend`` to open, ``--python FILE``, ``-o``/``--render-output``, ``-E``/``--engine``, ``-f``/``--render-frame``
 and ``-a``/``--render-anim``. As Blender does at startup, the user's preferences are loaded and the add-ons they
-enable are enabled (unless ``--factory-startup``). Anything else is refused, so a snippet that uses an option this
-stand-in does not know fails instead of passing unchecked.
+enable are enabled (unless ``--factory-startup``; on 4.2, whose module cannot reload preferences, the extensions
+installed in the user's repositories are enabled instead). Anything else is refused, so a snippet that uses an
+option this stand-in does not know fails instead of passing unchecked.
 
 Usage: python tests/blender_cli.py ARGS...   (the test puts a ``blender`` script that runs this first on PATH)
 """
@@ -14,15 +15,29 @@ Usage: python tests/blender_cli.py ARGS...   (the test puts a ``blender`` script
 import os
 import runpy
 import sys
+from pathlib import Path
 
 
 def _startup(factory):
+    """Load the user's preferences and enable the add-ons they enable, as Blender's startup does."""
     import addon_utils
     import bpy
 
-    if not factory:
+    if factory:
+        return
+    if bpy.app.version >= (4, 5, 0):
         bpy.ops.wm.read_userpref()
-        addon_utils.reset_all()  # what Blender's startup does with the add-ons the preferences enable
+        addon_utils.reset_all()
+        return
+    # Blender 4.2's bpy module crashes in wm.read_userpref: enable the extensions installed in the user's
+    # repositories instead (what an install with -e, as the README's, enabled)
+    for repo in bpy.context.preferences.extensions.repos:
+        folder = Path(repo.directory) if repo.enabled else None
+        if folder is None or not folder.is_dir():
+            continue
+        for package in sorted(folder.iterdir()):
+            if (package / "blender_manifest.toml").exists():
+                addon_utils.enable(f"bl_ext.{repo.module}.{package.name}", default_set=True)
 
 
 def _render(frames):
