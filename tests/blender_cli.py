@@ -63,22 +63,15 @@ def main(argv):
         from bl_pkg import bl_extension_cli
 
         return bl_extension_cli.cli_extension_handler(argv[2:])
-    factory = "--factory-startup" in argv
-    started = False
+    import bpy
+
+    _startup("--factory-startup" in argv)
     i = 0
     while i < len(argv):
         arg = argv[i]
         if arg in ("-b", "--background", "--factory-startup"):
             i += 1
-            continue
-        if not started:
-            import bpy
-
-            _startup(factory)
-            started = True
-        import bpy
-
-        if arg.endswith(".blend"):
+        elif arg.endswith(".blend"):
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(arg), load_ui=False)
             i += 1
         elif arg in ("--python", "-P"):
