@@ -273,6 +273,18 @@ def write_mesh(name, arrays, info=None, edges=None):
     return mesh
 
 
+def append_loose_edges(mesh, points, edges):
+    """Add vertices points (N, 3) and loose edges (K, 2) between them (indices from 0) to ``mesh``."""
+    co = _get(mesh.vertices, "co", len(mesh.vertices), np.float32, 3)
+    verts = _get(mesh.edges, "vertices", len(mesh.edges), np.int32, 2)
+    base = len(co)
+    mesh.vertices.add(len(points))
+    mesh.edges.add(len(edges))
+    mesh.vertices.foreach_set("co", np.concatenate([co, np.asarray(points, np.float32)]).ravel())
+    mesh.edges.foreach_set("vertices", np.concatenate([verts, np.asarray(edges, np.int32) + base]).ravel())
+    mesh.update()
+
+
 def _restore_active(mesh, info):
     colors = mesh.color_attributes
     if info.active_color and info.active_color in colors:

@@ -1,5 +1,5 @@
 """Curve data across the bpy boundary: legacy Curve objects (evaluated centre lines for tubes, control points of
-Bézier / poly splines, new poly curves), hair `Curves`, and the bicubic patches of surface objects. Mesh and pixel
+Bézier / poly / NURBS splines, new poly curves), hair `Curves`, and the NURBS splines of surface objects. Mesh and pixel
 data stay in `bridge`."""
 
 from dataclasses import dataclass
@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from ..kernels.common import nurbs
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from .bridge import _get
 
@@ -66,7 +67,8 @@ def read_curve_object(ob, radius_scale=1.0):
 @dataclass
 class SplineArrays:
     """One spline of a Curve data-block: kind ``BEZIER``, ``POLY`` or ``NURBS``; co (n, 3) float64; handle_left and
-    handle_right (n, 3) float64 (Bézier) or None; radius and tilt (n,) float64; cyclic; material_index."""
+    handle_right (n, 3) float64 (Bézier) or None; radius and tilt (n,) float64; cyclic; material_index; weight (n,)
+    float64, order and knot_mode (one of `kernels.common.nurbs.KNOT_MODES`) for NURBS, else None, 0, ""."""
 
     kind: str
     co: np.ndarray
@@ -76,6 +78,9 @@ class SplineArrays:
     tilt: np.ndarray
     cyclic: bool
     material_index: int = 0
+    weight: np.ndarray | None = None
+    order: int = 0
+    knot_mode: str = ""
 
 
 def read_splines(curve):
@@ -92,42 +97,35 @@ def read_splines(curve):
             hl = _get(points, "handle_left", n, np.float32, 3).astype(np.float64)
             hr = _get(points, "handle_right", n, np.float32, 3).astype(np.float64)
         else:
-            co, hl, hr = _get(points, "co", n, np.float32, 4)[:, :3].astype(np.float64), None, None
+            co4 = _get(points, "co", n, np.float32, 4).astype(np.float64)
+            co, hl, hr = co4[:, :3], None, None
+        nurbs_spline = s.type == "NURBS"
         out.append(SplineArrays(s.type, co, hl, hr, _control_values(s, "radius"), _control_values(s, "tilt"),
-                                bool(s.use_cyclic_u), s.material_index))
+                                bool(s.use_cyclic_u), s.material_index,
+                                co4[:, 3] if nurbs_spline else None, s.order_u if nurbs_spline else 0,
+                                nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u) if nurbs_spline else ""))
     return out
 
 
-def read_surface_patches(curve):
-    """The bicubic Bézier patches of a SURFACE curve's splines, in object space: ``(patches (P, 4, 4, 3) float64,
-    skipped)``, skipped naming each spline that is not piecewise bicubic Bézier (order 4, not cyclic, unit
-    weights, 4 points with endpoint or Bézier knots or 3k + 1 with Bézier knots, in both directions). Points are
-    stored u fastest: net[i, j] = point j * count_u + i."""
-    patches, skipped = [], []
+def read_surface_splines(curve):
+    """The NURBS splines of a SURFACE curve, in object space: ``(surfaces, rows)``. surfaces: (index,
+    `kernels.common.nurbs.SurfaceSpline`) for each spline with more than one point in both directions (points (nv,
+    nu, 4), u fastest in Blender's list); rows: (index, points (n, 4), `Direction`) for each spline that is a single
+    row (Add > Surface > NURBS Curve or Circle), a curve drawn as edges."""
+    surfaces, rows = [], []
     for k, s in enumerate(curve.splines):
         nu, nv = s.point_count_u, s.point_count_v
         co = _get(s.points, "co", len(s.points), np.float32, 4).astype(np.float64)
-
-        def bezier(count, endpoint, bez):
-            return (count == 4 and (endpoint or bez)) or (bez and count > 4 and (count - 1) % 3 == 0)
-
-        why = None
-        if s.type != "NURBS" or s.order_u != 4 or s.order_v != 4:
-            why = f"order {s.order_u} x {s.order_v} (bicubic needs 4 x 4)"
-        elif s.use_cyclic_u or s.use_cyclic_v:
-            why = "cyclic"
-        elif not np.allclose(co[:, 3], 1.0):
-            why = "rational (weights other than 1)"
-        elif not (bezier(nu, s.use_endpoint_u, s.use_bezier_u) and bezier(nv, s.use_endpoint_v, s.use_bezier_v)):
-            why = f"{nu} x {nv} points without Bézier knots (turn on Bezier, or Endpoint for 4 x 4)"
-        if why:
-            skipped.append(f"spline {k}: {why}")
+        u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), bool(s.use_cyclic_u))
+        if nv <= 1 or nu <= 1:
+            if nu <= 1:
+                u = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v),
+                                    bool(s.use_cyclic_v))
+            rows.append((k, co, u))
             continue
-        net = co[:, :3].reshape(nv, nu, 3).transpose(1, 0, 2)  # net[i (u), j (v)]
-        for a in range(0, nu - 1, 3):
-            for b in range(0, nv - 1, 3):
-                patches.append(net[a:a + 4, b:b + 4])
-    return (np.array(patches) if patches else np.zeros((0, 4, 4, 3))), skipped
+        v = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v), bool(s.use_cyclic_v))
+        surfaces.append((k, nurbs.SurfaceSpline(co.reshape(nv, nu, 4), u, v)))
+    return surfaces, rows
 
 
 def write_poly_curve(name, splines, dimensions="3D"):

@@ -27,7 +27,8 @@ from ..addon.surfaces.settings import (
     surface_from,
 )
 from ..addon.surfaces.sources import control_points
-from ..kernels.common.bezier_curves import adaptive_spline
+from ..kernels.common import nurbs
+from ..kernels.common.bezier_curves import MAX_TOLERANCE_SEGMENTS, CurveSampling, adaptive_nurbs, adaptive_spline
 from ..kernels.common.errors import BudgetError, GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
@@ -255,7 +256,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return object_poll(cls, context, {"SURFACE"}, "Select a surface object (NURBS surface patches) in Object Mode")
+        return object_poll(cls, context, {"SURFACE"}, "Select a surface object (Add > Surface) in Object Mode")
 
     def draw(self, context):
         draw_patch_options(self.layout, self)
@@ -263,27 +264,80 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
     @guarded
     def execute(self, context, tx):
         ob = context.active_object
-        patches, skipped = curve_bridge.read_surface_patches(ob.data)
-        if len(patches) == 0:
-            raise InvalidInputError(f"Surface {ob.name!r} has no bicubic Bézier patch"
-                                    + (": " + "; ".join(skipped) if skipped else ""))
+        surfaces, rows = curve_bridge.read_surface_splines(ob.data)
+        if not surfaces and not rows:
+            raise InvalidInputError(f"Surface {ob.name!r} has no spline: add one in Edit Mode, or select another")
         lod = patch_lod(self)
         cam = None
         if set(lod.metrics) & {"DISTANCE", "EDGE_LENGTH"}:
             cam = object_camera(camera_for(context, self.camera_source, "Camera levels"), ob.matrix_world)
-        edges = bp.patch_edges(patches)
-        edge_levels, inner = bp.patch_levels(patches, edges, lod, cam)
-        mesh = bp.tessellate_patches(patches, edge_levels, inner, edges)
-        arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles,
-                            corner_attributes={"UVMap": mesh.corner_uv}, attribute_types={"UVMap": "FLOAT2"})
-        data = tx.track(bridge.write_mesh(f"{ob.data.name}.tessellated", arrays))
-        data.shade_smooth()
+        budget = get_preferences(context).memory_budget_bytes
+        words, warn = [], False
+        if surfaces:
+            patch_set = _spline_patches(surfaces)
+            result = bp.tessellate(patch_set.patches, lod, cam, budget)
+            mesh = result.mesh
+            corner_uv = patch_set.uv(mesh.triangle_patch[:, None], mesh.corner_uv).astype(np.float32)
+            arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles, point_normals=mesh.normals,
+                                corner_attributes={"UVMap": corner_uv}, attribute_types={"UVMap": "FLOAT2"})
+            words.append(f"{len(patch_set.patches):,} patches, sides {int(result.edge_levels.min())}-"
+                         f"{int(result.edge_levels.max())} segments, {len(mesh.triangles):,} triangles")
+            if "TOLERANCE" in lod.metrics:
+                worst = float(np.nanmax(result.deviation))
+                if len(result.unmet):
+                    warn = True
+                    splines = sorted({surfaces[int(patch_set.spline[q])][0] for q in result.unmet})
+                    words.append(f"{len(result.unmet)} patch(es) of spline(s) {', '.join(map(str, splines))} stay "
+                                 f"over the tolerance at Max Level {lod.max_level} (up to {worst:.3g}): raise Max "
+                                 "Level or the Tolerance")
+                else:
+                    words.append(f"within {lod.tolerance:g} of the surface (largest measured {worst:.3g})")
+        line_points, line_edges = _row_lines(rows, lod.tolerance)
+        name = f"{ob.data.name}.tessellated"
+        data = tx.track(bridge.write_mesh(name, arrays) if surfaces else bpy.data.meshes.new(name))
+        if len(line_points):
+            bridge.append_loose_edges(data, line_points, line_edges)
+            words.append(f"{len(rows)} curve(s) as {len(line_edges):,} edges")
+        if surfaces:
+            data.shade_smooth()
         place_mesh(context, tx, ob, data, "NEW_OBJECT", "tessellated")
-        note = f"; {len(skipped)} spline(s) left out: " + "; ".join(skipped) if skipped else ""
-        self.report({"WARNING" if skipped else "INFO"},
-                    f"{len(patches)} patches, sides {int(edge_levels.min())}-{int(edge_levels.max())} segments, "
-                    f"{len(mesh.triangles):,} triangles{note}")
+        self.report({"WARNING" if warn else "INFO"}, "; ".join(words))
         return {"FINISHED"}
+
+
+def _spline_patches(surfaces):
+    """A `PatchSet` of (index, SurfaceSpline) pairs; a refusal names the spline in Blender's list."""
+    try:
+        return nurbs.patches_of([s for _, s in surfaces])
+    except InvalidInputError as err:
+        message = str(err)
+        for i, (k, _) in enumerate(surfaces):
+            message = message.replace(f"surface spline {i} ", f"surface spline {k} ")
+        raise InvalidInputError(message) from None
+
+
+def _row_lines(rows, tolerance):
+    """The single-row splines (curves in a surface object) as polylines within ``tolerance``: (points (N, 3),
+    edges (K, 2) int32)."""
+    points, edges, base = [], [], 0
+    sampling = CurveSampling(mode="TOLERANCE", tolerance=tolerance, max_segments=MAX_TOLERANCE_SEGMENTS)
+    for k, co, direction in rows:
+        n = len(co)
+        try:
+            [a] = adaptive_nurbs(co[:, :3], co[:, 3], direction, np.ones(n), np.zeros(n), sampling)
+        except InvalidInputError as err:
+            raise InvalidInputError(str(err).replace("The NURBS spline", f"Surface spline {k}")) from None
+        m = len(a.points)
+        idx = base + np.arange(m)
+        pairs = np.stack([idx[:-1], idx[1:]], 1)
+        if a.cyclic:
+            pairs = np.concatenate([pairs, [[idx[-1], idx[0]]]])
+        points.append(a.points)
+        edges.append(pairs)
+        base += m
+    if not points:
+        return np.zeros((0, 3)), np.zeros((0, 2), np.int32)
+    return np.concatenate(points), np.concatenate(edges).astype(np.int32)
 
 
 classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_parametric_surface_bake, TESSERA_OT_curve_adaptive,

@@ -238,14 +238,18 @@ PATCH_METRIC_ITEMS = (
     ("DISTANCE", "Distance", "From the camera distance: sides from their nearest control point, the inside from the "
                              "patch's centre"),
     ("EDGE_LENGTH", "Edge Length", "From each side's length on screen, Edge Pixels a segment"),
+    ("TOLERANCE", "Tolerance", "As many as keep the mesh within Tolerance of the surface, measured"),
 )
 
 
 class PatchOptions:
     """The options of ``tessera.surface_tessellate`` (`kernels.surfaces.bezier_patches.PatchLod`)."""
 
-    metrics: bpy.props.EnumProperty(name="Metrics", items=PATCH_METRIC_ITEMS, default={"CURVATURE"},
+    metrics: bpy.props.EnumProperty(name="Metrics", items=PATCH_METRIC_ITEMS, default={"TOLERANCE"},
                                     options={"ENUM_FLAG"}, description="Levels from these, the largest wins")
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=0.001, min=1e-7, max=MAX_WORLD_VALUE, soft_min=1e-5,
+                                       soft_max=1.0, precision=5, subtype="DISTANCE", unit="LENGTH",
+                                       description="Largest distance allowed between the mesh and the surface")
     max_level: bpy.props.IntProperty(name="Max Level", default=32, min=1, max=64,
                                      description="Most segments on a side or inside a patch")
     inner_rows: bpy.props.EnumProperty(name="Inner Curvature", default="ALL", items=(
@@ -278,7 +282,7 @@ def patch_lod(options):
         raise InvalidInputError("Choose at least one metric for the levels")
     return PatchLod(metrics=tuple(sorted(options.metrics)), max_level=options.max_level,
                     inner_rows=options.inner_rows, near=options.near, far=options.far, mapping=options.mapping,
-                    edge_pixels=options.edge_pixels, degenerate=options.degenerate)
+                    edge_pixels=options.edge_pixels, degenerate=options.degenerate, tolerance=options.tolerance)
 
 
 def draw_patch_options(layout, options):
@@ -287,6 +291,8 @@ def draw_patch_options(layout, options):
     col = layout.column()
     col.prop(options, "metrics")
     col.prop(options, "max_level")
+    if "TOLERANCE" in options.metrics:
+        col.prop(options, "tolerance")
     if "CURVATURE" in options.metrics:
         col.prop(options, "inner_rows")
         col.prop(options, "degenerate")

@@ -9,12 +9,17 @@ of consecutive segments share their end points, so the polyline is continuous an
 
 `adaptive_spline` samples a whole spline by a `CurveSampling` (curvature, world tolerance or pixels), with radius and
 tilt interpolated along each segment and [Nellmedin 2014]'s "copies" (OL0, §5.5.2): N offset copies, for hair.
+`adaptive_nurbs` does the same for a NURBS spline of any order, weights and knots, split exactly into rational Bézier
+pieces (`kernels.common.nurbs`): the curvature of each piece's control polygon, or a tolerance met by measuring the
+chords (`kernels.common.rational_bezier.tolerance_steps`).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import nurbs
+from . import rational_bezier as rb
 from .errors import InvalidInputError
 from .level_metrics import curvature_level, curve_kappa
 
@@ -147,13 +152,15 @@ class CurveSampling:
 @dataclass
 class AdaptiveSpline:
     """One output polyline: points (n, 3), radius (n,), tilt (n,) float64, cyclic; counts (S,) segments per Bézier
-    segment of its source."""
+    segment of its source; deviation (S,) float64: the largest distance measured between each segment and its
+    chords (NURBS splines sampled to a tolerance), else None."""
 
     points: np.ndarray
     radius: np.ndarray
     tilt: np.ndarray
     cyclic: bool
     counts: np.ndarray
+    deviation: np.ndarray | None = None
 
 
 def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, settings, camera=None):
@@ -184,3 +191,44 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
     r, tl = along(radius), along(tilt)
     return [AdaptiveSpline(p, r, tl, bool(cyclic), counts) for p in offset_copies(s.points, settings.copies,
                                                                                      settings.offset)]
+
+
+def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None):
+    """Sample one NURBS spline (points (n, 3), weights (n,), a `kernels.common.nurbs.Direction`, radius and tilt
+    (n,)) by ``settings`` (`CurveSampling`), through its exact rational Bézier pieces. CURVATURE: eq. 4.5 on each
+    piece's control polygon (a straight piece of order 2: one step); TOLERANCE and SCREEN: steps measured to meet the
+    tolerance (up to Max Segments; the deviation left is in the result). Returns the `AdaptiveSpline` of each copy."""
+    pts = np.c_[np.asarray(co, np.float64).reshape(-1, 3), np.asarray(weight, np.float64).reshape(-1)]
+    pieces, _ = nurbs.curve_pieces(pts, direction, np.c_[radius, tilt], what="NURBS spline")
+    geo = pieces[..., :4]
+    control = rb.cartesian(geo)
+    deviation = None
+    if settings.mode == "CURVATURE":
+        if direction.order == 2:
+            counts = np.ones(len(pieces), np.int64)
+        else:
+            counts = np.ceil(curvature_level(curve_kappa(control), n_control=direction.order, gain=GAIN,
+                                             t_max=settings.max_segments)).astype(np.int64)
+    else:
+        if settings.mode == "SCREEN":
+            if camera is None:
+                raise InvalidInputError("Sampling for the screen needs a camera")
+            tol = pixel_tolerance(control, camera, settings.pixels)
+        else:
+            tol = settings.tolerance
+            if not (np.isfinite(tol) and tol > 0):
+                raise InvalidInputError("The curve tolerance must be a positive number")
+        counts, deviation = rb.tolerance_steps(geo, tol, settings.max_segments)
+    segment = np.repeat(np.arange(len(pieces)), counts)
+    first = np.repeat(np.cumsum(counts) - counts, counts)
+    t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
+    if not direction.cyclic:  # the last end point
+        segment, t = np.append(segment, len(pieces) - 1), np.append(t, 1.0)
+    h = np.einsum("nk,nkc->nc", rb.bernstein(t, direction.order - 1), pieces[segment])
+    h[t == 0] = pieces[segment[t == 0], 0]  # piece ends exactly (shared by the pieces that meet there)
+    if not direction.cyclic:
+        h[-1] = pieces[-1, -1]
+    points = h[:, :3] / h[:, 3:4]
+    r, tl = h[:, 4] / h[:, 3], h[:, 5] / h[:, 3]
+    return [AdaptiveSpline(p, r, tl, bool(direction.cyclic), counts, deviation)
+            for p in offset_copies(points, settings.copies, settings.offset)]

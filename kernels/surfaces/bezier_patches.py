@@ -1,26 +1,34 @@
-"""Bicubic Bézier patches tessellated with per-patch, per-boundary levels, welded with no T-junction ([Nellmedin 2014,
-§4.3, §5.5.3]; the Utah teapot's kind of model).
+"""Rational Bézier patches of any degree tessellated with per-patch, per-boundary levels, welded with no
+T-junction ([Nellmedin 2014, §4.3, §5.5.3]; the Utah teapot's kind of model, and every NURBS surface Blender holds once
+`kernels.common.nurbs` has split it into patches).
 
-A patch is its 4 x 4 control net ``P[i, j]`` (i along u, j along v), ``P(u, v) = Σ B_i(u) B_j(v) P[i, j]``.
-Sides, in the pattern's order (`kernels.common.quad_pattern.pattern`): BOTTOM v = 0 (u from 0 to 1), RIGHT u = 1 (v
-up), TOP v = 1 (u up), LEFT u = 0 (v up). A side is a cubic of its 4 control points only, so it is one edge shared
-by the patches that have those 4 points: each edge is keyed by its control points in a canonical direction, its
-level computed once from them and its points evaluated once, in that direction; a patch reads them forwards or
-backwards. Corners are control points. Shared boundaries are therefore one set of vertices (welded by
-construction) and no crack or T-junction can appear. A boundary that collapses to a point (the teapot's lid top
-and bottom centre) gives the same point L + 1 times: such points are merged and the triangles they flatten
-dropped. Such a collapsed row has κ⁺ = 0/0: it counts as the cap by default, as [Nellmedin 2014]'s GPU did ([Nellmedin
-2014, item 5; `PatchLod.degenerate`), which with the knob's fold is what makes the teapot's knob and base its finest
-patches.
+A patch is its k x k homogeneous control net ``H[i, j] = (w x, w y, w z, w)`` (i along u, j along v; degree k - 1
+in both directions: a direction of lower degree is raised exactly, `kernels.common.nurbs.degree_elevate`), and
+``S(u, v) = Σ B_i(u) B_j(v) H[i, j]`` divided by its last coordinate. Polynomial patches may be given as (P, k, k, 3)
+Cartesian nets (weights 1). Sides, in the pattern's order (`kernels.common.quad_pattern.pattern`): BOTTOM v = 0 (u
+from 0 to 1), RIGHT u = 1 (v up), TOP v = 1 (u up), LEFT u = 0 (v up). A side is a rational curve of its k control
+points only, so it is one edge shared by the patches that have those points: each edge is keyed by its control points
+in a canonical direction, its level computed once from them and its points evaluated once, in that direction; a patch
+reads them forwards or backwards. Corners are control points. Shared boundaries are therefore one set of vertices
+(welded by construction) and no crack or T-junction can appear. A boundary that collapses to a point (the teapot's lid
+top, a NURBS sphere's poles) gives the same point L + 1 times: such points are merged (the poles of all the patches
+around one point become one vertex) and the triangles they flatten dropped. Such a collapsed row has κ⁺ = 0/0: it
+counts as the cap by default, as [Nellmedin 2014]'s GPU did ([Nellmedin 2014, item 5; `PatchLod.degenerate`).
 
-Levels (`patch_levels`):
-- curvature: a side's level from its own control polygon (eq. 4.5, min 6, max Max Level); the inner levels from
-  the rows (u) and the columns (v) of the net (``inner_rows`` ALL, [Nellmedin 2014]'s §4.1.2, or INTERIOR, its §5.3.3:
-  [Nellmedin 2014, correction 3]) and the 9 cells' diagonal κ× (eq. 4.6): if the largest κ× exceeds both, it sets both;
-- distance: a side from the smallest distance of its 4 control points to the eye, the inner from the net's
-  centroid, through the linear (or inverse) map between Near and Far;
+Levels (`patch_levels`), on the control points' Cartesian positions:
+- curvature: a side's level from its own control polygon (eq. 4.5, min 2 (k - 1), max Max Level); the inner levels
+  from the rows (u) and the columns (v) of the net (``inner_rows`` ALL, [Nellmedin 2014]'s §4.1.2, or INTERIOR, its
+  §5.3.3: [Nellmedin 2014, correction 3]) and the cells' diagonal κ× (eq. 4.6): if the largest κ× exceeds both, it sets
+  both;
+- distance: a side from the smallest distance of its control points to the eye, the inner from the net's centroid,
+  through the linear (or inverse) map between Near and Far;
 - projected edge length (§4.4): a side as a sphere as wide as its control polygon is long, at its centroid, over
   Edge Pixels; the inside from the net's longest row or column at its centroid;
+- tolerance (chordal deviation, scene units): a side's level from the deviation of its chords at 16 steps, a patch's
+  from its triangles' at an 8 x 8 grid, both scaled as the square root (the deviation of a chord falls with the square
+  of its length); then `tessellate` measures every triangle of the mesh against the surface and raises the levels
+  where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is met or the patches that cannot meet
+  it within Max Level are named;
 - any of these together: the largest. Levels are whole segment counts; one inner count per patch, the larger of u
   and v (the pattern's single inner level).
 """
@@ -30,29 +38,39 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes
-
-METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH")
-MAX_LEVEL = 64
-#: Control-net indices (i, j) of each side, in the side's direction.
-_SIDES = (
-    [(i, 0) for i in range(4)],   # BOTTOM
-    [(3, j) for j in range(4)],   # RIGHT
-    [(i, 3) for i in range(4)],   # TOP
-    [(0, j) for j in range(4)],   # LEFT
+from ..common.rational_bezier import (
+    bernstein,
+    bernstein_derivative,
+    cartesian,
+    chord_deviation,
+    steps_for,
 )
+
+METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
+MAX_LEVEL = 64
+#: Rounds of measuring the mesh against the surface and raising levels, for the tolerance.
+TOLERANCE_ROUNDS = 16
+#: Barycentric points where each triangle is measured against the surface: its edges' midpoints and quarter points,
+#: its centroid and the points halfway from the centroid to each corner.
+_B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [.25, .75, 0], [.75, .25, 0], [0, .25, .75], [0, .75, .25],
+               [.75, 0, .25], [.25, 0, .75], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6],
+               [1 / 6, 1 / 6, 2 / 3]])
+#: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
+COLLAPSED = 1e-12
 
 
 @dataclass(frozen=True)
 class PatchLod:
-    """How levels are chosen: metrics, some of CURVATURE, DISTANCE, EDGE_LENGTH (combined by maximum); max_level
-    (≤ 64, the curvature metric's cap t_tessmax); inner_rows ALL or INTERIOR; near, far, mapping (LINEAR or
+    """How levels are chosen: metrics, some of CURVATURE, DISTANCE, EDGE_LENGTH, TOLERANCE (combined by maximum);
+    max_level (≤ 64, the curvature metric's cap t_tessmax); inner_rows ALL or INTERIOR; near, far, mapping (LINEAR or
     INVERSE): the distance map; edge_pixels: the projected-edge metric's segment length on screen; degenerate:
     what a row of the net that collapses to one point (κ⁺ = 0/0) counts for the inner levels: CAP ([Nellmedin 2014]'s
     GPU, and what makes the teapot's knob and base its finest patches; [Nellmedin 2014, correction 4]) or ZERO (no
-    bend)."""
+    bend); tolerance: the largest distance between the mesh and the surface (scene units) for TOLERANCE."""
 
     metrics: tuple = ("CURVATURE",)
     max_level: int = 32
@@ -62,12 +80,15 @@ class PatchLod:
     mapping: str = "LINEAR"
     edge_pixels: float = 10.0
     degenerate: str = "CAP"
+    tolerance: float = 0.001
 
     def __post_init__(self):
         if not self.metrics or not set(self.metrics) <= set(METRICS):
             raise InvalidInputError(f"metrics must be some of {', '.join(METRICS)}; got {self.metrics!r}")
         if not (np.isfinite(self.edge_pixels) and self.edge_pixels > 0):
             raise InvalidInputError(f"Edge Pixels must be a positive number; got {self.edge_pixels!r}")
+        if not (np.isfinite(self.tolerance) and self.tolerance > 0):
+            raise InvalidInputError(f"Tolerance must be a positive distance; got {self.tolerance!r}")
         if self.degenerate not in ("CAP", "ZERO"):
             raise InvalidInputError(f"degenerate must be CAP or ZERO; got {self.degenerate!r}")
         if self.inner_rows not in ("ALL", "INTERIOR"):
@@ -78,19 +99,24 @@ class PatchLod:
 
 @dataclass
 class PatchEdges:
-    """The patches' sides as shared edges. control: (E, 4, 3) each edge's control points in its canonical
-    direction; edge: (P, 4) the edge of each patch side; reversed: (P, 4) whether the side runs against it."""
+    """The patches' sides as shared edges. control: (E, k, 4) each edge's homogeneous control points in its
+    canonical direction; edge: (P, 4) the edge of each patch side; reversed: (P, 4) whether the side runs against
+    it; collapsed: (E,) bool, the edge is one point (a pole); point: (E, 3) that point (the first control point's
+    position, the same for every collapsed edge that meets there)."""
 
     control: np.ndarray
     edge: np.ndarray
     reversed: np.ndarray
+    collapsed: np.ndarray = None
+    point: np.ndarray = None
 
 
 @dataclass
 class PatchMesh:
     """positions (V, 3) float32; triangles (T, 3) int32 (counter-clockwise in each patch's (u, v)); uv (V, 2)
     float32 and patch (V,) int64: where each vertex was evaluated (a shared vertex: its first patch);
-    triangle_patch (T,) int64 and corner_uv (T, 3, 2) float32: each triangle's patch and its corners' (u, v) in it."""
+    triangle_patch (T,) int64 and corner_uv (T, 3, 2) float32: each triangle's patch and its corners' (u, v) in it;
+    normals (V, 3) float32: the surface's unit normal at each vertex (along dS/du x dS/dv)."""
 
     positions: np.ndarray
     triangles: np.ndarray
@@ -98,51 +124,140 @@ class PatchMesh:
     patch: np.ndarray
     triangle_patch: np.ndarray
     corner_uv: np.ndarray
+    normals: np.ndarray = None
 
 
-def bernstein(t):
-    """Cubic Bernstein basis (..., 4) at t (...)."""
-    t = np.asarray(t, np.float64)[..., None]
-    s = 1.0 - t
-    return np.concatenate([s ** 3, 3 * s * s * t, 3 * s * t * t, t ** 3], axis=-1)
+@dataclass
+class Tessellation:
+    """What `tessellate` made: mesh (`PatchMesh`); edge_levels (E,) and inner_levels (P,) int64; edges
+    (`PatchEdges`); deviation (P,) float64: the largest distance measured between each patch's triangles and the
+    surface (NaN when the tolerance was not asked for); unmet (K,) int64: the patches still over the tolerance at Max
+    Level."""
+
+    mesh: PatchMesh
+    edge_levels: np.ndarray
+    inner_levels: np.ndarray
+    edges: PatchEdges
+    deviation: np.ndarray
+    unmet: np.ndarray
+
+
+
+
+
+
+def homogeneous_nets(control):
+    """(P, k, k, 4) homogeneous nets from (P, k, k, 3) Cartesian (weights 1) or (P, k, k, 4) homogeneous."""
+    c = np.asarray(control, np.float64)
+    if c.ndim == 4 and c.shape[-1] == 3:
+        c = np.concatenate([c, np.ones(c.shape[:-1] + (1,))], axis=-1)
+    return c
 
 
 def evaluate(control, u, v):
-    """Points of patches: control (P, 4, 4, 3), u and v (P, k) -> (P, k, 3)."""
-    bu, bv = bernstein(u), bernstein(v)
-    return np.einsum("pki,pkj,pijc->pkc", bu, bv, np.asarray(control, np.float64))
+    """Points of patches: control (P, k, k, 3 or 4), u and v (P, n) -> (P, n, 3)."""
+    h = homogeneous_nets(control)
+    d = h.shape[1] - 1
+    p = np.einsum("pki,pkj,pijc->pkc", bernstein(u, d), bernstein(v, d), h)
+    return p[..., :3] / p[..., 3:]
+
+
+def _point_and_normal(h, u, v):
+    """Positions (N, 3) and unit normals (N, 3) of nets h (N, k, k, 4) at u, v (N,). A normal that vanishes (at a
+    pole) is taken a little inside the patch, towards its centre."""
+    d = h.shape[1] - 1
+
+    def at(h, u, v):
+        bu, bv = bernstein(u, d), bernstein(v, d)
+        du, dv = bernstein_derivative(u, d), bernstein_derivative(v, d)
+        s = np.einsum("ni,nj,nijc->nc", bu, bv, h)
+        su = np.einsum("ni,nj,nijc->nc", du, bv, h)
+        sv = np.einsum("ni,nj,nijc->nc", bu, dv, h)
+        w = s[:, 3:]
+        p = s[:, :3] / w
+        n = np.cross(su[:, :3] - p * su[:, 3:], sv[:, :3] - p * sv[:, 3:])
+        return p, n
+
+    p, n = at(h, u, v)
+    length = np.linalg.norm(n, axis=1)
+    scale = np.abs(h[..., :3] / h[..., 3:]).reshape(len(h), -1).max(axis=1) + 1.0
+    weak = length <= 1e-9 * scale ** 2
+    for step in (1e-4, 1e-3, 1e-2):
+        if not weak.any():
+            break
+        _, n2 = at(h[weak], u[weak] + step * (0.5 - u[weak]), v[weak] + step * (0.5 - v[weak]))
+        n[weak] = n2
+        length = np.linalg.norm(n, axis=1)
+        weak = length <= 1e-9 * scale ** 2
+    n = n / np.where(length > 0, length, 1.0)[:, None]
+    return p, n
 
 
 def check_patches(control):
+    """Validated homogeneous nets (P, k, k, 4) float64 of (P, k, k, 3) Cartesian or (P, k, k, 4) homogeneous
+    control points, k from 2 to 7."""
     c = np.asarray(control, np.float64)
-    if c.ndim != 4 or c.shape[1:] != (4, 4, 3) or len(c) == 0:
-        raise InvalidInputError(f"Bicubic patches need (P, 4, 4, 3) control points; got {c.shape}")
+    if c.ndim != 4 or c.shape[1] != c.shape[2] or not 2 <= c.shape[1] <= 7 or c.shape[3] not in (3, 4) or len(c) == 0:
+        raise InvalidInputError(f"Patches need (P, k, k, 3) or (P, k, k, 4) control points, k from 2 to 7; got "
+                                f"{c.shape}")
     if not np.all(np.isfinite(c)):
         raise InvalidInputError("The surface has control points that are NaN or infinite")
-    return c
+    h = homogeneous_nets(c)
+    if np.any(h[..., 3] <= 0):
+        raise InvalidInputError("The surface has weights of zero or less; NURBS weights must be positive")
+    return h
+
+
+
+
+def _sides(h):
+    """Each patch's four sides' homogeneous control points, in the sides' directions: (P, 4, k, 4)."""
+    return np.stack([h[:, :, 0], h[:, -1, :], h[:, :, -1], h[:, 0, :]], axis=1)
 
 
 def patch_edges(control):
     """Key every patch side by its control points: a `PatchEdges`."""
-    c = check_patches(control)
-    sides = np.stack([c[:, [i for i, _ in s], [j for _, j in s]] for s in _SIDES], axis=1)  # (P, 4, 4, 3)
-    flat = sides.reshape(-1, 4, 3)
+    h = check_patches(control)
+    k = h.shape[1]
+    flat = _sides(h).reshape(-1, k, 4)
     back = flat[:, ::-1]
     fwd_key, back_key = flat.reshape(len(flat), -1), back.reshape(len(flat), -1)
     # canonical: the lexicographically smaller of the two directions (exact comparison of the float64 values)
-    rev = np.array([tuple(b) < tuple(f) for f, b in zip(fwd_key, back_key, strict=True)])
+    diff = fwd_key != back_key
+    first = np.where(diff.any(axis=1), diff.argmax(axis=1), 0)
+    rows = np.arange(len(flat))
+    rev = back_key[rows, first] < fwd_key[rows, first]
     canon = np.where(rev[:, None, None], back, flat)
-    _, first, edge = np.unique(canon.reshape(len(canon), -1), axis=0, return_index=True, return_inverse=True)
-    return PatchEdges(canon[first], edge.reshape(-1, 4), rev.reshape(-1, 4))
+    _, first_of, edge = np.unique(canon.reshape(len(canon), -1), axis=0, return_index=True, return_inverse=True)
+    control_e = canon[first_of]
+    pts = cartesian(control_e)
+    size = np.abs(cartesian(h)).max() + 1.0
+    collapsed = np.all(np.linalg.norm(pts - pts[:, :1], axis=-1) <= COLLAPSED * size, axis=1)
+    point = pts[:, 0].copy()
+    point[collapsed] = _cluster(point[collapsed], COLLAPSED * size * 16)
+    return PatchEdges(control_e, edge.reshape(-1, 4), rev.reshape(-1, 4), collapsed, point)
 
 
-def _eq45(kappa, max_level):
-    return np.ceil(curvature_level(kappa, n_control=4, t_max=float(max_level))).astype(np.int64)
+def _cluster(points, tol):
+    """Points (n, 3) with each group of near-equal ones (within tol) replaced by the group's first: (n, 3)."""
+    out = points.copy()
+    done = np.zeros(len(points), bool)
+    for i in range(len(points)):  # few: one per pole side
+        if done[i]:
+            continue
+        near = (np.linalg.norm(points - points[i], axis=1) <= tol) & ~done
+        out[near] = points[i]
+        done |= near
+    return out
+
+
+def _eq45(kappa, max_level, k):
+    return np.ceil(curvature_level(kappa, n_control=k, t_max=float(max_level))).astype(np.int64)
 
 
 def diagonal_kappa(control):
     """Eq. 4.6 per cell of each net: ½ |P[i+1,j+1] + P[i,j] - P[i+1,j] - P[i,j+1]| / min(diagonals), the largest
-    of the 9 cells: (P, 4, 4, 3) -> (P,). A cell whose diagonals both vanish counts as 0 (nothing to split)."""
+    of the cells: (P, k, k, 3) -> (P,). A cell whose diagonals both vanish counts as 0 (nothing to split)."""
     c = np.asarray(control, np.float64)
     a, b, d, e = c[:, :-1, :-1], c[:, 1:, 1:], c[:, 1:, :-1], c[:, :-1, 1:]
     num = 0.5 * np.linalg.norm(b + a - d - e, axis=-1)
@@ -156,27 +271,55 @@ def _polygon_length(points):
     return np.linalg.norm(np.diff(points, axis=-2), axis=-1).sum(axis=-1)
 
 
+
+
+
+
+
+
+def _inner_deviation(h, grid=8):
+    """Deviation of each patch's triangles on a grid x grid split (cells cut along a diagonal, as the pattern's):
+    measured at the cells' side midpoints and diagonal midpoints. (P,) float64."""
+    t = np.arange(2 * grid + 1) / (2 * grid)
+    d = h.shape[1] - 1
+    b = bernstein(t, d)
+    s = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h, optimize=True))  # (P, 2g+1, 2g+1, 3): [v, u]
+    c = s[:, ::2, ::2]
+    dev = np.zeros(len(h))
+    for mid, lin in ((s[:, ::2, 1::2], 0.5 * (c[:, :, :-1] + c[:, :, 1:])),
+                     (s[:, 1::2, ::2], 0.5 * (c[:, :-1] + c[:, 1:])),
+                     (s[:, 1::2, 1::2], 0.5 * (c[:, :-1, :-1] + c[:, 1:, 1:]))):
+        dev = np.maximum(dev, np.linalg.norm(mid - lin, axis=-1).reshape(len(h), -1).max(axis=1))
+    return dev
+
+
 def patch_levels(control, edges, lod, camera=None):
     """Levels: (edge levels (E,) int64, inner levels (P,) int64) in [1, max_level]. camera: a
     `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
-    c = check_patches(control)
+    h = check_patches(control)
+    c = cartesian(h)
+    k = h.shape[1]
+    ec = cartesian(edges.control)
     edge_level = np.ones(len(edges.control), np.int64)
     inner = np.ones(len(c), np.int64)
     if (set(lod.metrics) & {"DISTANCE", "EDGE_LENGTH"}) and camera is None:
         raise InvalidInputError("Distance and edge-length levels need a camera")
     if "CURVATURE" in lod.metrics:
-        edge_level = np.maximum(edge_level, _eq45(curve_kappa(edges.control), lod.max_level))
-        rows = slice(None) if lod.inner_rows == "ALL" else slice(1, 3)
-        along_u, along_v = c[:, :, rows].transpose(0, 2, 1, 3), c[:, rows, :]  # (P, rows, 4, 3) each
+        edge_level = np.maximum(edge_level, _eq45(curve_kappa(ec), lod.max_level, k))
+        rows = slice(None) if lod.inner_rows == "ALL" or k < 4 else slice(1, k - 1)
+        along_u, along_v = c[:, :, rows].transpose(0, 2, 1, 3), c[:, rows, :]  # (P, rows, k, 3) each
         k_u, k_v = curve_kappa(along_u), curve_kappa(along_v)
         if lod.degenerate == "CAP":
-            k_u = np.where(np.all(along_u == along_u[:, :, :1], axis=(2, 3)), np.inf, k_u)
-            k_v = np.where(np.all(along_v == along_v[:, :, :1], axis=(2, 3)), np.inf, k_v)
+            size = np.abs(c).max() + 1.0
+            one_u = np.all(np.linalg.norm(along_u - along_u[:, :, :1], axis=-1) <= COLLAPSED * size, axis=2)
+            one_v = np.all(np.linalg.norm(along_v - along_v[:, :, :1], axis=-1) <= COLLAPSED * size, axis=2)
+            k_u = np.where(one_u, np.inf, k_u)
+            k_v = np.where(one_v, np.inf, k_v)
         k_u, k_v = k_u.max(axis=1), k_v.max(axis=1)
         k_x = diagonal_kappa(c)
         diag = k_x > np.maximum(k_u, k_v)
         k_in = np.where(diag, k_x, np.maximum(k_u, k_v))
-        inner = np.maximum(inner, _eq45(k_in, lod.max_level))
+        inner = np.maximum(inner, _eq45(k_in, lod.max_level, k))
     if "EDGE_LENGTH" in lod.metrics:  # a sphere of the control polygon's length, at its centroid (§4.4)
         view = np.asarray(camera.view, np.float64)
 
@@ -186,12 +329,12 @@ def patch_levels(control, edges, lod, camera=None):
                                         float(lod.max_level))
             return np.ceil(t).astype(np.int64)
 
-        edge_level = np.maximum(edge_level, projected(edges.control.mean(axis=1), _polygon_length(edges.control)))
+        edge_level = np.maximum(edge_level, projected(ec.mean(axis=1), _polygon_length(ec)))
         size = np.maximum(_polygon_length(c).max(axis=1), _polygon_length(c.transpose(0, 2, 1, 3)).max(axis=1))
         inner = np.maximum(inner, projected(c.reshape(len(c), -1, 3).mean(axis=1), size))
     if "DISTANCE" in lod.metrics:
         eye = camera.eye
-        d_edge = np.linalg.norm(edges.control - eye, axis=-1).min(axis=1)
+        d_edge = np.linalg.norm(ec - eye, axis=-1).min(axis=1)
         d_in = np.linalg.norm(c.reshape(len(c), -1, 3).mean(axis=1) - eye, axis=-1)
 
         def dist(d):
@@ -199,27 +342,113 @@ def patch_levels(control, edges, lod, camera=None):
 
         edge_level = np.maximum(edge_level, dist(d_edge))
         inner = np.maximum(inner, dist(d_in))
+    if "TOLERANCE" in lod.metrics:
+        edge_level = np.maximum(edge_level, steps_for(chord_deviation(edges.control, np.full(len(ec), 16)), 16,
+                                                       lod.tolerance, lod.max_level))
+        inner = np.maximum(inner, steps_for(_inner_deviation(h), 8, lod.tolerance, lod.max_level))
     return np.minimum(edge_level, lod.max_level), np.minimum(inner, lod.max_level)
+
+
+def triangle_deviation(control, mesh):
+    """The largest distance between each triangle and the surface: (T,) float64. Each of `_B`'s barycentric points
+    of a triangle is compared with the surface at the same barycentric point of its corners' (u, v) — the mesh's
+    map to the surface — so this bounds the distance both ways where the points are dense enough."""
+    h = check_patches(control)
+    p = mesh.positions.astype(np.float64)[mesh.triangles]  # (T, 3, 3)
+    uv = mesh.corner_uv.astype(np.float64)
+    on_mesh = np.einsum("sc,tcd->tsd", _B, p)
+    at = np.einsum("sc,tcd->tsd", _B, uv)
+    out = np.empty(len(p))
+    for chunk in np.array_split(np.arange(len(p)), max(1, len(p) // 65536)):
+        s = evaluate(h[mesh.triangle_patch[chunk]], at[chunk, :, 0], at[chunk, :, 1])
+        out[chunk] = np.linalg.norm(on_mesh[chunk] - s, axis=-1).max(axis=1)
+    return out
+
+
+def estimate(edge_levels, inner_levels):
+    """The mesh's size at these levels, before it is made: an `Estimate` (peak bytes: the arrays being built,
+    float64, and the result)."""
+    n = np.maximum(np.asarray(inner_levels, np.int64), 2)
+    vertices = int(4 * len(n) + (np.asarray(edge_levels, np.int64) - 1).sum() + ((n - 1) ** 2).sum())
+    triangles = int((2 * n * n).sum())
+    return Estimate(vertices, triangles, vertices * 200 + triangles * 160)
+
+
+def tessellate(control, lod, camera=None, budget_bytes=None):
+    """Levels from ``lod`` and the welded mesh at them: a `Tessellation`. With TOLERANCE among the metrics, every
+    triangle is measured against the surface (`triangle_deviation`) and each side
+    (`kernels.common.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
+    within the tolerance or at Max Level. Every mesh is checked against ``budget_bytes``
+    (`kernels.common.budget.check_budget`) before it is made."""
+    h = check_patches(control)
+    edges = patch_edges(h)
+    el, inner = patch_levels(h, edges, lod, camera)
+    lower = "Max Level, or raise the Tolerance" if "TOLERANCE" in lod.metrics else "Max Level"
+    check_budget(estimate(el, inner), budget_bytes, lower)
+    mesh = tessellate_patches(h, el, inner, edges)
+    if "TOLERANCE" not in lod.metrics:
+        return Tessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
+    tol = lod.tolerance
+    for _ in range(TOLERANCE_ROUNDS):
+        side_dev = chord_deviation(edges.control, el)
+        tri_dev = triangle_deviation(h, mesh)
+        dev = np.zeros(len(h))
+        np.maximum.at(dev, mesh.triangle_patch, tri_dev)
+        # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
+        # inside raises that side (its long edge lies along it); any other raises the patch's inner level
+        over = np.flatnonzero(tri_dev > tol)
+        uv, tp, td = mesh.corner_uv[over], mesh.triangle_patch[over], tri_dev[over]
+        on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
+                            (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
+        side_need = side_dev.copy()
+        coarse_side = np.zeros(len(over), bool)
+        for side in range(4):
+            e = edges.edge[tp, side]
+            use = on_side[:, side] & (el[e] < inner[tp]) & ~edges.collapsed[e]
+            np.maximum.at(side_need, e[use], td[use])
+            coarse_side |= use
+        inner_need = np.zeros(len(h))
+        np.maximum.at(inner_need, tp[~coarse_side], td[~coarse_side])
+        new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, lod.max_level)), el)
+        new_inner = np.where(inner_need > tol, np.maximum(inner + 1, steps_for(inner_need, inner, tol,
+                                                                                lod.max_level)), inner)
+        new_el, new_inner = np.minimum(new_el, lod.max_level), np.minimum(new_inner, lod.max_level)
+        if np.array_equal(new_el, el) and np.array_equal(new_inner, inner):
+            break
+        el, inner = new_el, new_inner
+        check_budget(estimate(el, inner), budget_bytes, lower)
+        mesh = tessellate_patches(h, el, inner, edges)
+    else:
+        dev = np.zeros(len(h))
+        np.maximum.at(dev, mesh.triangle_patch, triangle_deviation(h, mesh))
+    return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > tol))
 
 
 def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     """The welded triangle mesh of the patches at these levels: a `PatchMesh`."""
-    c = check_patches(control)
-    edges = edges or patch_edges(c)
-    n_p = len(c)
+    h = check_patches(control)
+    edges = edges if edges is not None and edges.collapsed is not None else patch_edges(h)
+    k = h.shape[1]
+    deg = k - 1
+    n_p = len(h)
     el = np.asarray(edge_levels, np.int64)
     # vertices: corners (4 per patch, merged below), edge interior points (canonical order), inner grids
-    corners = c[:, [0, 3, 3, 0], [0, 0, 3, 3]]  # (P, 4, 3): (0,0) (1,0) (1,1) (0,1)
+    corners = cartesian(h[:, [0, deg, deg, 0], [0, 0, deg, deg]])  # (P, 4, 3): (0,0) (1,0) (1,1) (0,1)
+    # a corner on a collapsed side is that side's point (the poles of all patches around it are one point)
+    side_corners = ((0, 1), (1, 2), (3, 2), (0, 3))  # BOTTOM, RIGHT, TOP, LEFT: their corners in side direction
+    for side, (a, b) in enumerate(side_corners):
+        col = edges.collapsed[edges.edge[:, side]]
+        corners[col, a] = edges.point[edges.edge[col, side]]
+        corners[col, b] = edges.point[edges.edge[col, side]]
     corner_uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
     counts = el - 1
     e_first = np.concatenate([[0], np.cumsum(counts)])[:-1]
     e_of = np.repeat(np.arange(len(el)), counts)
-    k = np.arange(len(e_of)) - e_first[e_of] + 1
-    t = k / el[e_of]
-    b = bernstein(t)
-    edge_pts = np.einsum("nk,nkc->nc", b, edges.control[e_of])
-    collapsed = np.all(edges.control == edges.control[:, :1], axis=(1, 2))  # a side that is one point
-    edge_pts[collapsed[e_of]] = edges.control[e_of[collapsed[e_of]], 0]  # exactly (Σ B_k(t) need not round to 1)
+    kk = np.arange(len(e_of)) - e_first[e_of] + 1
+    t = kk / el[e_of]
+    b = bernstein(t, deg)
+    edge_pts = cartesian(np.einsum("nk,nkc->nc", b, edges.control[e_of]))
+    edge_pts[edges.collapsed[e_of]] = edges.point[e_of[edges.collapsed[e_of]]]  # exactly the one point
     # each edge's (patch, uv) for the vertex record: the first patch side that uses it
     sides = np.arange(n_p * 4)
     first_side = np.full(len(el), len(sides), np.int64)
@@ -238,14 +467,21 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     in_first = np.concatenate([[0], np.cumsum(m * m)])[:-1]
     inner_pts = np.empty((int((m * m).sum()), 3))
     inner_uv = np.empty((len(inner_pts), 2))
+    inner_nrm = np.empty((len(inner_pts), 3))
     p_of = np.repeat(np.arange(n_p), m * m)
     for n in np.unique(n_in[m > 0]):  # one tensor product per inner count: rows j, columns i, as the pattern
         ps = np.flatnonzero(n_in == n)
         t_in = np.arange(1, n) / n
-        b_in = bernstein(t_in)
-        grid = np.einsum("ik,jl,pklc->pjic", b_in, b_in, c[ps], optimize=True).reshape(len(ps), -1, 3)
+        b_in = bernstein(t_in, deg)
+        d_in = bernstein_derivative(t_in, deg)
+        grid = np.einsum("ik,jl,pklc->pjic", b_in, b_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
+        g_u = np.einsum("ik,jl,pklc->pjic", d_in, b_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
+        g_v = np.einsum("ik,jl,pklc->pjic", b_in, d_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
         rows = in_first[ps][:, None] + np.arange((n - 1) ** 2)[None]
-        inner_pts[rows] = grid
+        pts = cartesian(grid)
+        inner_pts[rows] = pts
+        w = grid[..., 3:]
+        inner_nrm[rows] = np.cross(g_u[..., :3] - pts * g_u[..., 3:], g_v[..., :3] - pts * g_v[..., 3:]) / (w * w)
         jj, ii = np.divmod(np.arange((n - 1) ** 2), n - 1)
         inner_uv[rows] = np.stack([t_in[ii], t_in[jj]], 1)[None]
 
@@ -282,11 +518,42 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     tris = remap[tris]
     keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
     tris, tri_patch, tri_uv = tris[keep], tri_patch[keep], tri_uv[keep]
+    tri_uv = _pole_corners(tri_uv, edges.collapsed[edges.edge[tri_patch]])
     used = np.zeros(len(positions), bool)
     used[tris.ravel()] = True
     new_id = np.cumsum(used) - 1
+    # normals from the surface (corners and sides from their first patch, a vanishing one a little inside it); a
+    # merged vertex (a pole) gets the mean of its patches' normals there
+    _, normals = _point_and_normal(h[patch[:shared]], uv[:shared, 0], uv[:shared, 1])
+    length = np.linalg.norm(inner_nrm, axis=1)
+    weak = np.flatnonzero(length <= 1e-12 * (1.0 + np.abs(corners).max()) ** 2)
+    if len(weak):
+        inner_nrm[weak] = _point_and_normal(h[p_of[weak]], inner_uv[weak, 0], inner_uv[weak, 1])[1]
+        length[weak] = 1.0
+    normals = np.concatenate([normals, inner_nrm / np.where(length > 0, length, 1.0)[:, None]])
+    summed = np.zeros_like(normals)
+    np.add.at(summed, remap, normals)
+    length = np.linalg.norm(summed, axis=1, keepdims=True)
+    normals = np.where(length > 0, summed / np.where(length > 0, length, 1.0), normals)
     return PatchMesh(positions[used].astype(np.float32), new_id[tris].astype(np.int32),
-                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv.astype(np.float32))
+                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv.astype(np.float32),
+                     normals[used].astype(np.float32))
+
+
+def _pole_corners(tri_uv, collapsed):
+    """Corner (u, v) of the triangles that meet at a pole: a corner on a side of its patch that is one point takes,
+    along that side, the mean of the triangle's other two corners (as a UV sphere's poles do), so each triangle of a
+    fan maps to the thin part of the surface it covers. tri_uv (T, 3, 2); collapsed (T, 4) its patch's sides BOTTOM,
+    RIGHT, TOP, LEFT are one point."""
+    uv = tri_uv.copy()
+    u, v = tri_uv[..., 0], tri_uv[..., 1]
+    others_u = (u.sum(axis=1, keepdims=True) - u) / 2
+    others_v = (v.sum(axis=1, keepdims=True) - v) / 2
+    on_uv = ((u == 1) & collapsed[:, 1:2]) | ((u == 0) & collapsed[:, 3:4])  # RIGHT, LEFT: v runs along them
+    on_vv = ((v == 0) & collapsed[:, 0:1]) | ((v == 1) & collapsed[:, 2:3])  # BOTTOM, TOP: u runs along them
+    uv[..., 1] = np.where(on_uv & ~on_vv, others_v, v)
+    uv[..., 0] = np.where(on_vv & ~on_uv, others_u, u)
+    return uv
 
 
 @lru_cache(maxsize=4096)

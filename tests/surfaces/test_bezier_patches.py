@@ -18,7 +18,7 @@ def edge_uses(tris):
 
 def open_boundary_levels(patches, edges, edge_levels):
     """Segments on the teapot's two open circles (the rim's inner edge r = 1.4 and the lid's edge r = 1.3, z 2.4)."""
-    c = edges.control
+    c = bp.cartesian(edges.control)
     r = np.hypot(c[:, 0, 0], c[:, 0, 1])
     on = np.all(np.isclose(c[:, :, 2], 2.4), axis=1) & (np.isclose(r, 1.4) | np.isclose(r, 1.3))
     return int(edge_levels[on].sum())
@@ -103,7 +103,7 @@ def test_projected_edge_levels_follow_the_screen():
     small = bp.patch_levels(patches, edges, lod, looking((0, -8, 1.5), size=128))
     assert near[0].sum() > 3 * far[0].sum() and near[0].sum() > 2 * small[0].sum()
     # a side's level is its control polygon's projected length over Edge Pixels (never below 1)
-    c = edges.control
+    c = bp.cartesian(edges.control)
     length = np.linalg.norm(np.diff(c, axis=1), axis=2).sum(axis=1)
     cam = looking((0, -8, 1.5))
     m = c.mean(axis=1) @ np.asarray(cam.view)[:3, :3].T + np.asarray(cam.view)[:3, 3]

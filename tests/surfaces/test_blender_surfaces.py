@@ -172,11 +172,14 @@ def test_vector_field_from_a_grid_mesh(clean_scene, bpy_module):
 def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
     bp = addon_module("kernels.surfaces.bezier_patches")
+    nurbs = addon_module("kernels.common.nurbs")
     patches, names = addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
     ob = addon_module("addon.curve_bridge").write_surface_patches(patches)
     assert len(ob.data.splines) == 24
-    read, skipped = addon_module("addon.curve_bridge").read_surface_patches(ob.data)
-    assert skipped == [] and np.allclose(read, patches.astype(np.float32))
+    surfaces, rows = addon_module("addon.curve_bridge").read_surface_splines(ob.data)
+    assert rows == [] and len(surfaces) == 24
+    read = nurbs.patches_of([s for _, s in surfaces]).patches
+    assert np.allclose(bp.cartesian(read), patches.astype(np.float32)) and np.all(read[..., 3] == 1)
     assert bpy.ops.tessera.surface_tessellate(metrics={"CURVATURE"}) == {"FINISHED"}
     out = bpy.context.active_object
     edges = bp.patch_edges(read)
@@ -184,12 +187,12 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
     want = bp.tessellate_patches(read, el, inner, edges)
     pos, tris, uv, corner_edges = mesh_arrays(out.data)
     assert np.array_equal(pos, want.positions) and np.array_equal(tris, want.triangles)
-    assert np.allclose(uv, want.corner_uv)
+    assert np.allclose(uv, want.corner_uv)  # one spline per patch: its UVs are the patch's own
     uses = np.bincount(corner_edges, minlength=len(out.data.edges))
     assert uses.max() == 2  # welded: only the rim's and the lid's open circles are boundary
-    assert (uses == 1).sum() == sum(int(el[e]) for e in range(len(edges.control))
-                                    if np.allclose(edges.control[e, :, 2], 2.4)
-                                    and np.isclose(np.hypot(*edges.control[e, 0, :2]), (1.3, 1.4)).any())
+    c = bp.cartesian(edges.control)
+    assert (uses == 1).sum() == sum(int(el[e]) for e in range(len(c)) if np.allclose(c[e, :, 2], 2.4)
+                                    and np.isclose(np.hypot(*c[e, 0, :2]), (1.3, 1.4)).any())
     # distance levels for the scene camera: near -> finer than far
     cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
     bpy.context.scene.collection.objects.link(cam)
@@ -204,11 +207,12 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
         assert counts[0] > 4 * counts[1], metrics
 
 
-def test_tessellate_surface_refuses_what_is_not_bicubic_bezier(clean_scene, bpy_module):
+def test_tessellate_surface_refuses_what_blender_cannot_draw(clean_scene, bpy_module):
     bpy = bpy_module
-    bpy.ops.surface.primitive_nurbs_surface_surface_add()  # 4 x 4 but uniform knots: a B-spline, not a Bézier patch
+    bpy.ops.surface.primitive_nurbs_surface_torus_add()  # order 3, 8 points, Bézier knots
+    bpy.context.active_object.data.splines[0].order_u = 4  # 8 points do not make order-4 Bézier spans
     before = len(bpy.data.objects), len(bpy.data.meshes)
-    with pytest.raises(RuntimeError, match="without Bézier knots"):
+    with pytest.raises(RuntimeError, match="surface spline 0 has Bézier knots that need 1 more point"):
         bpy.ops.tessera.surface_tessellate()
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
 
