@@ -2,7 +2,8 @@
 re-ordered to orders 2-6 and given random weights, becomes a mesh whose every vertex lies on the surface (checked with
 an independent NURBS evaluator, geomdl, at the vertex's UV), whose triangles stay within the tolerance (measured on a
 dense lattice in each triangle), welded (closed where the surface closes; open only on the surface's own border), and
-Blender's own conversion lies on the same surface (its knots are the kernel's). Bad splines are refused, nothing made."""
+Blender's own conversion lies on the same surface (its knots are the kernel's). Bad splines are refused, nothing
+made."""
 
 import numpy as np
 import pytest
@@ -121,7 +122,7 @@ def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_modu
             assert not border.any(), label
         else:
             corner_uv = {}
-            for c, (vert, t) in enumerate(zip(tris.ravel(), uv.reshape(-1, 2), strict=True)):
+            for vert, t in zip(tris.ravel(), uv.reshape(-1, 2), strict=True):
                 corner_uv.setdefault(int(vert), []).append(t)
             on_edge = np.array([any(_on_border(t, u.cyclic, v.cyclic) for t in corner_uv[int(i)])
                                 for i in edge_verts[border].ravel()])
