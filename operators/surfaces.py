@@ -132,7 +132,7 @@ class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
 
 
 class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
-    """Turn the active curve's Bézier splines into polylines with more points where they bend"""
+    """Turn the active curve's Bézier and NURBS splines into polylines with more points where they bend"""
 
     bl_idname = "tessera.curve_adaptive"
     bl_label = "Curve to Adaptive Polyline"
@@ -153,32 +153,43 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         if self.mode == "SCREEN":
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
                                    ob.matrix_world)
-        out, skipped, counts = [], 0, []
-        for sp in curve_bridge.read_splines(ob.data):
-            if sp.kind == "BEZIER" and len(sp.co) >= 2:
-                for a in adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic,
-                                         settings, camera):
-                    out.append(curve_bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
-                                                   sp.material_index))
-                counts.append(a.counts)
-            elif sp.kind == "POLY":
-                offset = np.asarray(settings.offset, np.float64)
-                for k in range(settings.copies):
-                    out.append(curve_bridge.SplineArrays("POLY", sp.co + offset * k / settings.copies, None, None,
-                                                   sp.radius, sp.tilt, sp.cyclic, sp.material_index))
+        out, counts, over = [], [], 0
+        for k, sp in enumerate(curve_bridge.read_splines(ob.data)):
+            if sp.kind in ("BEZIER", "NURBS") and len(sp.co) < 2:
+                raise InvalidInputError(f"Spline {k} of {ob.name!r} has a single point: delete it or add points")
+            if sp.kind == "BEZIER":
+                made = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic,
+                                       settings, camera)
+            elif sp.kind == "NURBS":
+                try:
+                    made = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic),
+                                          sp.radius, sp.tilt, settings, camera)
+                except InvalidInputError as err:
+                    raise InvalidInputError(str(err).replace("The NURBS spline", f"NURBS spline {k}")) from None
             else:
-                skipped += 1
+                offset = np.asarray(settings.offset, np.float64)
+                for c in range(settings.copies):
+                    out.append(curve_bridge.SplineArrays("POLY", sp.co + offset * c / settings.copies, None, None,
+                                                         sp.radius, sp.tilt, sp.cyclic, sp.material_index))
+                continue
+            for a in made:
+                out.append(curve_bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
+                                                     sp.material_index))
+            counts.append(made[0].counts)
+            if made[0].deviation is not None:
+                tol = settings.tolerance if settings.mode == "TOLERANCE" else None
+                if tol is not None:
+                    over += int((made[0].deviation > tol).sum())
         if not out:
-            raise InvalidInputError(f"Curve {ob.name!r} has no Bézier or poly spline to sample"
-                                    + (f" ({skipped} NURBS spline(s): convert them to Bézier first)" if skipped
-                                       else ""))
+            raise InvalidInputError(f"Curve {ob.name!r} has no spline to sample: add one, or select another curve")
         data = tx.track(curve_bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
         place_mesh(context, tx, ob, data, "NEW_OBJECT", "adaptive")
         seg = np.concatenate(counts) if counts else np.zeros(0, np.int64)
-        words = (f"{len(seg):,} Bézier segments -> {int(seg.sum()):,} ({int(seg.min())}-{int(seg.max())} each)"
-                 if len(seg) else "no Bézier segment")
-        note = f"; {skipped} NURBS spline(s) left out (convert them to Bézier)" if skipped else ""
-        self.report({"WARNING" if skipped else "INFO"}, f"{len(out):,} polylines: {words}{note}")
+        words = (f"{len(seg):,} curve segments -> {int(seg.sum()):,} ({int(seg.min())}-{int(seg.max())} each)"
+                 if len(seg) else "no curve segment")
+        note = (f"; {over} segment(s) stay over the tolerance at Max Segments {settings.max_segments}: raise Max "
+                "Segments or the Tolerance") if over else ""
+        self.report({"WARNING" if over else "INFO"}, f"{len(out):,} polylines: {words}{note}")
         return {"FINISHED"}
 
 

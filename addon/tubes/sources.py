@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ...kernels.common.bezier_curves import CurveSampling, adaptive_spline
+from ...kernels.common import nurbs
+from ...kernels.common.bezier_curves import CurveSampling, adaptive_nurbs, adaptive_spline
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.tubes.edge_chains import chains_from_edges
 from ...kernels.tubes.polylines import Polylines
@@ -38,19 +39,22 @@ def read_lines(ob, settings):
 
 
 def _curvature_lines(ob, settings):
-    """A Curve object's centre lines with each Bézier segment sampled by its curvature (eq. 4.5; poly splines as
-    they are), radius (x Radius, like a bevel) and tilt along each segment."""
+    """A Curve object's centre lines with each Bézier segment and each NURBS piece sampled by its curvature (eq.
+    4.5; poly splines as they are), radius (x Radius, like a bevel) and tilt along each segment."""
     sampling = CurveSampling(mode="CURVATURE", max_segments=settings.max_segments)
     points, radius, tilt, counts, cyclic, materials = [], [], [], [], [], []
     for sp in curve_bridge.read_splines(ob.data):
         if sp.kind == "BEZIER" and len(sp.co) >= 2:
             [a] = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic, sampling)
             pts, rad, til = a.points, a.radius, a.tilt
+        elif sp.kind == "NURBS" and len(sp.co) >= 2:
+            [a] = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic), sp.radius,
+                                 sp.tilt, sampling)
+            pts, rad, til = a.points, a.radius, a.tilt
         elif sp.kind == "POLY":
             pts, rad, til = sp.co, sp.radius, sp.tilt
         else:
-            raise InvalidInputError(f"Curve {ob.name!r} has a {sp.kind.lower()} spline: Curvature sampling takes "
-                                    "Bézier and poly splines (use Resolution, or convert it to Bézier)")
+            raise InvalidInputError(f"Curve {ob.name!r} has a spline of a single point: delete it or add points")
         points.append(pts)
         radius.append(rad * settings.radius)
         tilt.append(til)

@@ -251,3 +251,115 @@ def test_bad_surface_splines_are_refused_and_nothing_is_made(clean_scene, bpy_mo
     with pytest.raises(RuntimeError, match=f"surface spline 0 .*{words}|{words}"):
         bpy.ops.tessera.surface_tessellate()
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+
+
+CURVE_MODES = ("UNIFORM", "ENDPOINT", "BEZIER", "ENDPOINT_BEZIER")
+
+
+@pytest.mark.parametrize("order", range(2, 7))
+def test_blenders_curve_evaluation_lies_on_the_pieces(clean_scene, bpy_module, addon_module, order):
+    """Blender evaluates a NURBS curve at resolution equal steps of each span of its domain: its points are the
+    pieces' points at the same parameters, for every knot mode, cyclic or not, with weights."""
+    bpy = bpy_module
+    nurbs = addon_module("kernels.common.nurbs")
+    rng = np.random.default_rng(order)
+    for mode in CURVE_MODES:
+        for cyclic in (False, True):
+            n = 9
+            d = nurbs.Direction(order, mode, cyclic)
+            while True:
+                try:
+                    nurbs.direction_knots(n, d)
+                    break
+                except Exception:
+                    n += 1
+            cu = bpy.data.curves.new("c", "CURVE")
+            cu.dimensions = "3D"
+            s = cu.splines.new("NURBS")
+            s.points.add(n - 1)
+            co = np.c_[rng.normal(size=(n, 3)), rng.uniform(0.5, 2.0, n)].astype(np.float32)
+            s.points.foreach_set("co", co.ravel())
+            s.order_u, s.use_cyclic_u, s.resolution_u = order, cyclic, 6
+            s.use_endpoint_u, s.use_bezier_u = "ENDPOINT" in mode, "BEZIER" in mode
+            ob = bpy.data.objects.new("c", cu)
+            bpy.context.scene.collection.objects.link(ob)
+            ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            blender = np.array([v.co[:] for v in ev.to_mesh().vertices], np.float64)
+            ev.to_mesh_clear()
+            pieces, span = nurbs.curve_pieces(co.astype(np.float64), d)
+            x = np.linspace(span[0, 0], span[-1, 1], len(blender) + cyclic)[:len(blender)]
+            k = np.clip(np.searchsorted(span[:, 0], x, side="right") - 1, 0, len(span) - 1)
+            t = (x - span[k, 0]) / (span[k, 1] - span[k, 0])
+            mine = piece_points(pieces[k], t[:, None])[:, 0]
+            assert np.abs(mine - blender).max() < 1e-5 * np.abs(blender).max(), (mode, cyclic)
+            bpy.data.objects.remove(ob)
+            bpy.data.curves.remove(cu)
+
+
+@pytest.mark.parametrize("primitive", ("nurbs_circle", "nurbs_path", "bezier_circle"))
+def test_curve_to_adaptive_polyline_meets_the_tolerance_on_nurbs(clean_scene, bpy_module, addon_module, primitive):
+    bpy = bpy_module
+    nurbs = addon_module("kernels.common.nurbs")
+    getattr(bpy.ops.curve, f"primitive_{primitive}_add")()
+    source = bpy.context.active_object
+    rng = np.random.default_rng(5)
+    s = source.data.splines[0]
+    for order in (0, 2, 3, 4, 5, 6):
+        if order and s.type == "NURBS":
+            s.order_u = min(order, len(s.points))
+            s.use_bezier_u = False
+            co = co_of(s)
+            co[:, 3] = rng.uniform(0.5, 2.0, len(co))
+            s.points.foreach_set("co", co.astype(np.float32).ravel())
+            s.points.foreach_set("radius", rng.uniform(0.5, 2.0, len(co)).astype(np.float32))
+        elif order:
+            continue
+        bpy.context.view_layer.objects.active = source
+        tol = 1e-3
+        assert bpy.ops.tessera.curve_adaptive(mode="TOLERANCE", tolerance=tol, max_segments=1024) == {"FINISHED"}
+        out = bpy.context.active_object.data.splines[0]
+        pts = np.array([p.co[:3] for p in out.points], np.float64)
+        if s.type != "NURBS":
+            continue
+        d = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
+        radius = np.array([p.radius for p in s.points], np.float64)
+        pieces, _ = nurbs.curve_pieces(co_of(s), d, np.c_[radius, np.zeros(len(radius))])
+        size = np.abs(pts).max()
+        assert distance_to_curve(pieces[..., :4], pts).max() < 1e-6 * size, order
+        edges = np.stack([np.arange(len(pts) - 1), np.arange(1, len(pts))], 1)
+        if out.use_cyclic_u:
+            edges = np.concatenate([edges, [[len(pts) - 1, 0]]])
+        dense = dense_curve(pieces[..., :4], 2000)
+        a, b = pts[edges[:, 0]], pts[edges[:, 1]]
+        ab = b - a
+        gap = np.empty(len(dense))
+        for i in range(0, len(dense), 2000):
+            q = dense[i:i + 2000]
+            f = np.clip(np.einsum("nsc,sc->ns", q[:, None] - a[None], ab) / (ab * ab).sum(1), 0, 1)
+            gap[i:i + 2000] = np.linalg.norm(q[:, None] - (a[None] + f[..., None] * ab[None]), axis=2).min(1)
+        assert gap.max() <= tol, order
+        # radius follows the curve as Blender interpolates it (rational, with the weights)
+        r_out = np.array([p.radius for p in out.points], np.float64)
+        assert r_out.min() >= radius.min() - 1e-6 and r_out.max() <= radius.max() + 1e-6
+
+
+def test_tubes_sample_nurbs_curves_by_curvature(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bz = addon_module("kernels.common.bezier_curves")
+    nurbs = addon_module("kernels.common.nurbs")
+    bpy.ops.curve.primitive_nurbs_path_add()
+    ob = bpy.context.active_object
+    s = ob.data.splines[0]
+    co = co_of(s)
+    co[:, 1] = [0, 0, 0, 1.5, 0]  # straight, then a bend
+    co[:, 3] = [1, 2, 0.5, 2, 1]
+    s.points.foreach_set("co", co.astype(np.float32).ravel())
+    s.order_u = 3  # three pieces
+    assert bpy.ops.tessera.tubes(radius=0.05, sides=6, caps="NONE", curve_sampling="CURVATURE") == {"FINISHED"}
+    me = bpy.context.active_object.data
+    pos = np.array([v.co[:] for v in me.vertices], np.float64)
+    rings = pos.reshape(-1, 6, 3).mean(axis=1)
+    d = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
+    [want] = bz.adaptive_nurbs(co[:, :3], co[:, 3], d, np.ones(5), np.zeros(5), bz.CurveSampling(mode="CURVATURE"))
+    assert len(rings) == len(want.points) and np.allclose(rings, want.points, atol=1e-5)
+    assert want.counts.max() > want.counts.min()  # more rings where it bends

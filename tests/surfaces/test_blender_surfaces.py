@@ -122,15 +122,18 @@ def test_curve_copies_and_bad_splines(clean_scene, bpy_module):
     polys = poly_points(bpy.context.active_object)
     assert len(polys) == 6
     assert np.allclose(polys[5][0] - polys[0][0], [0, 0, 0.5], atol=1e-6)
-    # a curve with only a NURBS spline: refused, nothing added
+    # a curve with a one-point spline, or a NURBS spline of order above its points: refused, nothing added
     data = bpy.data.curves.new("Nurbs", "CURVE")
     s = data.splines.new("NURBS")
-    s.points.add(3)
     ob = bpy.data.objects.new("Nurbs", data)
     bpy.context.scene.collection.objects.link(ob)
     bpy.context.view_layer.objects.active = ob
     before = len(bpy.data.objects), len(bpy.data.curves)
-    with pytest.raises(RuntimeError, match="convert them to Bézier"):
+    with pytest.raises(RuntimeError, match="Spline 0 of 'Nurbs' has a single point"):
+        bpy.ops.tessera.curve_adaptive()
+    s.points.add(3)
+    s.points.foreach_set("co", np.array([[0, 0, 0, 1], [1, 0, 0, -1], [1, 1, 0, 1], [0, 1, 0, 1]], np.float32).ravel())
+    with pytest.raises(RuntimeError, match="NURBS spline 0 has control points or weights|weights of zero or less"):
         bpy.ops.tessera.curve_adaptive()
     assert (len(bpy.data.objects), len(bpy.data.curves)) == before
 
