@@ -17,10 +17,12 @@ Per N: bytes (Table 2.2's accounting, and measured), frame time (draw + a one-pi
 is included; ``mesh_upload_draw_ms`` adds building the buffer and its upload, what a changed surface costs), and
 their ratios. On a CPU-only machine the renderer is Mesa llvmpipe, a software rasteriser: absolute times are not
 a GPU's; the device tool runs the same on a real GPU where one is lent.
-- ``teapot``: *Tessellate Surface* (``tessera.surface_tessellate``, curvature levels) on the teapot's body of
-  revolution (24 bicubic patches as a surface object) end to end, against Blender's own conversion of the same
-  surface object to a mesh (its evaluation at a resolution giving about the same triangles, copied into a new mesh
-  object), triangles per second.
+- ``tessellate_surface_*``: *Tessellate Surface* (``tessera.surface_tessellate`` at a Tolerance of 2e-4 of the
+  model's size) end to end (read the splines, split them into patches, choose and check the levels, evaluate, write
+  the mesh) on Blender's NURBS sphere and torus and Newell's teapot (32 patches), against Blender's own conversion of
+  the same surface object to a mesh copied into a new object, at the lowest resolution whose mesh is as close to the
+  surface (both measured the same way: each triangle at 7 points against the surface at the same parameters):
+  triangles and seconds over the baseline's, and triangles per second.
 Run: .venv/bin/python bench/surfaces.py [--full]   (--full: N up to 20,000; else up to 2,500)
 """
 
@@ -59,7 +61,8 @@ def main():
 
     frame = offscreen_frame(box, SIZE, SIZE)
 
-    run_teapot(bpy, mod)
+    for name, make in surface_models(bpy, mod):
+        run_tessellate_surface(bpy, mod, name, make)
     counts = COUNTS if "--full" in sys.argv else COUNTS[:6]
     uv, tris = domain_mesh.domain_pattern(FACTOR)
     for n in counts:
@@ -98,24 +101,101 @@ def main():
     box.free()
 
 
-def run_teapot(bpy, mod):
-    nets, _ = mod("kernels.surfaces.revolved_teapot").teapot_patches()
-    surface = mod("addon.curve_bridge").write_surface_patches(nets)
+#: The tolerance of the Tessellate Surface cases, as a fraction of each model's size.
+RELATIVE_TOLERANCE = 2e-4
+BARY = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
+                 [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
+
+def _spline_direction(nurbs, s):
+    u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
+    v = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v), s.use_cyclic_v)
+    co = np.array([p.co[:] for p in s.points], np.float32).astype(np.float64).reshape(s.point_count_v,
+                                                                                      s.point_count_u, 4)
+    return nurbs.SurfaceSpline(co, u, v)
+
+
+def blender_deviation(mod, surface, me):
+    """The largest distance between Blender's conversion of ``surface`` and the surface, measured as Tessera's
+    meshes are (each triangle at 7 barycentric points against the surface at the same point of its corners'
+    parameters): Blender evaluates each spline on a grid of resolution x points equal steps a direction (v fastest);
+    each grid quad is taken at its better diagonal, a quad with two corners at one point (a pole) as a triangle."""
+    nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
+    pos = np.array([v.co[:] for v in me.vertices], np.float64)
+    worst, start = 0.0, 0
+    for s in surface.data.splines:
+        spline = _spline_direction(nurbs, s)
+        ps = nurbs.patches_of([spline])
+        n_u, n_v = s.resolution_u * s.point_count_u, s.resolution_v * s.point_count_v
+        cu, cv = s.use_cyclic_u, s.use_cyclic_v
+        fu, fv = np.linspace(0, 1, n_u + cu)[:n_u], np.linspace(0, 1, n_v + cv)[:n_v]
+        grid = pos[start:start + n_u * n_v].reshape(n_u, n_v, 3)
+        start += n_u * n_v
+        iu, jv = np.arange(n_u - 1 + cu), np.arange(n_v - 1 + cv)
+        i0, j0 = np.meshgrid(iu, jv, indexing="ij")
+        i1, j1 = (i0 + 1) % n_u, (j0 + 1) % n_v
+        corners = [(i0, j0), (i1, j0), (i1, j1), (i0, j1)]
+        p = np.stack([grid[i, j] for i, j in corners], 2).reshape(-1, 4, 3)
+        # parameters: the wrapped corner of a cyclic direction is 1, not 0
+        uu = np.stack([np.where(i == 0, 1.0, fu[i]) if cu else fu[i] for i, _ in corners], 2).reshape(-1, 4)
+        uu[:, [0, 3]] = fu[i0.ravel()][:, None]
+        vv = np.stack([fv[j] for _, j in corners], 2).reshape(-1, 4)
+        vv[:, [2, 3]] = np.where(j1.ravel() == 0, 1.0, fv[j1.ravel()])[:, None]
+        st = np.stack([uu, vv], -1)
+        best = np.full(len(p), np.inf)
+        for tris in (((0, 1, 2), (0, 2, 3)), ((0, 1, 3), (1, 2, 3))):
+            dev = np.zeros(len(p))
+            for tri in tris:
+                tp, tuv = p[:, tri].copy(), st[:, tri].copy()
+                for a, b in ((0, 1), (1, 2), (0, 2)):  # two corners at one point: a pole; its parameter halfway
+                    same = np.all(tp[:, a] == tp[:, b], axis=1)
+                    mid = 0.5 * (tuv[same, a] + tuv[same, b])
+                    tuv[same, a] = tuv[same, b] = mid
+                flat = np.all(tp[:, 0] == tp[:, 1], 1) | np.all(tp[:, 1] == tp[:, 2], 1) | np.all(
+                    tp[:, 0] == tp[:, 2], 1)
+                on_mesh = np.einsum("sc,tcd->tsd", BARY, tp)
+                at = np.einsum("sc,tcd->tsd", BARY, tuv)
+                box = ps.box
+                q = np.zeros(at.shape[:2], np.int64)
+                for k in range(len(box)):
+                    inside = ((box[k, 0, 0] <= at[..., 0] + 1e-12) & (at[..., 0] <= box[k, 0, 1] + 1e-12)
+                              & (box[k, 1, 0] <= at[..., 1] + 1e-12) & (at[..., 1] <= box[k, 1, 1] + 1e-12))
+                    q = np.where(inside, k, q)
+                b0 = box[q]
+                local = (at - b0[..., 0]) / (b0[..., 1] - b0[..., 0])
+                on = bp.evaluate(ps.patches[q.ravel()], local[..., 0].reshape(-1, 1), local[..., 1].reshape(-1, 1))
+                d = np.linalg.norm(on.reshape(on_mesh.shape) - on_mesh, axis=-1).max(axis=1)
+                dev = np.maximum(dev, np.where(flat, 0.0, d))
+            best = np.minimum(best, dev)
+        worst = max(worst, float(best.max()))
+    return worst
+
+
+def run_tessellate_surface(bpy, mod, name, make):
+    """*Tessellate Surface* at a tolerance, end to end, against Blender's own conversion of the same surface object
+    at the lowest resolution whose mesh is as close to the surface (measured the same way)."""
+    surface = make()
+    size = float(np.abs(np.array([v[:] for v in surface.bound_box])).max())
+    tol = RELATIVE_TOLERANCE * size
+    kw = dict(metrics={"TOLERANCE"}, tolerance=tol, max_level=64)
 
     def ours():
         bpy.context.view_layer.objects.active = surface
-        bpy.ops.tessera.surface_tessellate(metrics={"CURVATURE"})
+        assert bpy.ops.tessera.surface_tessellate(**kw) == {"FINISHED"}
         out = bpy.context.active_object
         n, data = len(out.data.polygons), out.data
         bpy.data.objects.remove(out)
         bpy.data.meshes.remove(data)
         return n
 
-    def blenders():
+    def converted():
         surface.data.update_tag()  # re-evaluate, as a changed surface would
         depsgraph = bpy.context.evaluated_depsgraph_get()
         depsgraph.update()
-        me = bpy.data.meshes.new_from_object(surface.evaluated_get(depsgraph))
+        return bpy.data.meshes.new_from_object(surface.evaluated_get(depsgraph))
+
+    def blenders():
+        me = converted()
         ob = bpy.data.objects.new("converted", me)
         bpy.context.scene.collection.objects.link(ob)
         n = sum(len(p.vertices) - 2 for p in me.polygons)
@@ -124,23 +204,47 @@ def run_teapot(bpy, mod):
         return n
 
     n_ours = ours()
-
-    def blender_count(res):
-        surface.data.resolution_u = surface.data.resolution_v = res
-        return blenders()
-
-    # the resolution whose triangle count is nearest ours (Blender's resolution counts per control point)
-    res = min(range(1, 33), key=lambda r: abs(blender_count(r) - n_ours))
-    surface.data.resolution_u = surface.data.resolution_v = res
-
+    nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
+    result = bp.tessellate(nurbs.patches_of([_spline_direction(nurbs, s) for s in surface.data.splines]).patches,
+                           bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+    ours_dev = float(result.deviation.max())
+    res, dev = 0, np.inf
+    while dev > ours_dev and res < 128:  # the lowest resolution as close to the surface as ours
+        res += 1 if res < 16 else 4
+        for s in surface.data.splines:
+            s.resolution_u = s.resolution_v = res
+        me = converted()
+        dev = blender_deviation(mod, surface, me)
+        bpy.data.meshes.remove(me)
     n_blender = blenders()
-    t_ours, t_blender = seconds(ours, 5), seconds(blenders, 5)
-    print(json.dumps({"bench": "surfaces", "case": "teapot_tessellate_surface", "patches": len(nets),
-                      "triangles": n_ours, "seconds": round(t_ours, 4),
-                      "baseline": f"Blender's surface to mesh (resolution {res}), copied into a new object",
-                      "baseline_triangles": n_blender, "baseline_seconds": round(t_blender, 4),
+    t_ours, t_blender = seconds(ours, 3), seconds(blenders, 3)
+    print(json.dumps({"bench": "surfaces", "case": f"tessellate_surface_{name}", "patches": len(result.inner_levels),
+                      "tolerance": round(tol, 6), "triangles": n_ours, "deviation": round(ours_dev, 6),
+                      "seconds": round(t_ours, 4),
+                      "baseline": f"Blender's surface to mesh at resolution {res}, copied into a new object",
+                      "baseline_triangles": n_blender, "baseline_deviation": round(dev, 6),
+                      "baseline_seconds": round(t_blender, 4),
+                      "triangles_over_baseline": round(n_ours / n_blender, 3),
+                      "seconds_over_baseline": round(t_ours / t_blender, 2),
                       "speedup_per_triangle": round((n_ours / t_ours) / (n_blender / t_blender), 2)}), flush=True)
     bpy.data.objects.remove(surface)
+
+
+def surface_models(bpy, mod):
+    """(name, maker) of the Tessellate Surface cases: Blender's NURBS sphere and torus as Add › Surface makes
+    them, and Newell's full teapot (32 patches) as a surface object."""
+
+    def primitive(kind):
+        def make():
+            getattr(bpy.ops.surface, f"primitive_nurbs_surface_{kind}_add")()
+            return bpy.context.active_object
+        return make
+
+    def teapot():
+        nets, _ = mod("kernels.surfaces.utah_teapot").teapot_patches()
+        return mod("addon.curve_bridge").write_surface_patches(nets)
+
+    return (("sphere", primitive("sphere")), ("torus", primitive("torus")), ("teapot", teapot))
 
 
 if __name__ == "__main__":

@@ -18,10 +18,16 @@ TOLERANCE_AIM = 0.8
 
 def bernstein(t, degree=3):
     """Bernstein basis of a degree (..., degree + 1) at t (...)."""
-    t = np.asarray(t, np.float64)[..., None]
-    i = np.arange(degree + 1)
-    coef = np.array([comb(degree, int(k)) for k in i], np.float64)
-    return coef * t ** i * (1.0 - t) ** (degree - i)
+    t = np.asarray(t, np.float64)
+    s = 1.0 - t
+    tp = np.empty(t.shape + (degree + 1,))
+    sp = np.empty_like(tp)
+    tp[..., 0] = sp[..., 0] = 1.0
+    for i in range(1, degree + 1):  # powers by products: no pow calls
+        tp[..., i] = tp[..., i - 1] * t
+        sp[..., i] = sp[..., i - 1] * s
+    coef = np.array([comb(degree, i) for i in range(degree + 1)], np.float64)
+    return coef * tp * sp[..., ::-1]
 
 
 def bernstein_derivative(t, degree=3):

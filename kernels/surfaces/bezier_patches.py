@@ -54,11 +54,11 @@ METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
 MAX_LEVEL = 64
 #: Rounds of measuring the mesh against the surface and raising levels, for the tolerance.
 TOLERANCE_ROUNDS = 16
-#: Barycentric points where each triangle is measured against the surface: its edges' midpoints and quarter points,
-#: its centroid and the points halfway from the centroid to each corner.
-_B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [.25, .75, 0], [.75, .25, 0], [0, .25, .75], [0, .75, .25],
-               [.75, 0, .25], [.25, 0, .75], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6],
-               [1 / 6, 1 / 6, 2 / 3]])
+#: Barycentric points where each triangle is measured against the surface: its edges' midpoints, its centroid and
+#: the points halfway from the centroid to each corner (where the deviation of a smooth surface from a small
+#: triangle is largest).
+_B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
+               [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
 #: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
 COLLAPSED = 1e-12
 
@@ -157,8 +157,9 @@ def homogeneous_nets(control):
 def evaluate(control, u, v):
     """Points of patches: control (P, k, k, 3 or 4), u and v (P, n) -> (P, n, 3)."""
     h = homogeneous_nets(control)
-    d = h.shape[1] - 1
-    p = np.einsum("pki,pkj,pijc->pkc", bernstein(u, d), bernstein(v, d), h)
+    k = h.shape[1]
+    w = (bernstein(u, k - 1)[..., :, None] * bernstein(v, k - 1)[..., None, :]).reshape(np.shape(u) + (k * k,))
+    p = np.einsum("pnk,pkc->pnc", w, h.reshape(len(h), k * k, 4))
     return p[..., :3] / p[..., 3:]
 
 
@@ -278,18 +279,23 @@ def _polygon_length(points):
 
 
 def _inner_deviation(h, grid=8):
-    """Deviation of each patch's triangles on a grid x grid split (cells cut along a diagonal, as the pattern's):
-    measured at the cells' side midpoints and diagonal midpoints. (P,) float64."""
-    t = np.arange(2 * grid + 1) / (2 * grid)
+    """Deviation of each patch's triangles on a grid x grid split (cells cut along their (i, j)-(i+1, j+1)
+    diagonal, as the pattern's), measured at `_B` in every triangle, as `triangle_deviation` measures a mesh: (P,)
+    float64."""
+    t = np.arange(grid + 1) / grid
     d = h.shape[1] - 1
     b = bernstein(t, d)
-    s = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h, optimize=True))  # (P, 2g+1, 2g+1, 3): [v, u]
-    c = s[:, ::2, ::2]
+    s = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h, optimize=True))  # (P, g+1, g+1, 3): [v, u]
+    c00, c10, c11, c01 = s[:, :-1, :-1], s[:, :-1, 1:], s[:, 1:, 1:], s[:, 1:, :-1]
+    jj, ii = np.meshgrid(np.arange(grid), np.arange(grid), indexing="ij")
     dev = np.zeros(len(h))
-    for mid, lin in ((s[:, ::2, 1::2], 0.5 * (c[:, :, :-1] + c[:, :, 1:])),
-                     (s[:, 1::2, ::2], 0.5 * (c[:, :-1] + c[:, 1:])),
-                     (s[:, 1::2, 1::2], 0.5 * (c[:, :-1, :-1] + c[:, 1:, 1:]))):
-        dev = np.maximum(dev, np.linalg.norm(mid - lin, axis=-1).reshape(len(h), -1).max(axis=1))
+    for corners, uv in (((c00, c10, c11), ((0, 0), (1, 0), (1, 1))), ((c00, c11, c01), ((0, 0), (1, 1), (0, 1)))):
+        lin = np.einsum("sc,cpvud->pvusd", _B, np.stack(corners))  # (P, g, g, S, 3)
+        at = np.einsum("sc,cd->sd", _B, np.asarray(uv, np.float64))  # (S, 2) inside a cell
+        u = (ii[..., None] + at[:, 0]) / grid
+        v = (jj[..., None] + at[:, 1]) / grid
+        on = evaluate(h, np.broadcast_to(u.ravel(), (len(h), u.size)), np.broadcast_to(v.ravel(), (len(h), v.size)))
+        dev = np.maximum(dev, np.linalg.norm(on.reshape(lin.shape) - lin, axis=-1).reshape(len(h), -1).max(axis=1))
     return dev
 
 
@@ -349,19 +355,49 @@ def patch_levels(control, edges, lod, camera=None):
     return np.minimum(edge_level, lod.max_level), np.minimum(inner, lod.max_level)
 
 
-def triangle_deviation(control, mesh):
+def triangle_deviation(control, mesh, which=None):
     """The largest distance between each triangle and the surface: (T,) float64. Each of `_B`'s barycentric points
     of a triangle is compared with the surface at the same barycentric point of its corners' (u, v) — the mesh's
-    map to the surface — so this bounds the distance both ways where the points are dense enough."""
+    map to the surface — so this bounds the distance both ways where the points are dense enough. which: (T',)
+    the triangles to measure (all by default); the result is theirs."""
     h = check_patches(control)
-    p = mesh.positions.astype(np.float64)[mesh.triangles]  # (T, 3, 3)
-    uv = mesh.corner_uv.astype(np.float64)
+    which = np.arange(len(mesh.triangles)) if which is None else np.asarray(which, np.int64)
+    p = mesh.positions.astype(np.float64)[mesh.triangles[which]]  # (T, 3, 3)
+    uv = mesh.corner_uv[which].astype(np.float64)
+    patch = mesh.triangle_patch[which]
     on_mesh = np.einsum("sc,tcd->tsd", _B, p)
     at = np.einsum("sc,tcd->tsd", _B, uv)
     out = np.empty(len(p))
     for chunk in np.array_split(np.arange(len(p)), max(1, len(p) // 65536)):
-        s = evaluate(h[mesh.triangle_patch[chunk]], at[chunk, :, 0], at[chunk, :, 1])
+        s = evaluate(h[patch[chunk]], at[chunk, :, 0], at[chunk, :, 1])
         out[chunk] = np.linalg.norm(on_mesh[chunk] - s, axis=-1).max(axis=1)
+    return out
+
+
+def grid_deviation(control, inner_levels):
+    """The largest distance between the surface and the triangles of each patch's inner grid (the cells between
+    its inner points (i / n, j / n), i, j from 1 to n - 1, each cut along its (i, j)-(i+1, j+1) diagonal as the
+    pattern cuts it), measured at `_B` in every triangle as `triangle_deviation` does, by tensor products (one per
+    inner level): (P,) float64, 0 for a patch with fewer than 2 cells a side."""
+    h = check_patches(control)
+    n_in = np.asarray(inner_levels, np.int64)
+    d = h.shape[1] - 1
+    out = np.zeros(len(h))
+    tri_offsets = (np.array([[0, 0], [1, 0], [1, 1]], np.float64), np.array([[0, 0], [1, 1], [0, 1]], np.float64))
+    for n in np.unique(n_in[n_in >= 3]):
+        ps = np.flatnonzero(n_in == n)
+        t = np.arange(1, n) / n  # the inner points
+        b = bernstein(t, d)
+        grid = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h[ps], optimize=True))  # (p, n-1, n-1, 3) [v, u]
+        cells = np.arange(1, n - 1)
+        for offs in tri_offsets:
+            corner = [grid[:, int(dv):int(dv) + n - 2, int(du):int(du) + n - 2] for du, dv in offs]
+            for bary in _B:
+                lin = sum(w * c for w, c in zip(bary, corner, strict=True))
+                a = bary @ offs
+                bu, bv = bernstein((cells + a[0]) / n, d), bernstein((cells + a[1]) / n, d)
+                on = cartesian(np.einsum("ui,vj,pijc->pvuc", bu, bv, h[ps], optimize=True))
+                out[ps] = np.maximum(out[ps], np.linalg.norm(on - lin, axis=-1).reshape(len(ps), -1).max(axis=1))
     return out
 
 
@@ -383,21 +419,28 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
     h = check_patches(control)
     edges = patch_edges(h)
     el, inner = patch_levels(h, edges, lod, camera)
+    if "TOLERANCE" in lod.metrics:  # a side as fine as the patches beside it: no stretched triangles along it
+        np.maximum.at(el, edges.edge.ravel(), np.repeat(inner, 4))
+        el = np.where(edges.collapsed, 1, el)
     lower = "Max Level, or raise the Tolerance" if "TOLERANCE" in lod.metrics else "Max Level"
     check_budget(estimate(el, inner), budget_bytes, lower)
     mesh = tessellate_patches(h, el, inner, edges)
     if "TOLERANCE" not in lod.metrics:
         return Tessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
     tol = lod.tolerance
-    for _ in range(TOLERANCE_ROUNDS):
+    for _round in range(TOLERANCE_ROUNDS):
         side_dev = chord_deviation(edges.control, el)
-        tri_dev = triangle_deviation(h, mesh)
-        dev = np.zeros(len(h))
-        np.maximum.at(dev, mesh.triangle_patch, tri_dev)
+        # the inner grids by tensor products; the triangles that reach a side of their patch one by one
+        grid_dev = grid_deviation(h, inner)
+        cuv = mesh.corner_uv
+        rim = np.flatnonzero(((cuv == 0) | (cuv == 1)).any(axis=(1, 2)))
+        rim_dev = triangle_deviation(h, mesh, rim)
+        dev = grid_dev.copy()
+        np.maximum.at(dev, mesh.triangle_patch[rim], rim_dev)
         # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
         # inside raises that side (its long edge lies along it); any other raises the patch's inner level
-        over = np.flatnonzero(tri_dev > tol)
-        uv, tp, td = mesh.corner_uv[over], mesh.triangle_patch[over], tri_dev[over]
+        over = rim[rim_dev > tol]
+        uv, tp, td = mesh.corner_uv[over], mesh.triangle_patch[over], rim_dev[rim_dev > tol]
         on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
                             (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
         side_need = side_dev.copy()
@@ -407,19 +450,21 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
             use = on_side[:, side] & (el[e] < inner[tp]) & ~edges.collapsed[e]
             np.maximum.at(side_need, e[use], td[use])
             coarse_side |= use
-        inner_need = np.zeros(len(h))
+        inner_need = np.where(grid_dev > tol, grid_dev, 0.0)
         np.maximum.at(inner_need, tp[~coarse_side], td[~coarse_side])
         new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, lod.max_level)), el)
         new_inner = np.where(inner_need > tol, np.maximum(inner + 1, steps_for(inner_need, inner, tol,
                                                                                 lod.max_level)), inner)
-        new_el, new_inner = np.minimum(new_el, lod.max_level), np.minimum(new_inner, lod.max_level)
+        new_inner = np.minimum(new_inner, lod.max_level)
+        np.maximum.at(new_el, edges.edge.ravel(), np.repeat(new_inner, 4))  # sides keep up with their patches
+        new_el = np.minimum(np.where(edges.collapsed, 1, new_el), lod.max_level)
         if np.array_equal(new_el, el) and np.array_equal(new_inner, inner):
             break
         el, inner = new_el, new_inner
         check_budget(estimate(el, inner), budget_bytes, lower)
         mesh = tessellate_patches(h, el, inner, edges)
     else:
-        dev = np.zeros(len(h))
+        dev = grid_deviation(h, inner)
         np.maximum.at(dev, mesh.triangle_patch, triangle_deviation(h, mesh))
     return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > tol))
 
