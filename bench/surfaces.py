@@ -210,7 +210,7 @@ def run_tessellate_surface(bpy, mod, name, make):
     ours_dev = float(result.deviation.max())
     res, dev = 0, np.inf
     while dev > ours_dev and res < 128:  # the lowest resolution as close to the surface as ours
-        res += 1 if res < 16 else 4
+        res += 1
         for s in surface.data.splines:
             s.resolution_u = s.resolution_v = res
         me = converted()

@@ -3,6 +3,8 @@ cursor: welded where it closes, with its domain coordinates as UVs. ``tessera.cu
 splines as polylines sampled where they bend ([Nellmedin 2014, §5.5.2]). ``tessera.vector_field_texture``: a steady
 field's line-integral-convolution image ([Nellmedin 2014, §5.5.4])."""
 
+import dataclasses
+
 import bpy
 import numpy as np
 
@@ -149,6 +151,8 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
     def execute(self, context, tx):
         ob = context.active_object
         settings = curve_sampling(self)
+        if settings.mode == "TOLERANCE":  # the tolerance is in scene units; the splines are in the object's
+            settings = dataclasses.replace(settings, tolerance=settings.tolerance / _largest_scale(ob))
         camera = None
         if self.mode == "SCREEN":
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
@@ -279,6 +283,8 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         if not surfaces and not rows:
             raise InvalidInputError(f"Surface {ob.name!r} has no spline: add one in Edit Mode, or select another")
         lod = patch_lod(self)
+        scale = _largest_scale(ob)
+        lod = dataclasses.replace(lod, tolerance=lod.tolerance / scale)  # scene units -> the object's
         cam = None
         if set(lod.metrics) & {"DISTANCE", "EDGE_LENGTH"}:
             cam = object_camera(camera_for(context, self.camera_source, "Camera levels"), ob.matrix_world)
@@ -294,7 +300,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
             words.append(f"{len(patch_set.patches):,} patches, sides {int(result.edge_levels.min())}-"
                          f"{int(result.edge_levels.max())} segments, {len(mesh.triangles):,} triangles")
             if "TOLERANCE" in lod.metrics:
-                worst = float(np.nanmax(result.deviation))
+                worst = float(np.nanmax(result.deviation)) * scale  # in scene units
                 if len(result.unmet):
                     warn = True
                     splines = sorted({surfaces[int(patch_set.spline[q])][0] for q in result.unmet})
@@ -302,7 +308,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
                                  f"over the tolerance at Max Level {lod.max_level} (up to {worst:.3g}): raise Max "
                                  "Level or the Tolerance")
                 else:
-                    words.append(f"within {lod.tolerance:g} of the surface (largest measured {worst:.3g})")
+                    words.append(f"within {self.tolerance:g} of the surface (largest measured {worst:.3g})")
         line_points, line_edges = _row_lines(rows, lod.tolerance)
         name = f"{ob.data.name}.tessellated"
         data = tx.track(bridge.write_mesh(name, arrays) if surfaces else bpy.data.meshes.new(name))
@@ -314,6 +320,13 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         place_mesh(context, tx, ob, data, "NEW_OBJECT", "tessellated")
         self.report({"WARNING" if warn else "INFO"}, "; ".join(words))
         return {"FINISHED"}
+
+
+def _largest_scale(ob):
+    """How much the object's transform stretches a length at most (its largest singular value; 1 if degenerate)."""
+    m = np.array(ob.matrix_world, np.float64)[:3, :3]
+    s = float(np.linalg.svd(m, compute_uv=False).max()) if np.all(np.isfinite(m)) else 0.0
+    return s if s > 0 else 1.0
 
 
 def _spline_patches(surfaces):

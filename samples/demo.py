@@ -613,19 +613,26 @@ def build_surfaces_scene():
 
 
 def build_teapot_scene():
-    """The teapot's body of revolution (24 bicubic patches as a surface object) tessellated by
-    ``tessera.surface_tessellate``: curvature levels (left: the knob and the base finest), and distance levels for
-    the scene camera (right: the near side finer), wireframe on top. Returns the two triangle counts."""
+    """Newell's full teapot (32 bicubic patches as a surface object) and Blender's own NURBS torus (order 3, rational,
+    cyclic both ways) tessellated by ``tessera.surface_tessellate`` to a tolerance of 0.005 (left: detail where they
+    bend most), and the teapot by distance for the scene camera (right: the near side finer), wireframe on top.
+    Returns the three triangle counts."""
     clear_scene()
     clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
-    nets, _ = _addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
+    nets, _ = _addon_module("kernels.surfaces.utah_teapot").teapot_patches()
     surface = _addon_module("addon.curve_bridge").write_surface_patches(nets)
-    add_camera((0.0, -13.0, 5.5), (1.27, 0.0, 0.0), lens=35)
+    bpy.ops.surface.primitive_nurbs_surface_torus_add(location=(0.0, -3.0, -0.2))
+    torus = bpy.context.active_object
+    torus.rotation_euler = (0.35, 0.0, 0.0)
+    add_camera((0.0, -15.0, 5.5), (1.27, 0.0, 0.0), lens=35)
     counts = []
-    for x, kw in ((-2.6, {"metrics": {"CURVATURE"}}), (2.6, {"metrics": {"DISTANCE"}, "near": 11.0, "far": 17.0,
-                                                         "max_level": 24})):
-        surface.location = (x, 0.0, 0.0)
-        bpy.context.view_layer.objects.active = surface
+    cases = ((surface, -3.4, {"metrics": {"TOLERANCE"}, "tolerance": 0.005, "max_level": 64}),
+             (torus, None, {"metrics": {"TOLERANCE"}, "tolerance": 0.005, "max_level": 64}),
+             (surface, 3.4, {"metrics": {"DISTANCE"}, "near": 13.0, "far": 19.0, "max_level": 24}))
+    for source, x, kw in cases:
+        if x is not None:
+            source.location = (x, 0.0, 0.0)
+        bpy.context.view_layer.objects.active = source
         bpy.context.view_layer.update()
         if bpy.ops.tessera.surface_tessellate(**kw) != {"FINISHED"}:
             sys.exit("demo: surface_tessellate failed")
@@ -634,6 +641,7 @@ def build_teapot_scene():
         wire_overlay(ob, wire_mat, thickness=0.008)
         counts.append(len(ob.data.polygons))
     bpy.data.objects.remove(surface)
+    bpy.data.objects.remove(torus)
     return counts
 
 
@@ -721,7 +729,7 @@ def main():
     print(f"demo: one-point parametric surfaces: {counts} triangles")
     counts = build_teapot_scene()
     render("demo_teapot.png")
-    print(f"demo: the teapot's body by Tessellate Surface, curvature / distance levels: {counts} triangles")
+    print(f"demo: Tessellate Surface, teapot and NURBS torus to a tolerance, teapot by distance: {counts} triangles")
     seconds = build_lic_picture()
     print(f"demo: vector-field textures (ABC flow, vortex) in {seconds:.1f} s")
     texels, seconds = build_nailboard_picture()

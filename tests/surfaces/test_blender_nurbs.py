@@ -363,3 +363,17 @@ def test_tubes_sample_nurbs_curves_by_curvature(clean_scene, bpy_module, addon_m
     [want] = bz.adaptive_nurbs(co[:, :3], co[:, 3], d, np.ones(5), np.zeros(5), bz.CurveSampling(mode="CURVATURE"))
     assert len(rings) == len(want.points) and np.allclose(rings, want.points, atol=1e-5)
     assert want.counts.max() > want.counts.min()  # more rings where it bends
+
+
+def test_the_tolerance_is_in_scene_units(clean_scene, bpy_module):
+    """A surface scaled 10 times at a tolerance 10 times larger gets the same mesh, and the report's figures are in
+    scene units."""
+    bpy = bpy_module
+    counts = []
+    for scale, tol in ((1.0, 1e-3), (10.0, 1e-2)):
+        ob = add_primitive(bpy, "sphere")
+        ob.scale = (scale,) * 3
+        bpy.context.view_layer.update()
+        assert bpy.ops.tessera.surface_tessellate(metrics={"TOLERANCE"}, tolerance=tol, max_level=64) == {"FINISHED"}
+        counts.append(len(bpy.context.active_object.data.polygons))
+    assert counts[0] == counts[1]
