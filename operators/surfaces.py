@@ -294,17 +294,19 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
             patch_set = _spline_patches(surfaces)
             result = bp.tessellate(patch_set.patches, lod, cam, budget)
             mesh = result.mesh
-            corner_uv = patch_set.uv(mesh.triangle_patch[:, None], mesh.corner_uv).astype(np.float32)
+            corner_uv = patch_set.uv(result.parent[mesh.triangle_patch][:, None], result.patch_uv())
+            corner_uv = corner_uv.astype(np.float32)
             arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles, point_normals=mesh.normals,
                                 corner_attributes={"UVMap": corner_uv}, attribute_types={"UVMap": "FLOAT2"})
-            words.append(f"{len(patch_set.patches):,} patches, sides {int(result.edge_levels.min())}-"
+            words.append(f"{len(patch_set.patches):,} patches in {len(result.parent):,} parts, sides "
+                         f"{int(result.edge_levels.min())}-"
                          f"{int(result.edge_levels.max())} segments, {len(mesh.triangles):,} triangles")
             if "TOLERANCE" in lod.metrics:
                 worst = float(np.nanmax(result.deviation)) * scale  # in scene units
                 if len(result.unmet):
                     warn = True
-                    splines = sorted({surfaces[int(patch_set.spline[q])][0] for q in result.unmet})
-                    words.append(f"{len(result.unmet)} patch(es) of spline(s) {', '.join(map(str, splines))} stay "
+                    splines = sorted({surfaces[int(patch_set.spline[result.parent[q]])][0] for q in result.unmet})
+                    words.append(f"{len(result.unmet)} part(s) of spline(s) {', '.join(map(str, splines))} stay "
                                  f"over the tolerance at Max Level {lod.max_level} (up to {worst:.3g}): raise Max "
                                  "Level or the Tolerance")
                 else:

@@ -29,8 +29,9 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
   of its length); then `tessellate` measures every triangle of the mesh against the surface and raises the levels
   where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is met or the patches that cannot meet
   it within Max Level are named;
-- any of these together: the largest. Levels are whole segment counts; one inner count per patch, the larger of u
-  and v (the pattern's single inner level).
+- any of these together: the largest. Levels are whole segment counts. The inside of a patch has a count of steps
+  along u and one along v: the same (the larger) for curvature, distance and edge length, each its own for the
+  tolerance.
 """
 
 from dataclasses import dataclass
@@ -49,6 +50,7 @@ from ..common.rational_bezier import (
     chord_deviation,
     steps_for,
 )
+from . import patch_split
 
 METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
 MAX_LEVEL = 64
@@ -59,6 +61,16 @@ TOLERANCE_ROUNDS = 16
 #: triangle is largest).
 _B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
                [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+#: The offsets inside a cell (in cells) of the corners and of `_B`'s points of the cell's two triangles.
+_OFFSETS = np.array([0.0, 1 / 6, 1 / 3, 1 / 2, 2 / 3, 5 / 6, 1.0])
+
+
+def _offset_index(a):
+    return int(np.argmin(np.abs(_OFFSETS - a)))
+
+
+#: With the tolerance, how many times patches still over it at Max Level are split and the whole made again.
+SPLIT_ROUNDS = 3
 #: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
 COLLAPSED = 1e-12
 
@@ -129,10 +141,12 @@ class PatchMesh:
 
 @dataclass
 class Tessellation:
-    """What `tessellate` made: mesh (`PatchMesh`); edge_levels (E,) and inner_levels (P,) int64; edges
+    """What `tessellate` made: mesh (`PatchMesh`); edge_levels (E,) and inner_levels (P, 2) int64; edges
     (`PatchEdges`); deviation (P,) float64: the largest distance measured between each patch's triangles and the
     surface (NaN when the tolerance was not asked for); unmet (K,) int64: the patches still over the tolerance at Max
-    Level."""
+    Level. With the tolerance a patch may have been split into parts (`kernels.surfaces.patch_split`): then the mesh,
+    the levels, the deviation and unmet are the parts', parent (P',) int64 is each part's patch and box (P', 2, 2)
+    its ((u0, u1), (v0, v1)) there."""
 
     mesh: PatchMesh
     edge_levels: np.ndarray
@@ -140,10 +154,24 @@ class Tessellation:
     edges: PatchEdges
     deviation: np.ndarray
     unmet: np.ndarray
+    parent: np.ndarray = None
+    box: np.ndarray = None
+
+    def patch_uv(self):
+        """Each triangle's corners' (u, v) in its patch (not its part): (T, 3, 2) float64."""
+        b = self.box[self.mesh.triangle_patch][:, None]
+        return b[..., 0] + self.mesh.corner_uv.astype(np.float64) * (b[..., 1] - b[..., 0])
 
 
 
 
+
+
+def tensor_grid(b_u, b_v, h):
+    """Homogeneous points of patches h (P, k, k, c) on a grid: b_u (U, k) and b_v (V, k) basis values along u and
+    v -> (P, V, U, c) (row j at the j-th v). Two matrix products."""
+    tmp = np.tensordot(h, b_v, axes=([2], [1]))  # (P, k_u, c, V)
+    return np.tensordot(tmp, b_u, axes=([1], [1])).transpose(0, 2, 3, 1)  # (P, V, U, c)
 
 
 def homogeneous_nets(control):
@@ -278,30 +306,29 @@ def _polygon_length(points):
 
 
 
-def _inner_deviation(h, grid=8):
-    """Deviation of each patch's triangles on a grid x grid split (cells cut along their (i, j)-(i+1, j+1)
-    diagonal, as the pattern's), measured at `_B` in every triangle, as `triangle_deviation` measures a mesh: (P,)
-    float64."""
-    t = np.arange(grid + 1) / grid
+def _direction_deviation(h, steps=16, lines=9):
+    """How far each patch's iso-lines stray from their chords at ``steps`` equal steps: along u (``lines`` lines of
+    constant v) and along v, measured at each chord's quarter points: (P, 2) float64."""
     d = h.shape[1] - 1
-    b = bernstein(t, d)
-    s = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h, optimize=True))  # (P, g+1, g+1, 3): [v, u]
-    c00, c10, c11, c01 = s[:, :-1, :-1], s[:, :-1, 1:], s[:, 1:, 1:], s[:, 1:, :-1]
-    jj, ii = np.meshgrid(np.arange(grid), np.arange(grid), indexing="ij")
-    dev = np.zeros(len(h))
-    for corners, uv in (((c00, c10, c11), ((0, 0), (1, 0), (1, 1))), ((c00, c11, c01), ((0, 0), (1, 1), (0, 1)))):
-        lin = np.einsum("sc,cpvud->pvusd", _B, np.stack(corners))  # (P, g, g, S, 3)
-        at = np.einsum("sc,cd->sd", _B, np.asarray(uv, np.float64))  # (S, 2) inside a cell
-        u = (ii[..., None] + at[:, 0]) / grid
-        v = (jj[..., None] + at[:, 1]) / grid
-        on = evaluate(h, np.broadcast_to(u.ravel(), (len(h), u.size)), np.broadcast_to(v.ravel(), (len(h), v.size)))
-        dev = np.maximum(dev, np.linalg.norm(on.reshape(lin.shape) - lin, axis=-1).reshape(len(h), -1).max(axis=1))
-    return dev
+    fine = np.arange(4 * steps + 1) / (4 * steps)
+    across = np.linspace(0.0, 1.0, lines)
+    b_f, b_a = bernstein(fine, d), bernstein(across, d)
+    out = np.empty((len(h), 2))
+    for axis in (0, 1):
+        pts = cartesian(tensor_grid(b_f, b_a, h) if axis == 0 else
+                        tensor_grid(b_a, b_f, h).transpose(0, 2, 1, 3))  # (P, lines, 4 steps + 1, 3)
+        ends = pts[:, :, ::4]
+        frac = np.array([0.25, 0.5, 0.75])
+        chord = ends[:, :, :-1, None] + frac[None, None, None, :, None] * (ends[:, :, 1:, None] - ends[:, :, :-1, None])
+        mid = np.stack([pts[:, :, k::4][:, :, :steps] for k in (1, 2, 3)], axis=3)
+        out[:, axis] = np.linalg.norm(mid - chord, axis=-1).reshape(len(h), -1).max(axis=1)
+    return out
 
 
 def patch_levels(control, edges, lod, camera=None):
-    """Levels: (edge levels (E,) int64, inner levels (P,) int64) in [1, max_level]. camera: a
-    `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
+    """Levels: (edge levels (E,) int64, inner levels (P, 2) int64: steps along u and along v) in [1, max_level].
+    Curvature, distance and edge length give the same inner level both ways; the tolerance gives each direction
+    its own. camera: a `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
     h = check_patches(control)
     c = cartesian(h)
     k = h.shape[1]
@@ -351,7 +378,9 @@ def patch_levels(control, edges, lod, camera=None):
     if "TOLERANCE" in lod.metrics:
         edge_level = np.maximum(edge_level, steps_for(chord_deviation(edges.control, np.full(len(ec), 16)), 16,
                                                        lod.tolerance, lod.max_level))
-        inner = np.maximum(inner, steps_for(_inner_deviation(h), 8, lod.tolerance, lod.max_level))
+    inner = np.stack([inner, inner], 1)
+    if "TOLERANCE" in lod.metrics:  # each direction half the tolerance: a cell's diagonal strays about their sum
+        inner = np.maximum(inner, steps_for(_direction_deviation(h), 16, 0.5 * lod.tolerance, lod.max_level))
     return np.minimum(edge_level, lod.max_level), np.minimum(inner, lod.max_level)
 
 
@@ -374,39 +403,70 @@ def triangle_deviation(control, mesh, which=None):
     return out
 
 
+def inner_pairs(inner_levels, count):
+    """Inner levels as (P, 2) int64 steps along u and along v: (P,) (the same both ways) or (P, 2) as given."""
+    n = np.asarray(inner_levels, np.int64)
+    n = np.stack([n, n], 1) if n.ndim == 1 else n
+    if n.shape != (count, 2):
+        raise InvalidInputError(f"Inner levels must be (P,) or (P, 2) for {count} patches; got {n.shape}")
+    return np.maximum(n, 1)
+
+
 def grid_deviation(control, inner_levels):
     """The largest distance between the surface and the triangles of each patch's inner grid (the cells between
-    its inner points (i / n, j / n), i, j from 1 to n - 1, each cut along its (i, j)-(i+1, j+1) diagonal as the
-    pattern cuts it), measured at `_B` in every triangle as `triangle_deviation` does, by tensor products (one per
-    inner level): (P,) float64, 0 for a patch with fewer than 2 cells a side."""
+    its inner points (i / n, j / m), each cut along its (i, j)-(i+1, j+1) diagonal as the pattern cuts it), measured
+    at `_B` in every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels).
+    Returns (P, 3) float64: the largest distance anywhere, at the cells' sides along u, and along v (0 for a patch
+    with fewer than 2 cells a way)."""
     h = check_patches(control)
-    n_in = np.asarray(inner_levels, np.int64)
+    n_in = inner_pairs(inner_levels, len(h))
     d = h.shape[1] - 1
-    out = np.zeros(len(h))
+    out = np.zeros((len(h), 3))
     tri_offsets = (np.array([[0, 0], [1, 0], [1, 1]], np.float64), np.array([[0, 0], [1, 1], [0, 1]], np.float64))
-    for n in np.unique(n_in[n_in >= 3]):
-        ps = np.flatnonzero(n_in == n)
-        t = np.arange(1, n) / n  # the inner points
-        b = bernstein(t, d)
-        grid = cartesian(np.einsum("ui,vj,pijc->pvuc", b, b, h[ps], optimize=True))  # (p, n-1, n-1, 3) [v, u]
-        cells = np.arange(1, n - 1)
+    ok = (n_in >= 3).all(axis=1)
+    pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
+    for q, (nu, nv) in enumerate(pairs):
+        ps = np.flatnonzero((pair_of.ravel() == q) & ok)
+        if len(ps) == 0:
+            continue
+        # every sample point of every cell at once: the cells' corners plus offsets a in each direction
+        cu, cv = np.arange(1, nu - 1), np.arange(1, nv - 1)
+        fu = ((cu[:, None] + _OFFSETS[None]) / nu).ravel()
+        fv = ((cv[:, None] + _OFFSETS[None]) / nv).ravel()
+        dense = cartesian(tensor_grid(bernstein(fu, d), bernstein(fv, d), h[ps]))
+        dense = dense.reshape(len(ps), nv - 2, len(_OFFSETS), nu - 2, len(_OFFSETS), 3)
+        at = {0.0: 0, 1.0: len(_OFFSETS) - 1}
         for offs in tri_offsets:
-            corner = [grid[:, int(dv):int(dv) + n - 2, int(du):int(du) + n - 2] for du, dv in offs]
+            corner = [dense[:, :, at[dv], :, at[du]] for du, dv in offs]
             for bary in _B:
                 lin = sum(w * c for w, c in zip(bary, corner, strict=True))
                 a = bary @ offs
-                bu, bv = bernstein((cells + a[0]) / n, d), bernstein((cells + a[1]) / n, d)
-                on = cartesian(np.einsum("ui,vj,pijc->pvuc", bu, bv, h[ps], optimize=True))
-                out[ps] = np.maximum(out[ps], np.linalg.norm(on - lin, axis=-1).reshape(len(ps), -1).max(axis=1))
+                on = dense[:, :, _offset_index(a[1]), :, _offset_index(a[0])]
+                dev = np.linalg.norm(on - lin, axis=-1).reshape(len(ps), -1).max(axis=1)
+                out[ps, 0] = np.maximum(out[ps, 0], dev)
+                if a[1] in (0.0, 1.0):  # on a side of the cell along u
+                    out[ps, 1] = np.maximum(out[ps, 1], dev)
+                elif a[0] in (0.0, 1.0):  # along v
+                    out[ps, 2] = np.maximum(out[ps, 2], dev)
     return out
+
+
+def _sides_keep_up(edge_levels, inner, edges):
+    """Edge levels raised to the steps of the patches beside them in the side's direction (a bottom or top side
+    runs along u, a left or right one along v); a pole stays one segment."""
+    el = np.asarray(edge_levels, np.int64).copy()
+    np.maximum.at(el, edges.edge[:, [0, 2]].ravel(), np.repeat(inner[:, 0], 2))
+    np.maximum.at(el, edges.edge[:, [1, 3]].ravel(), np.repeat(inner[:, 1], 2))
+    return np.where(edges.collapsed, 1, el)
 
 
 def estimate(edge_levels, inner_levels):
     """The mesh's size at these levels, before it is made: an `Estimate` (peak bytes: the arrays being built,
     float64, and the result)."""
     n = np.maximum(np.asarray(inner_levels, np.int64), 2)
-    vertices = int(4 * len(n) + (np.asarray(edge_levels, np.int64) - 1).sum() + ((n - 1) ** 2).sum())
-    triangles = int((2 * n * n).sum())
+    n = np.stack([n, n], 1) if n.ndim == 1 else n
+    vertices = int(4 * len(n) + (np.asarray(edge_levels, np.int64) - 1).sum() + ((n - 1).prod(axis=1)).sum())
+    triangles = int((2 * n.prod(axis=1)).sum())
     return Estimate(vertices, triangles, vertices * 200 + triangles * 160)
 
 
@@ -414,20 +474,41 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
     """Levels from ``lod`` and the welded mesh at them: a `Tessellation`. With TOLERANCE among the metrics, every
     triangle is measured against the surface (`triangle_deviation`) and each side
     (`kernels.common.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
-    within the tolerance or at Max Level. Every mesh is checked against ``budget_bytes``
-    (`kernels.common.budget.check_budget`) before it is made."""
+    within the tolerance or at Max Level; a patch still over it at Max Level is split in two along each direction at
+    Max Level (`kernels.surfaces.patch_split`, with every patch that shares those sides) and the whole is made again,
+    up to SPLIT_ROUNDS times. Every mesh is checked against ``budget_bytes`` (`kernels.common.budget.check_budget`)
+    before it is made."""
     h = check_patches(control)
+    parent = np.arange(len(h))
+    box = np.broadcast_to(np.array([[0.0, 1.0], [0.0, 1.0]]), (len(h), 2, 2))
+    for attempt in range(SPLIT_ROUNDS + 1):
+        result = _tessellate_once(h, lod, camera, budget_bytes)
+        result.parent, result.box = parent, box
+        if len(result.unmet) == 0 or attempt == SPLIT_ROUNDS:
+            return result
+        want = np.ones((len(h), 2), np.int64)
+        at_top = result.inner_levels[result.unmet] >= lod.max_level
+        at_top[~at_top.any(axis=1)] = True  # over at its sides only: split both ways
+        want[result.unmet] = np.where(at_top, 2, 1)
+        counts = patch_split.consistent_counts(want, result.edges.edge, result.edges.reversed)
+        h, sub_parent, sub_box = patch_split.split_patches(h, counts, result.edges)
+        lo, size = box[sub_parent, :, :1], box[sub_parent, :, 1:] - box[sub_parent, :, :1]
+        parent, box = parent[sub_parent], lo + sub_box * size
+    return result
+
+
+def _tessellate_once(h, lod, camera, budget_bytes):
+    """`tessellate` without splitting: a `Tessellation` of these patches (parent and box left to the caller)."""
     edges = patch_edges(h)
     el, inner = patch_levels(h, edges, lod, camera)
     if "TOLERANCE" in lod.metrics:  # a side as fine as the patches beside it: no stretched triangles along it
-        np.maximum.at(el, edges.edge.ravel(), np.repeat(inner, 4))
-        el = np.where(edges.collapsed, 1, el)
+        el = _sides_keep_up(el, inner, edges)
     lower = "Max Level, or raise the Tolerance" if "TOLERANCE" in lod.metrics else "Max Level"
     check_budget(estimate(el, inner), budget_bytes, lower)
     mesh = tessellate_patches(h, el, inner, edges)
     if "TOLERANCE" not in lod.metrics:
         return Tessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
-    tol = lod.tolerance
+    tol, top = lod.tolerance, lod.max_level
     for _round in range(TOLERANCE_ROUNDS):
         side_dev = chord_deviation(edges.control, el)
         # the inner grids by tensor products; the triangles that reach a side of their patch one by one
@@ -435,36 +516,47 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
         cuv = mesh.corner_uv
         rim = np.flatnonzero(((cuv == 0) | (cuv == 1)).any(axis=(1, 2)))
         rim_dev = triangle_deviation(h, mesh, rim)
-        dev = grid_dev.copy()
+        dev = grid_dev[:, 0].copy()
         np.maximum.at(dev, mesh.triangle_patch[rim], rim_dev)
         # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
-        # inside raises that side (its long edge lies along it); any other raises the patch's inner level
+        # inside has along it raises that side (its long edge lies along it); any other raises the patch's steps
         over = rim[rim_dev > tol]
         uv, tp, td = mesh.corner_uv[over], mesh.triangle_patch[over], rim_dev[rim_dev > tol]
         on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
                             (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
         side_need = side_dev.copy()
+        side_need[edges.collapsed] = 0.0  # a pole has no length to split
         coarse_side = np.zeros(len(over), bool)
         for side in range(4):
             e = edges.edge[tp, side]
-            use = on_side[:, side] & (el[e] < inner[tp]) & ~edges.collapsed[e]
+            use = on_side[:, side] & (el[e] < inner[tp, side % 2]) & ~edges.collapsed[e]
             np.maximum.at(side_need, e[use], td[use])
             coarse_side |= use
-        inner_need = np.where(grid_dev > tol, grid_dev, 0.0)
-        np.maximum.at(inner_need, tp[~coarse_side], td[~coarse_side])
-        new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, lod.max_level)), el)
-        new_inner = np.where(inner_need > tol, np.maximum(inner + 1, steps_for(inner_need, inner, tol,
-                                                                                lod.max_level)), inner)
-        new_inner = np.minimum(new_inner, lod.max_level)
-        np.maximum.at(new_el, edges.edge.ravel(), np.repeat(new_inner, 4))  # sides keep up with their patches
-        new_el = np.minimum(np.where(edges.collapsed, 1, new_el), lod.max_level)
+        new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, top)), el)
+        # a grid over the tolerance: each direction by its own cells' sides (half the tolerance each), at least
+        # one step more; a triangle along a side: both directions
+        rim_need = np.zeros(len(h))
+        np.maximum.at(rim_need, tp[~coarse_side], td[~coarse_side])
+        new_inner = inner.copy()
+        grid_over = grid_dev[:, 0] > tol
+        for axis in (0, 1):
+            want = steps_for(np.maximum(grid_dev[:, 1 + axis], 0.25 * grid_dev[:, 0]), inner[:, axis], 0.5 * tol,
+                             top)
+            new_inner[:, axis] = np.where(grid_over, np.maximum(inner[:, axis], want), new_inner[:, axis])
+        stuck = grid_over & (new_inner == inner).all(axis=1)
+        new_inner[stuck] += 1
+        rim_over = rim_need > tol
+        new_inner[rim_over] = np.maximum(new_inner[rim_over], np.maximum(
+            inner[rim_over] + 1, steps_for(rim_need[rim_over, None], inner[rim_over], tol, top)))
+        new_inner = np.minimum(new_inner, top)
+        new_el = np.minimum(_sides_keep_up(new_el, new_inner, edges), top)
         if np.array_equal(new_el, el) and np.array_equal(new_inner, inner):
             break
         el, inner = new_el, new_inner
         check_budget(estimate(el, inner), budget_bytes, lower)
         mesh = tessellate_patches(h, el, inner, edges)
     else:
-        dev = grid_deviation(h, inner)
+        dev = grid_deviation(h, inner)[:, 0]
         np.maximum.at(dev, mesh.triangle_patch, triangle_deviation(h, mesh))
     return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > tol))
 
@@ -503,32 +595,38 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     tl = np.where(fr[e_of], 1.0 - t, t)
     side_uv = np.stack([np.select([fs[e_of] == 1, fs[e_of] == 3], [1.0, 0.0], tl),
                         np.select([fs[e_of] == 0, fs[e_of] == 2], [0.0, 1.0], tl)], 1)
-    n_in = np.maximum(np.asarray(inner_levels, np.int64), 1)
+    n_in = inner_pairs(inner_levels, n_p)  # (P, 2): steps along u and along v
     side_counts = el[edges.edge]  # (P, 4)
     one = side_counts == 1
-    strip = (one[:, 1] & one[:, 3]) | (one[:, 0] & one[:, 2])  # as terrain tiles: a single strip
-    n_in = np.where((n_in == 1) & ~strip, 2, n_in)
-    m = n_in - 1
-    in_first = np.concatenate([[0], np.cumsum(m * m)])[:-1]
-    inner_pts = np.empty((int((m * m).sum()), 3))
+    # as terrain tiles: one step along u is a strip between the left and right sides when the bottom and top are
+    # one segment each (and along v likewise); else at least 2
+    n_in = np.stack([np.where((n_in[:, 0] == 1) & ~(one[:, 0] & one[:, 2]), 2, n_in[:, 0]),
+                     np.where((n_in[:, 1] == 1) & ~(one[:, 1] & one[:, 3]), 2, n_in[:, 1])], 1)
+    mu, mv = n_in[:, 0] - 1, n_in[:, 1] - 1
+    count = mu * mv
+    in_first = np.concatenate([[0], np.cumsum(count)])[:-1]
+    inner_pts = np.empty((int(count.sum()), 3))
     inner_uv = np.empty((len(inner_pts), 2))
     inner_nrm = np.empty((len(inner_pts), 3))
-    p_of = np.repeat(np.arange(n_p), m * m)
-    for n in np.unique(n_in[m > 0]):  # one tensor product per inner count: rows j, columns i, as the pattern
-        ps = np.flatnonzero(n_in == n)
-        t_in = np.arange(1, n) / n
-        b_in = bernstein(t_in, deg)
-        d_in = bernstein_derivative(t_in, deg)
-        grid = np.einsum("ik,jl,pklc->pjic", b_in, b_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
-        g_u = np.einsum("ik,jl,pklc->pjic", d_in, b_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
-        g_v = np.einsum("ik,jl,pklc->pjic", b_in, d_in, h[ps], optimize=True).reshape(len(ps), -1, 4)
-        rows = in_first[ps][:, None] + np.arange((n - 1) ** 2)[None]
+    p_of = np.repeat(np.arange(n_p), count)
+    pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
+    for q, (nu, nv) in enumerate(pairs):  # one tensor product per pair of inner counts: rows j, columns i
+        ps = np.flatnonzero((pair_of.ravel() == q) & (count > 0))
+        if len(ps) == 0:
+            continue
+        t_u, t_v = np.arange(1, nu) / nu, np.arange(1, nv) / nv
+        b_u, b_v = bernstein(t_u, deg), bernstein(t_v, deg)
+        d_u, d_v = bernstein_derivative(t_u, deg), bernstein_derivative(t_v, deg)
+        grid = tensor_grid(b_u, b_v, h[ps]).reshape(len(ps), -1, 4)
+        g_u = tensor_grid(d_u, b_v, h[ps]).reshape(len(ps), -1, 4)
+        g_v = tensor_grid(b_u, d_v, h[ps]).reshape(len(ps), -1, 4)
+        rows = in_first[ps][:, None] + np.arange((nu - 1) * (nv - 1))[None]
         pts = cartesian(grid)
         inner_pts[rows] = pts
         w = grid[..., 3:]
         inner_nrm[rows] = np.cross(g_u[..., :3] - pts * g_u[..., 3:], g_v[..., :3] - pts * g_v[..., 3:]) / (w * w)
-        jj, ii = np.divmod(np.arange((n - 1) ** 2), n - 1)
-        inner_uv[rows] = np.stack([t_in[ii], t_in[jj]], 1)[None]
+        jj, ii = np.divmod(np.arange((nu - 1) * (nv - 1)), nu - 1)
+        inner_uv[rows] = np.stack([t_u[ii], t_v[jj]], 1)[None]
 
     n_c = 4 * n_p
     base_e, base_i = n_c, n_c + len(edge_pts)
@@ -537,7 +635,7 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     patch = np.concatenate([np.repeat(np.arange(n_p), 4), fp[e_of], p_of])
 
     tris, tri_patch, tri_uv = [], [], []
-    keys = np.concatenate([side_counts, n_in[:, None]], axis=1)
+    keys = np.concatenate([side_counts, n_in], axis=1)
     classes, inverse = np.unique(keys, axis=0, return_inverse=True)
     for cls, key in enumerate(classes):
         ps = np.flatnonzero(inverse.ravel() == cls)
@@ -547,8 +645,8 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
             e, r = edges.edge[ps, side], edges.reversed[ps, side]
             q = np.arange(int(key[side]) - 1)[None]  # the side's interior points in the patch's direction
             cols.append(base_e + e_first[e][:, None] + np.where(r[:, None], q.shape[1] - 1 - q, q))
-        mloc = int(key[4]) - 1
-        cols.append(base_i + in_first[ps][:, None] + np.arange(mloc * mloc)[None])
+        cells = (int(key[4]) - 1) * (int(key[5]) - 1) if key[4] > 1 and key[5] > 1 else 0
+        cols.append(base_i + in_first[ps][:, None] + np.arange(cells)[None])
         lmap = np.concatenate(cols, 1)
         tris.append(lmap[:, tmpl].reshape(-1, 3))
         tri_patch.append(np.repeat(ps, len(tmpl)))
@@ -603,13 +701,13 @@ def _pole_corners(tri_uv, collapsed):
 
 @lru_cache(maxsize=4096)
 def _pattern_uv(key):
-    """(u, v) of each local vertex of the pattern of class key (c0, c1, c2, c3, n), from its `pattern_codes`:
-    corners, side points k / c in each side's direction, inner (i / n, j / n)."""
+    """(u, v) of each local vertex of the pattern of class key (c0, c1, c2, c3, n, m), from its `pattern_codes`:
+    corners, side points k / c in each side's direction, inner (i / n, j / m)."""
     codes = pattern_codes(*key)
     kind, a, b = codes[:, 0].astype(int), codes[:, 1].astype(np.float64), codes[:, 2].astype(np.float64)
     c = np.asarray(key[:4], np.float64)
-    n = float(key[4])
+    n, m = float(key[4]), float(key[5])
     t = np.divide(a, c[np.clip(kind - 1, 0, 3)])
     u = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4], [a, t, 1.0, t, 0.0], a / n)
-    v = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4], [b, 0.0, t, 1.0, t], b / n)
+    v = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4], [b, 0.0, t, 1.0, t], b / m)
     return np.stack([u, v], 1)

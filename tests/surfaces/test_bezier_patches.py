@@ -126,3 +126,69 @@ def test_both_sides_of_an_edge_get_one_level_and_bad_input_is_refused():
         bp.check_patches(np.full((1, 4, 4, 3), np.nan))
     with pytest.raises(InvalidInputError):
         bp.PatchLod(metrics=("FAST",))
+
+
+def full_teapot():
+    from tessera.kernels.surfaces.utah_teapot import teapot_patches as full
+
+    return full()
+
+
+def test_the_full_teapot_welds_where_its_patches_share_sides():
+    patches, parts = full_teapot()
+    assert patches.shape == (32, 4, 4, 3) and list(dict.fromkeys(parts)) == list(
+        ("rim", "body_upper", "body_lower", "handle", "spout", "lid_top", "lid_bottom", "bottom"))
+    edges = bp.patch_edges(patches)
+    assert edges.collapsed.sum() == 2  # the lid's top, the bottom's centre
+    mesh = bp.tessellate_patches(patches, np.full(len(edges.control), 5), np.full(len(patches), 5), edges)
+    _, counts = edge_uses(mesh.triangles)
+    assert counts.max() == 2
+    # open: the rim's inside, the lid's edge (4 sides each), the handle's and the spout's two ends (2 sides each)
+    assert (counts == 1).sum() == 5 * (4 + 4 + 2 * 2 + 2 * 2)
+    n = mesh.normals.astype(np.float64)
+    body = np.isin(mesh.patch, np.flatnonzero(np.isin(parts, ("body_upper", "body_lower"))))
+    out = mesh.positions[body] * [1, 1, 0]
+    assert (np.einsum("ij,ij->i", n[body], out) > 0).all()  # normals point out of the body
+
+
+def test_anisotropic_levels_and_splitting_meet_the_tolerance_and_stay_welded():
+    patches, _ = full_teapot()
+    tol = 2e-3
+    # Max Level 6 cannot reach the tolerance on whole patches: patches over it are split (with their neighbours
+    # along the split sides) until it is met
+    r = bp.tessellate(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=6))
+    assert len(r.parent) > len(patches) and len(r.unmet) == 0 and r.deviation.max() <= tol
+    _, counts = edge_uses(r.mesh.triangles)
+    assert counts.max() == 2
+    # every vertex on the teapot at its patch's (u, v), through the parts' boxes
+    uv = r.patch_uv()
+    want = bp.evaluate(patches[r.parent[r.mesh.triangle_patch]], uv[..., 0], uv[..., 1])
+    assert np.abs(want - r.mesh.positions[r.mesh.triangles]).max() < 1e-5
+    # the inside of a patch steps each way on its own: the spout's patches are long and thin
+    whole = bp.tessellate(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+    assert (whole.inner_levels[:, 0] != whole.inner_levels[:, 1]).any() and len(whole.parent) == len(patches)
+    assert whole.deviation.max() <= tol and len(whole.unmet) == 0
+
+
+def test_split_parts_lie_on_their_patches_and_keep_shared_sides():
+    from tessera.kernels.surfaces import patch_split as sp
+
+    patches, _ = full_teapot()
+    h = bp.check_patches(patches)
+    edges = bp.patch_edges(h)
+    rng = np.random.default_rng(0)
+    counts = sp.consistent_counts(rng.integers(1, 4, (len(h), 2)), edges.edge, edges.reversed)
+    parts, parent, box = sp.split_patches(h, counts, edges)
+    assert len(parts) == counts.prod(axis=1).sum()
+    s, t = rng.random((len(parts), 5)), rng.random((len(parts), 5))
+    u = box[:, 0, :1] + s * (box[:, 0, 1:] - box[:, 0, :1])
+    v = box[:, 1, :1] + t * (box[:, 1, 1:] - box[:, 1, :1])
+    assert np.abs(bp.evaluate(parts, s, t) - bp.evaluate(h[parent], u, v)).max() < 1e-12
+    split_edges = bp.patch_edges(parts)
+    mesh = bp.tessellate_patches(parts, np.full(len(split_edges.control), 3), np.full(len(parts), 3), split_edges)
+    _, uses = edge_uses(mesh.triangles)
+    # open sides only where the whole patches had them, each cut into its parts
+    once = np.bincount(edges.edge.ravel(), minlength=len(edges.control)) == 1
+    want = sum(3 * counts[q, sp.SIDE_AXIS[side]] for q in range(len(h)) for side in range(4)
+               if once[edges.edge[q, side]] and not edges.collapsed[edges.edge[q, side]])
+    assert uses.max() == 2 and (uses == 1).sum() == want

@@ -133,9 +133,9 @@ def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_modu
         result = bp.tessellate(ps.patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
         assert len(result.mesh.triangles) == len(tris), label
         dev, patch = lattice_deviation(bp, ps, pos, tris, uv)
-        assert dev[~np.isin(patch, result.unmet)].max() <= tol, label
-        at_max = (result.inner_levels[result.unmet] == 64) | (result.edge_levels[result.edges.edge[result.unmet]]
-                                                              == 64).any(axis=1)
+        assert dev[~np.isin(patch, result.parent[result.unmet])].max() <= tol, label
+        at_max = (result.inner_levels[result.unmet] == 64).any(axis=1) | (
+            result.edge_levels[result.edges.edge[result.unmet]] == 64).any(axis=1)
         assert at_max.all(), label
         unmet += len(result.unmet)
         variants_done += 1
