@@ -163,6 +163,18 @@ class AdaptiveSpline:
     deviation: np.ndarray | None = None
 
 
+def _world_tolerance(control, settings, camera):
+    """The tolerance of TOLERANCE or SCREEN sampling in the curve's units: a number, or (S,) per segment for the
+    screen (control (S, k, 3) the segments' control points)."""
+    if settings.mode == "SCREEN":
+        if camera is None:
+            raise InvalidInputError("Sampling for the screen needs a camera")
+        return pixel_tolerance(control, camera, settings.pixels)
+    if not (np.isfinite(settings.tolerance) and settings.tolerance > 0):
+        raise InvalidInputError("The curve tolerance must be a positive number")
+    return settings.tolerance
+
+
 def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, settings, camera=None):
     """Sample one Bézier spline (control points (n, 3), handles (n, 3), radius and tilt (n,)) by ``settings``
     (`CurveSampling`); camera: a `kernels.common.camera.Camera` in the spline's space, for SCREEN. Returns the
@@ -173,13 +185,8 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
     if settings.mode == "CURVATURE":
         counts = curvature_counts(control, t_max=settings.max_segments)
     else:
-        if settings.mode == "SCREEN":
-            if camera is None:
-                raise InvalidInputError("Sampling for the screen needs a camera")
-            tol = pixel_tolerance(control, camera, settings.pixels)
-        else:
-            tol = settings.tolerance
-        counts = np.minimum(tolerance_counts(control, tol), settings.max_segments)
+        counts = np.minimum(tolerance_counts(control, _world_tolerance(control, settings, camera)),
+                            settings.max_segments)
     s = sample(control, counts, cyclic)
     n = len(np.asarray(co))
     k = (s.segment + 1) % n
@@ -210,15 +217,7 @@ def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None):
             counts = np.ceil(curvature_level(curve_kappa(control), n_control=direction.order, gain=GAIN,
                                              t_max=settings.max_segments)).astype(np.int64)
     else:
-        if settings.mode == "SCREEN":
-            if camera is None:
-                raise InvalidInputError("Sampling for the screen needs a camera")
-            tol = pixel_tolerance(control, camera, settings.pixels)
-        else:
-            tol = settings.tolerance
-            if not (np.isfinite(tol) and tol > 0):
-                raise InvalidInputError("The curve tolerance must be a positive number")
-        counts, deviation = rb.tolerance_steps(geo, tol, settings.max_segments)
+        counts, deviation = rb.tolerance_steps(geo, _world_tolerance(control, settings, camera), settings.max_segments)
     segment = np.repeat(np.arange(len(pieces)), counts)
     first = np.repeat(np.cumsum(counts) - counts, counts)
     t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
