@@ -61,14 +61,6 @@ TOLERANCE_ROUNDS = 16
 #: triangle is largest).
 _B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
                [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
-#: The offsets inside a cell (in cells) of the corners and of `_B`'s points of the cell's two triangles.
-_OFFSETS = np.array([0.0, 1 / 6, 1 / 3, 1 / 2, 2 / 3, 5 / 6, 1.0])
-
-
-def _offset_index(a):
-    return int(np.argmin(np.abs(_OFFSETS - a)))
-
-
 #: With the tolerance, how many times patches still over it at Max Level are split and the whole made again.
 SPLIT_ROUNDS = 3
 #: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
@@ -429,19 +421,22 @@ def grid_deviation(control, inner_levels):
         ps = np.flatnonzero((pair_of.ravel() == q) & ok)
         if len(ps) == 0:
             continue
-        # every sample point of every cell at once: the cells' corners plus offsets a in each direction
+        # the cells' corners (the inner grid) and each sample point of every cell, by offsets a in each
+        # direction: the v basis contracted once per distinct a along v, then the u basis per sample
         cu, cv = np.arange(1, nu - 1), np.arange(1, nv - 1)
-        fu = ((cu[:, None] + _OFFSETS[None]) / nu).ravel()
-        fv = ((cv[:, None] + _OFFSETS[None]) / nv).ravel()
-        dense = cartesian(tensor_grid(bernstein(fu, d), bernstein(fv, d), h[ps]))
-        dense = dense.reshape(len(ps), nv - 2, len(_OFFSETS), nu - 2, len(_OFFSETS), 3)
-        at = {0.0: 0, 1.0: len(_OFFSETS) - 1}
+        corners = cartesian(tensor_grid(bernstein(np.arange(1, nu) / nu, d), bernstein(np.arange(1, nv) / nv, d),
+                                        h[ps]))  # (p, nv - 1, nu - 1, 3)
+        along_v = {}
         for offs in tri_offsets:
-            corner = [dense[:, :, at[dv], :, at[du]] for du, dv in offs]
+            corner = [corners[:, int(dv):int(dv) + nv - 2, int(du):int(du) + nu - 2] for du, dv in offs]
             for bary in _B:
                 lin = sum(w * c for w, c in zip(bary, corner, strict=True))
                 a = bary @ offs
-                on = dense[:, :, _offset_index(a[1]), :, _offset_index(a[0])]
+                key = round(float(a[1]) * 6)
+                if key not in along_v:
+                    along_v[key] = np.tensordot(h[ps], bernstein((cv + a[1]) / nv, d), axes=([2], [1]))
+                on = np.tensordot(along_v[key], bernstein((cu + a[0]) / nu, d), axes=([1], [1]))  # (p, c, V, U)
+                on = cartesian(on.transpose(0, 2, 3, 1))
                 dev = np.linalg.norm(on - lin, axis=-1).reshape(len(ps), -1).max(axis=1)
                 out[ps, 0] = np.maximum(out[ps, 0], dev)
                 if a[1] in (0.0, 1.0):  # on a side of the cell along u
