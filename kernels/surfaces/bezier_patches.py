@@ -656,7 +656,8 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     tris = remap[tris]
     keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
     tris, tri_patch, tri_uv = tris[keep], tri_patch[keep], tri_uv[keep]
-    tri_uv = _pole_corners(tri_uv, edges.collapsed[edges.edge[tri_patch]])
+    if edges.collapsed.any():
+        tri_uv = _pole_corners(tri_uv, edges.collapsed[edges.edge[tri_patch]])
     used = np.zeros(len(positions), bool)
     used[tris.ravel()] = True
     new_id = np.cumsum(used) - 1
