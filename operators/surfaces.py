@@ -291,7 +291,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         budget = get_preferences(context).memory_budget_bytes
         words, warn = [], False
         if surfaces:
-            patch_set = _spline_patches(surfaces)
+            patch_set = nurbs.patches_of([s for _, s in surfaces], [k for k, _ in surfaces])
             result = bp.tessellate(patch_set.patches, lod, cam, budget)
             mesh = result.mesh
             corner_uv = patch_set.uv(result.parent[mesh.triangle_patch][:, None], result.patch_uv())
@@ -329,17 +329,6 @@ def _largest_scale(ob):
     m = np.array(ob.matrix_world, np.float64)[:3, :3]
     s = float(np.linalg.svd(m, compute_uv=False).max()) if np.all(np.isfinite(m)) else 0.0
     return s if s > 0 else 1.0
-
-
-def _spline_patches(surfaces):
-    """A `PatchSet` of (index, SurfaceSpline) pairs; a refusal names the spline in Blender's list."""
-    try:
-        return nurbs.patches_of([s for _, s in surfaces])
-    except InvalidInputError as err:
-        message = str(err)
-        for i, (k, _) in enumerate(surfaces):
-            message = message.replace(f"surface spline {i} ", f"surface spline {k} ")
-        raise InvalidInputError(message) from None
 
 
 def _row_lines(rows, tolerance):

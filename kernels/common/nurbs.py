@@ -258,15 +258,18 @@ class PatchSet:
         return b[..., 0] + np.asarray(st, np.float64) * (b[..., 1] - b[..., 0])
 
 
-def patches_of(splines):
+def patches_of(splines, numbers=None):
     """Every `SurfaceSpline`'s rational Bézier patches, raised to one degree: a `PatchSet`. Raising a degree moves
     no point of the surface, and the sides that patches of one spline share stay bitwise equal (the same numbers go
-    through the same steps)."""
+    through the same steps). numbers: how a refusal names each spline (its place in Blender's list; by default
+    its place in ``splines``)."""
     if not splines:
         raise InvalidInputError("There is no surface spline to tessellate")
+    numbers = range(len(splines)) if numbers is None else numbers
     parts, owner, boxes = [], [], []
     for i, sp in enumerate(splines):
-        patches, (su, sv), span_u, span_v = surface_patches(sp.points, sp.u, sp.v, what=f"surface spline {i}")
+        patches, (su, sv), span_u, span_v = surface_patches(sp.points, sp.u, sp.v,
+                                                            what=f"surface spline {numbers[i]}")
         parts.append(patches)
         owner.append(np.full(len(patches), i, np.int64))
         nu = (span_u - span_u[0, 0]) / (span_u[-1, 1] - span_u[0, 0])

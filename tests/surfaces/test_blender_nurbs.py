@@ -377,3 +377,18 @@ def test_the_tolerance_is_in_scene_units(clean_scene, bpy_module):
         assert bpy.ops.tessera.surface_tessellate(metrics={"TOLERANCE"}, tolerance=tol, max_level=64) == {"FINISHED"}
         counts.append(len(bpy.context.active_object.data.polygons))
     assert counts[0] == counts[1]
+
+
+def test_a_bad_spline_is_named_by_its_place_in_blenders_list(clean_scene, bpy_module):
+    bpy = bpy_module
+    ob = add_primitive(bpy, "curve")  # spline 0: a single row (a curve), spline 1: a surface with a bad weight
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.surface.primitive_nurbs_surface_surface_add()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    assert len(ob.data.splines) == 2
+    ob.data.splines[1].points[5].co[3] = -1.0
+    bpy.context.view_layer.objects.active = ob
+    before = len(bpy.data.objects), len(bpy.data.meshes)
+    with pytest.raises(RuntimeError, match="surface spline 1 has weights of zero or less"):
+        bpy.ops.tessera.surface_tessellate()
+    assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
