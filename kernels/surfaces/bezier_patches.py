@@ -117,10 +117,11 @@ class PatchEdges:
 
 @dataclass
 class PatchMesh:
-    """positions (V, 3) float32; triangles (T, 3) int32 (counter-clockwise in each patch's (u, v)); uv (V, 2)
-    float32 and patch (V,) int64: where each vertex was evaluated (a shared vertex: its first patch);
-    triangle_patch (T,) int64 and corner_uv (T, 3, 2) float32: each triangle's patch and its corners' (u, v) in it;
-    normals (V, 3) float32: the surface's unit normal at each vertex (along dS/du x dS/dv)."""
+    """positions (V, 3) float32; triangles (T, 3) int32; uv (V, 2) float32 and patch (V,) int64: where each vertex
+    was evaluated (a shared vertex: its first patch); triangle_patch (T,) int64 and corner_uv (T, 3, 2) float32:
+    each triangle's patch and its corners' (u, v) in it; normals (V, 3) float32: the surface's unit normal at each
+    vertex. Oriented as Blender orients a NURBS surface's faces (its primitives face out): the normal along
+    dS/dv x dS/du, the triangles clockwise in (u, v) (counter-clockwise seen from the normal's side)."""
 
     positions: np.ndarray
     triangles: np.ndarray
@@ -674,9 +675,10 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     np.add.at(summed, remap, normals)
     length = np.linalg.norm(summed, axis=1, keepdims=True)
     normals = np.where(length > 0, summed / np.where(length > 0, length, 1.0), normals)
-    return PatchMesh(positions[used].astype(np.float32), new_id[tris].astype(np.int32),
-                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv.astype(np.float32),
-                     normals[used].astype(np.float32))
+    # Blender's orientation: the pattern's counter-clockwise (u, v) triangles reversed, the normals along dS/dv x dS/du
+    return PatchMesh(positions[used].astype(np.float32), new_id[tris[:, ::-1]].astype(np.int32),
+                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv[:, ::-1].astype(np.float32),
+                     -normals[used].astype(np.float32))
 
 
 def _pole_corners(tri_uv, collapsed):

@@ -94,8 +94,8 @@ _PATCHES = """
 
 
 def teapot_patches():
-    """(32, 4, 4, 3) float64 control nets and each patch's part (32,). net[i, j] is point i of row j of the patch's
-    16 numbers (the table's rows run along v), so dS/du x dS/dv points out of the teapot."""
+    """(32, 4, 4, 3) float64 control nets (net[i, j]: row i of the patch's 16 numbers, column j) and each patch's
+    part (32,). In Blender's orientation of surfaces (faces along dS/dv x dS/du) the teapot faces out."""
     points = np.array([[float(c) for c in p.split(",")] for p in _POINTS.split()], np.float64)
     index = np.array([int(i) for i in _PATCHES.split()], np.int64).reshape(32, 4, 4) - 1
-    return points[index].transpose(0, 2, 1, 3), np.repeat(np.array(PARTS), 4)
+    return points[index], np.repeat(np.array(PARTS), 4)

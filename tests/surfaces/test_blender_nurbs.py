@@ -392,3 +392,24 @@ def test_a_bad_spline_is_named_by_its_place_in_blenders_list(clean_scene, bpy_mo
     with pytest.raises(RuntimeError, match="surface spline 1 has weights of zero or less"):
         bpy.ops.tessera.surface_tessellate()
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+
+
+def test_normals_and_uvs_come_from_the_surface(clean_scene, bpy_module):
+    """On Blender's NURBS sphere (radius 1 at the origin) every corner's normal is its position's direction, poles
+    included, and the UVs are the spline's parameters: U from pole to pole, V once around."""
+    bpy = bpy_module
+    add_primitive(bpy, "sphere")
+    assert bpy.ops.tessera.surface_tessellate(metrics={"TOLERANCE"}, tolerance=1e-3) == {"FINISHED"}
+    me = bpy.context.active_object.data
+    pos, tris, _, uv, _ = read_mesh(me)
+    normals = np.array([n.vector[:] for n in me.corner_normals], np.float64).reshape(-1, 3, 3)
+    radial = pos[tris] / np.linalg.norm(pos[tris], axis=-1, keepdims=True)
+    assert np.einsum("tci,tci->tc", normals, radial).min() > 0.9999
+    faces = np.array([p.normal[:] for p in me.polygons], np.float64)  # the faces wind as Blender's own face: out
+    assert (np.einsum("ti,ti->t", faces, radial.mean(axis=1)) > 0).all()
+    assert uv.min() >= 0.0 and uv.max() <= 1.0
+    assert np.isclose(uv[..., 0].min(), 0.0) and np.isclose(uv[..., 0].max(), 1.0)
+    assert np.isclose(uv[..., 1].min(), 0.0) and np.isclose(uv[..., 1].max(), 1.0)
+    # U runs from pole to pole (the sphere's axis is z): U and z agree in order
+    z = pos[tris][..., 2].ravel()
+    assert abs(np.corrcoef(uv[..., 0].ravel(), z)[0, 1]) > 0.95
