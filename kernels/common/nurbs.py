@@ -205,20 +205,6 @@ def surface_patches(points, u, v, what="surface"):
     return patches, (su, sv), span_u, span_v
 
 
-def deboor_point(points_h, knots, order, x):
-    """One point of a B-spline at parameter x by de Boor's algorithm (a reference for tests and checks):
-    points_h (m, d) homogeneous, knots (m + order,) -> (d,)."""
-    t = np.asarray(knots, np.float64)
-    c = np.asarray(points_h, np.float64)
-    p = order - 1
-    i = int(np.clip(np.searchsorted(t, x, side="right") - 1, p, len(c) - 1))
-    d = c[i - p:i + 1].copy()
-    for level in range(1, p + 1):
-        for j in range(p, level - 1, -1):
-            lo, hi = t[i - p + j], t[i + 1 + j - level]
-            alpha = (x - lo) / (hi - lo)
-            d[j] = (1.0 - alpha) * d[j - 1] + alpha * d[j]
-    return d[p]
 
 
 def degree_elevate(pieces, degree):

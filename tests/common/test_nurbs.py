@@ -162,3 +162,20 @@ def test_tolerance_steps_meet_the_tolerance_measured_densely():
         if tol == 1e-4:  # and not far over what is needed: one step fewer would be over
             fewer = rb.chord_deviation(pieces, np.maximum(steps - 1, 1))
             assert (fewer[steps > 1] > 0.5 * tol).all()
+
+
+def test_custom_knots_are_taken_as_given_and_checked():
+    rng = np.random.default_rng(2)
+    co = np.c_[rng.normal(size=(7, 3)), rng.uniform(0.5, 2.0, 7)]
+    blender = nb.Direction(4, "ENDPOINT")
+    knots = nb.blender_knots(7, 4, "ENDPOINT", False)
+    same, _ = nb.curve_pieces(co, nb.Direction(4, "CUSTOM", knots=tuple(knots)))
+    assert np.array_equal(same, nb.curve_pieces(co, blender)[0])
+    uneven = knots.copy()
+    uneven[4:7] = [0.5, 2.5, 2.75]  # inner knots moved: other pieces, the same curve ends
+    pieces, span = nb.curve_pieces(co, nb.Direction(4, "CUSTOM", knots=tuple(uneven)))
+    assert np.allclose(span[:, 0], [0, 0.5, 2.5, 2.75]) and np.array_equal(pieces[0, 0], same[0, 0])
+    with pytest.raises(InvalidInputError, match="non-decreasing"):
+        nb.curve_pieces(co, nb.Direction(4, "CUSTOM", knots=tuple(knots[::-1])))
+    with pytest.raises(InvalidInputError, match="must be 11"):
+        nb.curve_pieces(co, nb.Direction(4, "CUSTOM", knots=tuple(knots[:-1])))
