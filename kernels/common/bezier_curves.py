@@ -98,17 +98,25 @@ def evaluate(control, t):
             + t ** 3 * c[:, None, 3])
 
 
+def steps(counts, cyclic):
+    """Where a spline of segments split into counts (S,) equal steps is sampled: (segment (n,) int64, t (n,)
+    float64); each segment from its start, the last end point once more unless the spline is cyclic."""
+    counts = np.asarray(counts, np.int64)
+    segment = np.repeat(np.arange(len(counts)), counts)
+    first = np.repeat(np.cumsum(counts) - counts, counts)
+    t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
+    if not cyclic:
+        segment, t = np.append(segment, len(counts) - 1), np.append(t, 1.0)
+    return segment, t
+
+
 def sample(control, counts, cyclic):
     """A `SampledSpline`: segment i split into counts[i] equal steps of t; shared ends written once."""
     c = np.asarray(control, np.float64)
     counts = np.asarray(counts, np.int64)
     if len(c) == 0:
         return SampledSpline(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0), counts, bool(cyclic))
-    segment = np.repeat(np.arange(len(c)), counts)
-    first = np.repeat(np.cumsum(counts) - counts, counts)
-    t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
-    if not cyclic:  # the last end point
-        segment, t = np.append(segment, len(c) - 1), np.append(t, 1.0)
+    segment, t = steps(counts, cyclic)
     points = evaluate(c[segment], t[:, None])[:, 0]
     if not cyclic:
         points[-1] = c[-1, 3]
@@ -218,11 +226,7 @@ def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None):
                                              t_max=settings.max_segments)).astype(np.int64)
     else:
         counts, deviation = rb.tolerance_steps(geo, _world_tolerance(control, settings, camera), settings.max_segments)
-    segment = np.repeat(np.arange(len(pieces)), counts)
-    first = np.repeat(np.cumsum(counts) - counts, counts)
-    t = (np.arange(len(segment)) - first) / np.repeat(counts, counts)
-    if not direction.cyclic:  # the last end point
-        segment, t = np.append(segment, len(pieces) - 1), np.append(t, 1.0)
+    segment, t = steps(counts, direction.cyclic)
     h = np.einsum("nk,nkc->nc", rb.bernstein(t, direction.order - 1), pieces[segment])
     h[t == 0] = pieces[segment[t == 0], 0]  # piece ends exactly (shared by the pieces that meet there)
     if not direction.cyclic:

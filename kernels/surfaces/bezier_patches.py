@@ -300,22 +300,15 @@ def _polygon_length(points):
 
 
 def _direction_deviation(h, steps=16, lines=9):
-    """How far each patch's iso-lines stray from their chords at ``steps`` equal steps: along u (``lines`` lines of
-    constant v) and along v, measured at each chord's quarter points: (P, 2) float64."""
-    d = h.shape[1] - 1
-    fine = np.arange(4 * steps + 1) / (4 * steps)
-    across = np.linspace(0.0, 1.0, lines)
-    b_f, b_a = bernstein(fine, d), bernstein(across, d)
-    out = np.empty((len(h), 2))
-    for axis in (0, 1):
-        pts = cartesian(tensor_grid(b_f, b_a, h) if axis == 0 else
-                        tensor_grid(b_a, b_f, h).transpose(0, 2, 1, 3))  # (P, lines, 4 steps + 1, 3)
-        ends = pts[:, :, ::4]
-        frac = np.array([0.25, 0.5, 0.75])
-        chord = ends[:, :, :-1, None] + frac[None, None, None, :, None] * (ends[:, :, 1:, None] - ends[:, :, :-1, None])
-        mid = np.stack([pts[:, :, k::4][:, :, :steps] for k in (1, 2, 3)], axis=3)
-        out[:, axis] = np.linalg.norm(mid - chord, axis=-1).reshape(len(h), -1).max(axis=1)
-    return out
+    """How far each patch's iso-lines stray from their chords at ``steps`` equal steps
+    (`kernels.common.rational_bezier.chord_deviation`): along u (``lines`` lines of constant v) and along v:
+    (P, 2) float64."""
+    k = h.shape[1]
+    b = bernstein(np.linspace(0.0, 1.0, lines), k - 1)  # (lines, k)
+    along_u = np.einsum("aj,pijc->paic", b, h)  # the iso-lines' control points (P, lines, k, 4)
+    along_v = np.einsum("ai,pijc->pajc", b, h)
+    return np.stack([chord_deviation(c.reshape(-1, k, 4), steps).reshape(len(h), lines).max(axis=1)
+                     for c in (along_u, along_v)], axis=1)
 
 
 def patch_levels(control, edges, lod, camera=None):
