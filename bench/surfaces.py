@@ -155,15 +155,8 @@ def blender_deviation(mod, surface, me):
                     tp[:, 0] == tp[:, 2], 1)
                 on_mesh = np.einsum("sc,tcd->tsd", BARY, tp)
                 at = np.einsum("sc,tcd->tsd", BARY, tuv)
-                box = ps.box
-                q = np.zeros(at.shape[:2], np.int64)
-                for k in range(len(box)):
-                    inside = ((box[k, 0, 0] <= at[..., 0] + 1e-12) & (at[..., 0] <= box[k, 0, 1] + 1e-12)
-                              & (box[k, 1, 0] <= at[..., 1] + 1e-12) & (at[..., 1] <= box[k, 1, 1] + 1e-12))
-                    q = np.where(inside, k, q)
-                b0 = box[q]
-                local = (at - b0[..., 0]) / (b0[..., 1] - b0[..., 0])
-                on = bp.evaluate(ps.patches[q.ravel()], local[..., 0].reshape(-1, 1), local[..., 1].reshape(-1, 1))
+                q, local = ps.locate(at.reshape(-1, 2))
+                on = bp.evaluate(ps.patches[q], local[:, :1], local[:, 1:])
                 d = np.linalg.norm(on.reshape(on_mesh.shape) - on_mesh, axis=-1).max(axis=1)
                 dev = np.maximum(dev, np.where(flat, 0.0, d))
             best = np.minimum(best, dev)

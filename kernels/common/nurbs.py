@@ -243,6 +243,19 @@ class PatchSet:
         b = self.box[patch]
         return b[..., 0] + np.asarray(st, np.float64) * (b[..., 1] - b[..., 0])
 
+    def locate(self, uv, spline=0):
+        """Which patch of a spline holds each of its (u, v) in [0, 1] (N, 2), and where in it: (patch (N,) int64,
+        st (N, 2) float64). A (u, v) on a border between patches goes to the later one (the last at 1)."""
+        q = np.flatnonzero(self.spline == spline)
+        b = self.box[q]
+        u0, v0 = np.unique(b[:, 0, 0]), np.unique(b[:, 1, 0])
+        uv = np.asarray(uv, np.float64)
+        iu = np.clip(np.searchsorted(u0, uv[:, 0], side="right") - 1, 0, len(u0) - 1)
+        iv = np.clip(np.searchsorted(v0, uv[:, 1], side="right") - 1, 0, len(v0) - 1)
+        patch = q[iu * len(v0) + iv]  # a spline's patches run u-major
+        lo, hi = self.box[patch, :, 0], self.box[patch, :, 1]
+        return patch, (uv - lo) / (hi - lo)
+
 
 def patches_of(splines, numbers=None):
     """Every `SurfaceSpline`'s rational Bézier patches, raised to one degree: a `PatchSet`. Raising a degree moves

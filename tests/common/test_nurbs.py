@@ -122,6 +122,11 @@ def test_splines_of_mixed_orders_become_patches_of_one_degree_on_the_same_surfac
                                               [2 / 3, 1]])
     assert np.allclose(ps.box[owner == 0, 1], [[0, .5], [.5, 1]] * 3)
     assert np.allclose(ps.uv(np.array([0, 5]), np.array([[.5, .5], [1, 1]])), [[1 / 6, .25], [1, 1]])
+    # and back: any (u, v) of spline 1 to its patch and the place in it, borders and ends included
+    uv = np.concatenate([rng.random((50, 2)), [[0, 0], [1, 1], [0.5, 1], [1, 0.25]]])
+    patch, st = ps.locate(uv, spline=1)
+    assert (owner[patch] == 1).all() and (st >= -1e-12).all() and (st <= 1 + 1e-12).all()
+    assert np.allclose(ps.uv(patch, st), uv)
     first = nb.surface_patches(a.points, a.u, a.v)[0]
     for f in (0.0, 0.37, 1.0):
         for g in (0.0, 0.5, 0.9):

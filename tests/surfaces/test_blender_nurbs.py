@@ -191,13 +191,8 @@ def lattice_deviation(bp, patch_set, pos, tris, uv, steps=6):
     bary = np.stack([a[keep], b[keep], steps - a[keep] - b[keep]], 1) / steps
     on_mesh = np.einsum("sc,tcd->tsd", bary, pos[tris])
     at = np.einsum("sc,tcd->tsd", bary, uv.astype(np.float64)).reshape(-1, 2)
-    # which patch: the one whose box holds the triangle's centre
-    centre = uv.astype(np.float64).mean(axis=1)
-    box = patch_set.box
-    inside = ((box[None, :, 0, 0] <= centre[:, None, 0] + 1e-9) & (centre[:, None, 0] <= box[None, :, 0, 1] + 1e-9)
-              & (box[None, :, 1, 0] <= centre[:, None, 1] + 1e-9) & (centre[:, None, 1] <= box[None, :, 1, 1] + 1e-9))
-    patch = inside.argmax(axis=1)
-    b0 = box[patch]
+    patch, _ = patch_set.locate(uv.astype(np.float64).mean(axis=1))  # the patch that holds the triangle's centre
+    b0 = patch_set.box[patch]
     local = (at.reshape(len(tris), -1, 2) - b0[:, None, :, 0]) / (b0[:, None, :, 1] - b0[:, None, :, 0])
     s = bp.evaluate(patch_set.patches[patch], np.clip(local[..., 0], 0, 1), np.clip(local[..., 1], 0, 1))
     return np.linalg.norm(on_mesh - s, axis=-1).max(axis=1), patch
@@ -227,13 +222,8 @@ def test_blenders_own_conversion_lies_on_the_same_surface(clean_scene, bpy_modul
     fu = np.linspace(0, 1, n_u + u.cyclic)[:n_u]
     fv = np.linspace(0, 1, n_v + v.cyclic)[:n_v]
     uu, vv = (a.ravel() for a in np.meshgrid(fu, fv, indexing="ij"))  # v fastest, as Blender lists them
-    box = ps.box
-    patch = np.array([np.flatnonzero((box[:, 0, 0] <= a + 1e-12) & (a <= box[:, 0, 1] + 1e-12)
-                                     & (box[:, 1, 0] <= b + 1e-12) & (b <= box[:, 1, 1] + 1e-12))[0]
-                      for a, b in zip(uu, vv, strict=True)])
-    b0 = box[patch]
-    su = (uu - b0[:, 0, 0]) / (b0[:, 0, 1] - b0[:, 0, 0])
-    sv = (vv - b0[:, 1, 0]) / (b0[:, 1, 1] - b0[:, 1, 0])
+    patch, st = ps.locate(np.stack([uu, vv], 1))
+    su, sv = st[:, 0], st[:, 1]
     mine = bp.evaluate(ps.patches[patch], su[:, None], sv[:, None])[:, 0]
     assert len(mine) == len(blender)
     assert np.abs(mine - blender).max() < 1e-5 * np.abs(blender).max()
