@@ -107,14 +107,6 @@ BARY = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [
                  [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
 
 
-def _spline_direction(nurbs, s):
-    u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
-    v = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v), s.use_cyclic_v)
-    co = np.array([p.co[:] for p in s.points], np.float32).astype(np.float64).reshape(s.point_count_v,
-                                                                                      s.point_count_u, 4)
-    return nurbs.SurfaceSpline(co, u, v)
-
-
 def blender_deviation(mod, surface, me):
     """The largest distance between Blender's conversion of ``surface`` and the surface, measured as Tessera's
     meshes are (each triangle at 7 barycentric points against the surface at the same point of its corners'
@@ -123,8 +115,8 @@ def blender_deviation(mod, surface, me):
     nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
     pos = np.array([v.co[:] for v in me.vertices], np.float64)
     worst, start = 0.0, 0
-    for s in surface.data.splines:
-        spline = _spline_direction(nurbs, s)
+    surfaces, _ = mod("addon.curve_bridge").read_surface_splines(surface.data)
+    for (_, spline), s in zip(surfaces, surface.data.splines, strict=True):
         ps = nurbs.patches_of([spline])
         n_u, n_v = s.resolution_u * s.point_count_u, s.resolution_v * s.point_count_v
         cu, cv = s.use_cyclic_u, s.use_cyclic_v
@@ -198,7 +190,8 @@ def run_tessellate_surface(bpy, mod, name, make):
 
     n_ours = ours()
     nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
-    result = bp.tessellate(nurbs.patches_of([_spline_direction(nurbs, s) for s in surface.data.splines]).patches,
+    surfaces, _ = mod("addon.curve_bridge").read_surface_splines(surface.data)
+    result = bp.tessellate(nurbs.patches_of([s for _, s in surfaces]).patches,
                            bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
     ours_dev = float(result.deviation.max())
     res, dev = 0, np.inf

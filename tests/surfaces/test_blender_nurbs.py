@@ -35,12 +35,8 @@ def read_mesh(me):
 
 
 def reference(nurbs, spline):
-    """geomdl's surface of a Blender spline (its knots and wrapped points) and the spline's domain."""
-    s = spline
-    u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
-    v = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v), s.use_cyclic_v)
-    co = np.array([p.co[:] for p in s.points], np.float32).astype(np.float64).reshape(s.point_count_v,
-                                                                                      s.point_count_u, 4)
+    """geomdl's surface of a `SurfaceSpline` (its knots and wrapped points) and the spline's domain."""
+    co, u, v = spline.points, spline.u, spline.v
     wrapped = nurbs.wrap_cyclic(nurbs.wrap_cyclic(co, u.order, u.cyclic, axis=1), v.order, v.cyclic, axis=0)
     ku, kv = nurbs.direction_knots(co.shape[1], u), nurbs.direction_knots(co.shape[0], v)
     ref = NURBS.Surface()
@@ -83,6 +79,7 @@ def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_modu
     bpy = bpy_module
     nurbs = addon_module("kernels.common.nurbs")
     bp = addon_module("kernels.surfaces.bezier_patches")
+    curve_bridge = addon_module("addon.curve_bridge")
     rng = np.random.default_rng(len(name))
     source = add_primitive(bpy, name)
     unmet, variants_done = 0, 0
@@ -108,7 +105,8 @@ def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_modu
             assert gap.max() <= tol, label
             variants_done += 1
             continue
-        ref, ku, kv, dom_u, dom_v, (u, v, co) = reference(nurbs, spline)
+        [(_, read)], _ = curve_bridge.read_surface_splines(source.data)
+        ref, ku, kv, dom_u, dom_v, (u, v, co) = reference(nurbs, read)
         # every vertex on the surface, at its UV, by an independent evaluator
         pick = rng.choice(3 * len(tris), min(3000, 3 * len(tris)), replace=False)  # geomdl is pure Python
         corner_pos = pos[tris].reshape(-1, 3)[pick]
@@ -215,9 +213,9 @@ def test_blenders_own_conversion_lies_on_the_same_surface(clean_scene, bpy_modul
     me = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
     blender = np.array([v.co[:] for v in me.vertices], np.float64)
     ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh_clear()
-    u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), s.use_cyclic_u)
-    v = nurbs.Direction(s.order_v, nurbs.knot_mode(s.use_endpoint_v, s.use_bezier_v), s.use_cyclic_v)
-    ps = nurbs.patches_of([nurbs.SurfaceSpline(co_of(s).reshape(s.point_count_v, s.point_count_u, 4), u, v)])
+    [(_, spline)], _ = addon_module("addon.curve_bridge").read_surface_splines(ob.data)
+    u, v = spline.u, spline.v
+    ps = nurbs.patches_of([spline])
     n_u, n_v = s.resolution_u * s.point_count_u, s.resolution_v * s.point_count_v
     fu = np.linspace(0, 1, n_u + u.cyclic)[:n_u]
     fv = np.linspace(0, 1, n_v + v.cyclic)[:n_v]
