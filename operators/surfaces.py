@@ -165,11 +165,8 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
                 made = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic,
                                        settings, camera)
             elif sp.kind == "NURBS":
-                try:
-                    made = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic),
-                                          sp.radius, sp.tilt, settings, camera)
-                except InvalidInputError as err:
-                    raise InvalidInputError(str(err).replace("The NURBS spline", f"NURBS spline {k}")) from None
+                made = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic), sp.radius,
+                                      sp.tilt, settings, camera, what=f"NURBS spline {k}")
             else:
                 offset = np.asarray(settings.offset, np.float64)
                 for c in range(settings.copies):
@@ -180,10 +177,8 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
                 out.append(curve_bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
                                                      sp.material_index))
             counts.append(made[0].counts)
-            if made[0].deviation is not None:
-                tol = settings.tolerance if settings.mode == "TOLERANCE" else None
-                if tol is not None:
-                    over += int((made[0].deviation > tol).sum())
+            if made[0].deviation is not None and settings.mode == "TOLERANCE":
+                over += int((made[0].deviation > settings.tolerance).sum())
         if not out:
             raise InvalidInputError(f"Curve {ob.name!r} has no spline to sample: add one, or select another curve")
         data = tx.track(curve_bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
@@ -338,10 +333,8 @@ def _row_lines(rows, tolerance):
     sampling = CurveSampling(mode="TOLERANCE", tolerance=tolerance, max_segments=MAX_TOLERANCE_SEGMENTS)
     for k, co, direction in rows:
         n = len(co)
-        try:
-            [a] = adaptive_nurbs(co[:, :3], co[:, 3], direction, np.ones(n), np.zeros(n), sampling)
-        except InvalidInputError as err:
-            raise InvalidInputError(str(err).replace("The NURBS spline", f"Surface spline {k}")) from None
+        [a] = adaptive_nurbs(co[:, :3], co[:, 3], direction, np.ones(n), np.zeros(n), sampling,
+                             what=f"surface spline {k}")
         m = len(a.points)
         idx = base + np.arange(m)
         pairs = np.stack([idx[:-1], idx[1:]], 1)

@@ -208,13 +208,14 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
                                                                                      settings.offset)]
 
 
-def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None):
+def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, what="NURBS spline"):
     """Sample one NURBS spline (points (n, 3), weights (n,), a `kernels.common.nurbs.Direction`, radius and tilt
     (n,)) by ``settings`` (`CurveSampling`), through its exact rational Bézier pieces. CURVATURE: eq. 4.5 on each
     piece's control polygon (a straight piece of order 2: one step); TOLERANCE and SCREEN: steps measured to meet the
-    tolerance (up to Max Segments; the deviation left is in the result). Returns the `AdaptiveSpline` of each copy."""
+    tolerance (up to Max Segments; the deviation left is in the result). what: how a refusal names the spline.
+    Returns the `AdaptiveSpline` of each copy."""
     pts = np.c_[np.asarray(co, np.float64).reshape(-1, 3), np.asarray(weight, np.float64).reshape(-1)]
-    pieces, _ = nurbs.curve_pieces(pts, direction, np.c_[radius, tilt], what="NURBS spline")
+    pieces, _ = nurbs.curve_pieces(pts, direction, np.c_[radius, tilt], what=what)
     geo = pieces[..., :4]
     control = rb.cartesian(geo)
     deviation = None
