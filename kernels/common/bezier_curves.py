@@ -94,8 +94,8 @@ def evaluate(control, t):
     c = np.asarray(control, np.float64)
     t = np.asarray(t, np.float64)[..., None]
     s = 1.0 - t
-    return (s ** 3 * c[:, None, 0] + 3 * s * s * t * c[:, None, 1] + 3 * s * t * t * c[:, None, 2]
-            + t ** 3 * c[:, None, 3])
+    return (s * s * s * c[:, None, 0] + 3 * s * s * t * c[:, None, 1] + 3 * s * t * t * c[:, None, 2]
+            + t * t * t * c[:, None, 3])
 
 
 def steps(counts, cyclic):

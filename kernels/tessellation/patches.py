@@ -61,7 +61,7 @@ def cubic_basis(bary):
     b0, b1, b2 = _corners(bary)
     out = np.empty((10, len(b0)))  # filled by rows and returned transposed: each column is one flat run
     for row, x in zip(out[:3], (b0, b1, b2), strict=True):
-        np.power(x, 3, out=row)
+        _product(row, x, x, x)  # products, not pow: pow's SIMD paths round differently per CPU
     # Left to right as written, ``3 * b0 * b0 * b1`` is ((3 b0) b0) b1: the shared leading products are the same
     # roundings, so each column has the bits of its expression evaluated alone.
     three0, three1 = 3 * b0, 3 * b1
@@ -93,7 +93,7 @@ def cubic_edge_basis(t):
     """(P,) parameters -> (P, 4) float64 for the Bézier controls ``[a, near a, near b, b]``."""
     t = np.asarray(t, dtype=np.float64)
     s = 1.0 - t
-    return np.stack([s ** 3, 3 * s * s * t, 3 * s * t * t, t ** 3], axis=1)
+    return np.stack([s * s * s, 3 * s * s * t, 3 * s * t * t, t * t * t], axis=1)
 
 
 def _dot(a, b):
