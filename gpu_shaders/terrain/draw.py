@@ -23,7 +23,7 @@ def _describe():
     info = shaded_create_info("terrain", "partition.glsl", "terrain/terrain_vert.glsl")
     info.push_constant("VEC4", "edge_counts")
     info.push_constant("FLOAT", "inner_count")
-    info.push_constant("VEC3", "grid")
+    info.push_constant("VEC4", "grid")
     info.push_constant("FLOAT", "height_stride")
     info.push_constant("INT", "tex_width")
     info.push_constant("INT", "fractional")
@@ -79,7 +79,7 @@ class TerrainDrawData:
         shader = loader.shader("terrain_preview", _describe)
         set_shading(shader, view_projection, color, lit)
         hm = self.hm
-        shader.uniform_float("grid", ((hm.width - 1) * 0.5, (hm.height - 1) * 0.5, hm.texel_size))
+        shader.uniform_float("grid", ((hm.width - 1) * 0.5, (hm.height - 1) * 0.5, *hm.texel))
         shader.uniform_float("height_stride", float(self.stride))
         shader.uniform_int("tex_width", TEX_WIDTH)
         shader.uniform_int("fractional", 1 if self.fractional else 0)

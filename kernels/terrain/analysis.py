@@ -25,6 +25,9 @@ from ..common.opencl_runtime import backend_runtime
 
 #: HAM rows at the border of an edit that change: the two Sobel passes each reach one sample.
 HAM_REACH = 2
+#: A map read from disk (memory-mapped, or block by block) goes to the device whole only up to this many bytes of
+#: float32; larger ones stay in bands on the host, so the analysis of any size keeps its memory bound.
+OUT_OF_CORE_DEVICE_BYTES = 64 * 2**20
 
 
 def tile_counts(width, height, tile_size):
@@ -123,7 +126,7 @@ def _windows(band, tile_size, count, fill):
 def _analyse(table, hm, ty0, ty1, tx0, tx1, progress=None):
     """Fill tiles rows ``[ty0, ty1)``, columns ``[tx0, tx1)`` of ``table`` from height map ``hm``."""
     ts, (n_rows, width) = table.tile_size, table.shape
-    inv_texel = np.float32(1.0 / hm.texel_size)
+    inv_texel = np.float32(1.0 / hm.mean_texel)
     c0, c1 = tx0 * ts, min(width, tx1 * ts + 1)
     for ty in range(ty0, ty1):
         y0, y1 = (int(v) for v in tile_bounds(ty, ts, n_rows))
@@ -154,7 +157,8 @@ def tile_table(hm, tile_size=64, backend="auto", progress=None):
 
     numpy works band by band (one tile row at a time, bounded memory: memory-mapped maps of any size);
     OpenCL (``backend="opencl"`` or "auto" with a device) analyses the whole map on the device when it fits
-    in memory as float32. ``progress(done, total)`` is called after each band.
+    in memory as float32 (a map read from disk only up to `OUT_OF_CORE_DEVICE_BYTES`). ``progress(done, total)``
+    is called after each band.
     """
     table = TileTable.empty((hm.height, hm.width), tile_size)
     runtime = backend_runtime(backend, "the terrain analysis")
@@ -172,6 +176,8 @@ def tile_table(hm, tile_size=64, backend="auto", progress=None):
 
 def _fits_device(runtime, hm):
     need = hm.width * hm.height * 4 * 3  # heights, M, HAM as float32
+    if not hm.in_memory and need > 3 * OUT_OF_CORE_DEVICE_BYTES:
+        return False
     return need <= min(runtime.device.max_mem_alloc_size * 3, runtime.device.global_mem_size // 2)
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from ..common.errors import InvalidInputError, TesseraError
 from ..common.image_io import read_pixels
 from ..common.limits import MAX_WORLD_VALUE
+from .sample_grid import SampleGrid
 
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".exr")
 RAW_TYPES = {".r16": np.dtype("<u2"), ".raw": np.dtype("<u2"), ".r32": np.dtype("<f4")}
@@ -33,8 +34,10 @@ SCAN_ROWS = 1024
 class HeightMap:
     """Height samples and their world scale.
 
-    samples: (H, W) uint8, uint16 or float32 (may be a read-only memory map); row 0 at the bottom.
-    texel_size: world distance between neighbouring samples (> 0). scale, offset: see the module docstring.
+    samples: (H, W) uint8, uint16 or float32 (may be a read-only memory map, or a `sample_grid.SampleGrid` read
+    block by block: a GeoTIFF, its voids filled); row 0 at the bottom.
+    texel_size: world distance between neighbouring samples along x (> 0); texel_size_y: along y (0: the same;
+    geographic data has longer rows than columns away from the equator). scale, offset: see the module docstring.
     """
 
     samples: np.ndarray
@@ -42,20 +45,45 @@ class HeightMap:
     scale: float = 1.0
     offset: float = 0.0
     source: str = ""
+    texel_size_y: float = 0.0
 
     def __post_init__(self):
         s = self.samples
-        if not isinstance(s, np.ndarray) or s.ndim != 2 or s.dtype not in (np.uint8, np.uint16, np.float32):
+        if not isinstance(s, np.ndarray | SampleGrid) or s.ndim != 2 or s.dtype not in (np.uint8, np.uint16,
+                                                                                        np.float32):
             raise InvalidInputError("Height samples must be a 2-D uint8, uint16 or float32 array")
         if min(s.shape) < 2:
             raise InvalidInputError(f"A height map needs at least 2x2 samples; got {s.shape[1]}x{s.shape[0]}")
-        for name, label in (("texel_size", "Texel Size"), ("scale", "Height Scale"), ("offset", "Height Offset")):
+        for name, label in (("texel_size", "Texel Size"), ("texel_size_y", "Texel Size Y"),
+                            ("scale", "Height Scale"), ("offset", "Height Offset")):
             value = getattr(self, name)
             if not (np.isfinite(value) and abs(value) <= MAX_WORLD_VALUE):
                 raise InvalidInputError(f"{label} must be a finite number between {-MAX_WORLD_VALUE:g} and "
                                         f"{MAX_WORLD_VALUE:g}; got {value!r}")
-        if not self.texel_size > 0:
+        if not (self.texel_size > 0 and self.texel_size_y >= 0):
             raise InvalidInputError(f"The texel size must be positive; got {self.texel_size!r}")
+
+    @property
+    def texel(self):
+        """World distance between samples along x and y: (tx, ty)."""
+        return self.texel_size, self.texel_size_y or self.texel_size
+
+    @property
+    def mean_texel(self):
+        """The geometric mean of the two spacings: the one length the height analysis measures slopes in."""
+        tx, ty = self.texel
+        return tx if tx == ty else float(np.sqrt(tx * ty))
+
+    @property
+    def in_memory(self):
+        """Whether every sample is held in memory (not a memory map, not a grid read block by block)."""
+        return isinstance(self.samples, np.ndarray) and not isinstance(self.samples, np.memmap)
+
+    def void_at(self, x, y):
+        """Whether points at sample coordinates ``x, y`` touch a void that is cut out (a hole): bool array, or
+        None when the map has no holes."""
+        cut = getattr(self.samples, "void_at", None)
+        return None if cut is None or not getattr(self.samples, "cut", False) else cut(x, y)
 
     @property
     def width(self):

@@ -97,8 +97,9 @@ class Selection:
 
 def to_world(hm, x, y, z):
     """Terrain-local world coordinates of sample coordinates: (..., 3) float64."""
-    return np.stack([(np.asarray(x, np.float64) - (hm.width - 1) * 0.5) * hm.texel_size,
-                     (np.asarray(y, np.float64) - (hm.height - 1) * 0.5) * hm.texel_size,
+    tx, ty = hm.texel
+    return np.stack([(np.asarray(x, np.float64) - (hm.width - 1) * 0.5) * tx,
+                     (np.asarray(y, np.float64) - (hm.height - 1) * 0.5) * ty,
                      np.asarray(z, np.float64)], axis=-1)
 
 
@@ -124,7 +125,7 @@ def auto_d_max(hm, camera, settings):
     if settings.d_max > 0:
         return float(settings.d_max)
     focal = 0.5 * camera.height * float(np.asarray(camera.projection)[1, 1])
-    return hm.texel_size * focal / settings.quad_pixels
+    return hm.mean_texel * focal / settings.quad_pixels
 
 
 def _clip_matrix(camera):
@@ -241,7 +242,7 @@ def t_min_levels(hm, table, camera, settings, t_max, xs, ys):
 
 def box_distance(hm, table, camera):
     """Distance from ``camera``'s eye to the terrain's bounding box (terrain-local units): float, 0 inside."""
-    half = np.array([(hm.width - 1) * 0.5, (hm.height - 1) * 0.5]) * hm.texel_size
+    half = np.array([(hm.width - 1) * 0.5, (hm.height - 1) * 0.5]) * hm.texel
     lo = np.array([-half[0], -half[1], float(table.h_min.min())])
     hi = np.array([half[0], half[1], float(table.h_max.max())])
     eye = camera.eye
@@ -256,8 +257,9 @@ def _culled(hm, table, camera, xs, ys):
     """
     m = _clip_matrix(camera)
     (x0, x1), (y0, y1) = xs, ys
-    wx = [(x[0] - (hm.width - 1) * 0.5) * hm.texel_size for x in (x0, x1)]  # (ntx,) each, as in to_world
-    wy = [(y[:, 0] - (hm.height - 1) * 0.5) * hm.texel_size for y in (y0, y1)]  # (nty,) each
+    tx, ty = hm.texel
+    wx = [(x[0] - (hm.width - 1) * 0.5) * tx for x in (x0, x1)]  # (ntx,) each, as in to_world
+    wy = [(y[:, 0] - (hm.height - 1) * 0.5) * ty for y in (y0, y1)]  # (nty,) each
     out = np.zeros(x0.shape, bool)
     for axis in range(3):
         for sign in (1.0, -1.0):

@@ -12,7 +12,9 @@ segments on a side one texel long).
 
 Vertices are welded by construction: a tile corner is one vertex for four tiles, an edge point one vertex
 for its two tiles (edges run +x or +y, so both tiles read the same points), inner points belong to their
-tile. A shared edge therefore cannot crack. Culled tiles emit no triangles; unused vertices are dropped.
+tile. A shared edge therefore cannot crack. Culled tiles emit no triangles; where the map's no-data voids are cut
+(`HeightMap.void_at`), so is every triangle with a corner whose bilinear footprint reads a void; unused vertices are
+dropped.
 Triangles are counter-clockwise seen from +z.
 """
 
@@ -122,6 +124,9 @@ def bake(hm, table, selection):
         lmap = np.stack(cols, 1)
         tri_parts.append(lmap[:, tmpl].reshape(-1, 3))
     tris = np.concatenate(tri_parts) if tri_parts else np.zeros((0, 3), np.int64)
+    holes = hm.void_at(samples[:, 0], samples[:, 1])  # no-data cut out: a triangle with a corner on a void goes
+    if holes is not None and holes.any():
+        tris = tris[~holes[tris].any(axis=1)]
     used = np.zeros(samples.shape[0], bool)
     used[tris.ravel()] = True
     remap = np.cumsum(used) - 1

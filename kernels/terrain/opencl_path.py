@@ -36,7 +36,7 @@ def ham(runtime, heights, inv_texel=1.0):
 def analyse_on_device(runtime, hm, table):
     """Fill every tile of ``table`` (a `terrain_analysis.TileTable`) from height map ``hm``."""
     cl = runtime.cl
-    d_ham, d_h = ham_on_device(runtime, hm.heights(), 1.0 / hm.texel_size)
+    d_ham, d_h = ham_on_device(runtime, hm.heights(), 1.0 / hm.mean_texel)
     ntx, nty = table.counts
     rows, width = table.shape
     outs = [np.empty((nty, ntx), np.float32) for _ in range(3)] + [np.empty((nty, ntx), np.int32) for _ in range(2)]

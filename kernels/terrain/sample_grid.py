@@ -1,0 +1,213 @@
+"""Height samples that are never held whole: TIFF images read block by block, several files on one grid.
+
+A `SampleGrid` answers the two questions the terrain asks of its samples: a band of whole rows (the analysis,
+the GPU preview) and the values at scattered points (the mesh). Rows count from the bottom (row 0 is the
+southern edge, Blender's image order); files store their top row first.
+
+`TiffSource` decodes one TIFF's samples through OpenImageIO (every compression and predictor its libtiff
+reads) a block of whole tile rows or strips at a time, keeping the last few blocks; `Mosaic` lays several
+sources on one grid by their sample offsets (a DEM split over adjacent files), where a sample no file covers is a
+void. Values are float32; voids (no file, the file's no-data value, NaN) are NaN here, and the layer above
+(`void_fill.FilledGrid`) fills or cuts them before any height reaches the terrain.
+"""
+
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.errors import InvalidInputError, TesseraError
+from ..common.image_io import oiio_module
+
+#: Bytes of decoded blocks a source keeps (at least two blocks are kept whatever their size).
+CACHE_BYTES = 64 * 2**20
+#: Rows per block of a striped file (tiled files use whole tile rows, at least this many rows).
+BLOCK_ROWS = 256
+#: Sample formats read exactly as float32.
+_EXACT = {"int8", "uint8", "int16", "uint16", "half", "float"}
+_NUMERIC = _EXACT | {"int32", "uint32", "double"}
+
+
+class SampleGrid:
+    """Read-only (H, W) float32 samples, row 0 at the bottom, answering ``grid[y0:y1]`` (a band of rows,
+    (y1 - y0, W)) and ``grid[ys, xs]`` (int arrays of equal shape -> values of that shape)."""
+
+    ndim = 2
+    dtype = np.dtype(np.float32)
+    shape = (0, 0)
+
+    def band(self, y0, y1):  # pragma: no cover - the interface
+        raise NotImplementedError
+
+    def points(self, ys, xs):  # pragma: no cover - the interface
+        raise NotImplementedError
+
+    def __len__(self):
+        return self.shape[0]
+
+    def __getitem__(self, key):
+        if isinstance(key, slice):
+            y0, y1, step = key.indices(self.shape[0])
+            if step != 1:
+                raise IndexError("sample grids give bands of consecutive rows")
+            return self.band(y0, max(y0, y1))
+        if isinstance(key, tuple) and len(key) == 2:
+            ys, xs = np.broadcast_arrays(np.asarray(key[0], np.int64), np.asarray(key[1], np.int64))
+            return self.points(ys, xs)
+        raise IndexError(f"sample grids take a row slice or two index arrays, not {key!r}")
+
+
+@dataclass(frozen=True)
+class TiffLayout:
+    """What a TIFF's header says about its samples: width, height, channels, format name (OpenImageIO's),
+    block rows (whole tile rows or strips), and whether it is tiled."""
+
+    width: int
+    height: int
+    channels: int
+    format: str
+    block_rows: int
+    tiled: bool
+
+
+def tiff_layout(path):
+    """The `TiffLayout` of ``path``'s first image, from its header; refuses non-numeric samples."""
+    oiio = oiio_module()
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise InvalidInputError(f"Cannot read {path}: {(oiio.geterror() or 'not a TIFF file').strip()}")
+    try:
+        spec = inp.spec()
+        fmt = str(spec.format)
+        tile = int(spec.tile_height) if spec.tile_width else 0
+    finally:
+        inp.close()
+    if fmt not in _NUMERIC:
+        raise InvalidInputError(f"{path} stores {fmt} samples; elevation data must be integers or floats")
+    rows = tile * max(1, -(-BLOCK_ROWS // tile)) if tile else BLOCK_ROWS
+    return TiffLayout(int(spec.width), int(spec.height), int(spec.nchannels), fmt, rows, bool(tile))
+
+
+class TiffSource:
+    """One TIFF image's first channel, decoded a block of rows at a time (file order: row 0 at the top).
+
+    ``nodata``: the file's no-data value (None: none); its samples, and NaN, read as NaN.
+    """
+
+    def __init__(self, path, layout, nodata=None):
+        self.path, self.layout, self.nodata = path, layout, nodata
+        self._cache = OrderedDict()  # block index -> (rows, W) float32
+        self._keep = max(2, CACHE_BYTES // max(1, layout.block_rows * layout.width * 4))
+
+    @property
+    def shape(self):
+        return self.layout.height, self.layout.width
+
+    def block(self, index):
+        """Decoded rows of block ``index``: (rows, W) float32 (file order), voids as NaN."""
+        hit = self._cache.get(index)
+        if hit is not None:
+            self._cache.move_to_end(index)
+            return hit
+        data = self._decode(index)
+        self._cache[index] = data
+        while len(self._cache) > self._keep:
+            self._cache.popitem(last=False)
+        return data
+
+    def _decode(self, index):
+        lay = self.layout
+        r0 = index * lay.block_rows
+        r1 = min(lay.height, r0 + lay.block_rows)
+        oiio = oiio_module()
+        inp = oiio.ImageInput.open(self.path)
+        if inp is None:
+            raise TesseraError(f"Cannot read {self.path}: {(oiio.geterror() or 'the file is gone').strip()}")
+        try:
+            # "unknown": the file's own type (OpenImageIO would scale integers into [0, 1] for "float")
+            if lay.tiled:
+                data = inp.read_tiles(0, 0, 0, lay.width, r0, r1, 0, 1, 0, 1, "unknown")
+            else:
+                data = inp.read_scanlines(0, 0, r0, r1, 0, 0, 1, "unknown")
+            error = inp.geterror()  # a strip it cannot decode still returns an array, with an error set
+            if data is None or error:
+                reason = (error or oiio.geterror() or "the file is damaged or truncated").strip()
+                raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {self.path} failed: {reason}")
+        finally:
+            inp.close()
+        raw = np.asarray(data).reshape(r1 - r0, lay.width)
+        out = raw.astype(np.float32)
+        void = ~np.isfinite(out)
+        if self.nodata is not None and np.isfinite(self.nodata):
+            if raw.dtype.kind not in "iu":
+                void |= out == np.float32(self.nodata)
+            elif float(self.nodata).is_integer() and np.iinfo(raw.dtype).min <= self.nodata <= np.iinfo(raw.dtype).max:
+                void |= raw == raw.dtype.type(int(self.nodata))  # compared as stored, not after rounding
+        out[void] = np.nan
+        return out
+
+    def rows(self, r0, r1):
+        """File rows ``[r0, r1)``: (r1 - r0, W) float32, voids NaN."""
+        b = self.layout.block_rows
+        parts = []
+        for index in range(r0 // b, (r1 - 1) // b + 1):
+            lo = index * b
+            parts.append(self.block(index)[max(r0, lo) - lo:min(r1, lo + b) - lo])
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def points(self, rows, cols):
+        """Values at file rows and columns (int64 (n,) each, inside the image): (n,) float32."""
+        out = np.empty(rows.shape, np.float32)
+        block = rows // self.layout.block_rows
+        order = np.argsort(block, kind="stable")
+        edges = np.flatnonzero(np.diff(block[order])) + 1
+        for run in np.split(order, edges):
+            if run.size:
+                index = int(block[run[0]])
+                out[run] = self.block(index)[rows[run] - index * self.layout.block_rows, cols[run]]
+        return out
+
+
+class Mosaic(SampleGrid):
+    """Sources placed on one grid: ``placements`` is a list of (source, column offset, row offset from the top);
+    the grid spans them all. Where sources overlap, the first in the list gives the sample. Row 0 at the bottom."""
+
+    def __init__(self, placements, width, height):
+        self.placements = list(placements)
+        self.shape = (int(height), int(width))
+
+    def band(self, y0, y1):
+        h, w = self.shape
+        out = np.full((y1 - y0, w), np.nan, np.float32)
+        if y1 <= y0:
+            return out
+        filled = np.zeros(out.shape, bool) if len(self.placements) > 1 else None
+        top0, top1 = h - y1, h - y0  # the band in top-first rows [top0, top1)
+        for source, col, row in self.placements:
+            sh, sw = source.shape
+            a, b = max(top0, row), min(top1, row + sh)
+            if a >= b:
+                continue
+            rows = source.rows(a - row, b - row)[::-1]  # bottom-first
+            sl = (slice(top1 - b, top1 - a), slice(col, col + sw))
+            if filled is None:
+                out[sl] = rows
+            else:
+                take = ~filled[sl]
+                out[sl][take] = rows[take]
+                filled[sl] = True
+        return out
+
+    def points(self, ys, xs):
+        h = self.shape[0]
+        top = (h - 1 - ys).ravel()
+        x = xs.ravel()
+        out = np.full(top.shape, np.nan, np.float32)
+        todo = np.ones(top.shape, bool)
+        for source, col, row in self.placements:
+            sh, sw = source.shape
+            inside = todo & (top >= row) & (top < row + sh) & (x >= col) & (x < col + sw)
+            if inside.any():
+                out[inside] = source.points(top[inside] - row, x[inside] - col)
+                todo &= ~inside
+        return out.reshape(ys.shape)
