@@ -1,6 +1,7 @@
 """``tessera.terrain_add`` (a terrain object from a height map) and ``tessera.terrain_bake`` (its crack-free
 adaptive mesh for a camera, for render and export)."""
 
+import os
 import time
 
 import bpy
@@ -69,6 +70,25 @@ def _bake_into(context, ob, camera, report, tx):
     return sel
 
 
+def _place(context, ob, geo, report):
+    """Put a georeferenced terrain where its data lies: the first in a scene at the world origin (its centre
+    becomes the scene's geographic origin), later ones beside it; a terrain in another CRS stays at the cursor."""
+    scene = context.scene
+    at = terrain_data.geo_location(scene, geo)
+    if at is None and scene.get(terrain_data.GEO_ORIGIN) is not None:
+        report({"WARNING"}, "This terrain's coordinate system differs from the one the scene's first georeferenced "
+                            "terrain set; it is placed at the 3D cursor, not beside the others")
+    else:
+        ob.location = (*(at or (0.0, 0.0)), 0.0)
+        terrain_data.set_geo_origin(scene, geo)
+    hm, _ = terrain_data.analysis(ob)  # cached: read once
+    voids = hm.samples.void_count
+    what = "none" if not voids else f"{voids:,} samples {'cut out' if hm.samples.cut else 'filled'}"
+    (tx, ty), files = geo.texel, len(geo.files)
+    report({"INFO"}, f"GeoTIFF: {files} file{'s' if files > 1 else ''}, {geo.grid.shape[1]:,} x {geo.grid.shape[0]:,} "
+                     f"samples, {tx:.4g} x {ty:.4g} m apart; no-data: {what}")
+
+
 class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     """Add a terrain object from a height map, meshed adaptively for the scene camera"""
 
@@ -79,6 +99,9 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     # the options: TerrainOptions (addon/terrain/settings.py), shared with Object.tessera.terrain
     filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw", options={"HIDDEN"},
                                           description="Files listed")
+    # several files picked at once (the adjacent tiles of one elevation model) become one terrain
+    files: bpy.props.CollectionProperty(type=bpy.types.OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})
+    directory: bpy.props.StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"})
 
     @classmethod
     def poll(cls, context):
@@ -98,6 +121,10 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
 
     @guarded
     def execute(self, context, tx):
+        names = [f.name for f in self.files if f.name]
+        if len(names) > 1 and self.directory:  # picked together: the first is the height map, the rest its tiles
+            self.filepath = os.path.join(self.directory, names[0])
+            self.tile_files = ";".join(names[1:])
         mesh = tx.new_mesh("Terrain")
         ob = tx.new_object("Terrain", mesh)
         tx.on_rollback(lambda: terrain_data.forget(ob))
@@ -109,6 +136,9 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
             ob.location = context.scene.cursor.location
             context.collection.objects.link(ob)
             _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx)
+            geo = terrain_data.georeference(ob)
+            if geo is not None:
+                _place(context, ob, geo, self.report)
         finally:
             wm.progress_end()
         select_only(context, [ob])

@@ -5,22 +5,51 @@ for raw files) and analysed once per source and kept here until the source setti
 is written through the bridge and replaces the object's mesh data.
 """
 
+import dataclasses
 import os
 
 import bpy
 
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.mesh_arrays import MeshArrays
-from ...kernels.terrain import heightmap_io
+from ...kernels.terrain import geotiff, heightmap_io
 from ...kernels.terrain.analysis import tile_table
 from .. import bridge
-from .settings import source_key
+from ..preferences import get_preferences
+from .settings import is_tiff, source_key
 
-_cache = {}  # object session_uid -> (source key, HeightMap, TileTable)
+_cache = {}  # object session_uid -> (source key, HeightMap, TileTable, GeoGrid or None)
+#: Scene custom property: the model position (x, y), CRS code and kind (1: geographic) that the scene's origin
+#: stands for, set by the first georeferenced terrain, so that later ones (adjacent tiles) land beside it.
+GEO_ORIGIN = "tessera_geo_origin"
 
 
-def read_source(s):
-    """The `HeightMap` named by terrain settings ``s``. Raises `TesseraError` with what to fix."""
+def source_paths(s):
+    """The files named by terrain settings ``s``: the height map, then the More Tiles in its folder."""
+    path = os.path.normpath(bpy.path.abspath(s.filepath))
+    folder = os.path.dirname(path)
+    return [path] + [os.path.join(folder, n.strip()) for n in s.tile_files.split(";") if n.strip()]
+
+
+def _unit_metres(scene):
+    return scene.unit_settings.scale_length if scene.unit_settings.system != "NONE" else 1.0
+
+
+def read_source(s, scene=None, progress=None):
+    """``(HeightMap, GeoGrid or None)`` named by terrain settings ``s`` (GeoTIFFs in the units of ``scene``).
+    Raises `TesseraError` with what to fix."""
+    if s.source == "FILE" and s.filepath and s.georeferenced and is_tiff(s.filepath):
+        paths = source_paths(s)
+        if os.path.isfile(paths[0]) and geotiff.read_geoinfo(paths[0]) is not None:
+            scene = scene or bpy.context.scene
+            hm, geo = geotiff.read_geotiff(paths, voids=s.voids, exaggeration=s.exaggeration,
+                                           budget_bytes=get_preferences().memory_budget_bytes,
+                                           unit_metres=_unit_metres(scene), progress=progress)
+            return dataclasses.replace(hm, offset=s.height_offset), geo
+    return _read_plain(s), None
+
+
+def _read_plain(s):
     scale = dict(texel_size=s.texel_size, scale=s.height_scale, offset=s.height_offset)
     if s.source == "IMAGE":
         image = bpy.data.images.get(s.image_name)
@@ -37,17 +66,47 @@ def read_source(s):
     return heightmap_io.read_heightmap(os.path.normpath(path), raw_size=raw, **scale)
 
 
-def analysis(ob, progress=None):
+def analysis(ob, progress=None, scene=None):
     """(HeightMap, TileTable) for terrain object ``ob``, read and analysed on first use or after a change."""
     s = ob.tessera.terrain
-    key = source_key(s)
+    scene = scene or bpy.context.scene
+    key = (source_key(s), _unit_metres(scene))
     hit = _cache.get(ob.session_uid)
     if hit is not None and hit[0] == key:
         return hit[1], hit[2]
-    hm = read_source(s)
-    table = tile_table(hm, s.tile_size, progress=progress)
-    _cache[ob.session_uid] = (key, hm, table)
+    half = None if progress is None else (lambda done, total: progress(done, 2 * total))
+    hm, geo = read_source(s, scene, half)
+    rest = None if progress is None else (lambda done, total: progress(total + done, 2 * total))
+    table = tile_table(hm, s.tile_size, progress=rest)
+    _cache[ob.session_uid] = (key, hm, table, geo)
     return hm, table
+
+
+def georeference(ob):
+    """The `geotiff.GeoGrid` of a terrain read from GeoTIFFs (after `analysis`), or None."""
+    hit = _cache.get(ob.session_uid)
+    return None if hit is None else hit[3]
+
+
+def geo_location(scene, geo):
+    """Where a georeferenced terrain's centre goes in ``scene``: ``(x, y)`` world units from the scene's geographic
+    origin, or None when the scene has none yet (the terrain then sets it) or when its CRS differs (the terrain
+    stays where it is put). The offset is converted at the origin's latitude for geographic data."""
+    first = geo.files[0]
+    origin = scene.get(GEO_ORIGIN)
+    if origin is None or int(origin[2]) != first.crs or bool(origin[3]) != first.geographic:
+        return None
+    mx, my = geotiff.metres_per_unit(first, origin[1] if first.geographic else None)
+    unit = _unit_metres(scene)
+    cx, cy = geo.centre
+    return (cx - origin[0]) * mx / unit, (cy - origin[1]) * my / unit
+
+
+def set_geo_origin(scene, geo):
+    """Make ``geo``'s centre the scene's geographic origin (when it has none)."""
+    if scene.get(GEO_ORIGIN) is None:
+        first = geo.files[0]
+        scene[GEO_ORIGIN] = [float(geo.centre[0]), float(geo.centre[1]), float(first.crs), float(first.geographic)]
 
 
 def forget(ob=None):

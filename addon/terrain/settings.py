@@ -10,7 +10,7 @@ from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator, with_update
 
 SOURCE_ITEMS = (
-    ("FILE", "File", "PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw .r16/.r32 files"),
+    ("FILE", "File", "GeoTIFF elevation data, PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw .r16/.r32 files"),
     ("IMAGE", "Image", "An image in this Blender file (its first channel)"),
 )
 MODE_ITEMS = (
@@ -27,6 +27,10 @@ T_MIN_ITEMS = (
     ("LOG2", "Closed Form", "A formula from the peak's height and the error (faster, approximate)"),
     ("PRINTED", "Reversed Closed Form", "The formula with its ratio reversed: never adds detail (for comparisons)"),
 )
+VOID_ITEMS = (
+    ("FILL", "Fill", "Fill each no-data void smoothly from the heights around it"),
+    ("HOLES", "Holes", "Leave each no-data void out of the mesh"),
+)
 LEVEL_ITEMS = (
     ("POW2", "Powers of Two", "Vertices land on texels and stay put as levels change (no swimming)"),
     ("INTEGER", "Integer", "Whole levels"),
@@ -42,7 +46,20 @@ class TerrainOptions:
     source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE",
                                    description="Read the heights from a file or from an image in this Blender file")
     filepath: bpy.props.StringProperty(name="Height Map", subtype="FILE_PATH",
-                                       description="The height map file (PNG, TIFF, EXR, or raw .r16/.r32)")
+                                       description="The height map file (GeoTIFF, PNG, TIFF, EXR, or raw .r16/.r32)")
+    tile_files: bpy.props.StringProperty(name="More Tiles",
+                                         description="Other GeoTIFF files of the same elevation data (adjacent "
+                                                     "tiles) in the height map's folder, separated by semicolons: "
+                                                     "they become one terrain")
+    georeferenced: bpy.props.BoolProperty(name="Use Georeferencing", default=True,
+                                          description="For GeoTIFF files: take the texel size, the height units and "
+                                                      "the position from the file (Texel Size and Height Scale are "
+                                                      "then not used)")
+    exaggeration: bpy.props.FloatProperty(name="Vertical Exaggeration", default=1.0, min=0.0, max=MAX_FACTOR,
+                                          soft_max=10.0, description="Factor on a GeoTIFF's heights (1: true scale)")
+    voids: bpy.props.EnumProperty(name="No-Data", items=VOID_ITEMS, default="FILL",
+                                  description="What becomes of samples the file marks as having no height "
+                                              "(voids, sea)")
     image_name: bpy.props.StringProperty(name="Image", description="Blender image with the heights")
     raw_width: bpy.props.IntProperty(name="Raw Width", default=0, min=0, soft_max=65536, subtype="PIXEL",
                                      description="Samples per row of a raw .r16/.r32 file")
@@ -90,8 +107,8 @@ class TerrainOptions:
 TOPIC = "terrain"
 _changed = invalidator(TOPIC)
 TERRAIN_SETTING_NAMES = tuple(TerrainOptions.__annotations__)
-SOURCE_NAMES = ("source", "filepath", "image_name", "raw_width", "raw_height", "texel_size", "height_scale",
-                "height_offset", "tile_size")
+SOURCE_NAMES = ("source", "filepath", "tile_files", "georeferenced", "exaggeration", "voids", "image_name",
+                "raw_width", "raw_height", "texel_size", "height_scale", "height_offset", "tile_size")
 
 
 class TESSERA_PG_terrain(bpy.types.PropertyGroup):
@@ -102,6 +119,11 @@ class TESSERA_PG_terrain(bpy.types.PropertyGroup):
                                                       "re-selecting levels as the view moves"),
         "is_terrain": bpy.props.BoolProperty(name="Terrain", default=False, options={"HIDDEN"}),
     }
+
+
+def is_tiff(path):
+    """Whether a height-map path names a TIFF (which may carry GeoTIFF tags)."""
+    return path.lower().endswith((".tif", ".tiff"))
 
 
 def copy_terrain_settings(source, target):
@@ -125,15 +147,25 @@ def draw_terrain_settings(layout, s, show_source=True):
     col = layout.column()
     if show_source:
         col.prop(s, "source")
+        geo = s.source == "FILE" and s.georeferenced and is_tiff(s.filepath)
         if s.source == "FILE":
             col.prop(s, "filepath")
-            sub = col.column(align=True)
-            sub.prop(s, "raw_width")
-            sub.prop(s, "raw_height")
+            if is_tiff(s.filepath):
+                col.prop(s, "tile_files")
+                col.prop(s, "georeferenced")
+                col.prop(s, "voids")
+            else:
+                sub = col.column(align=True)
+                sub.prop(s, "raw_width")
+                sub.prop(s, "raw_height")
         else:
             col.prop_search(s, "image_name", bpy.data, "images")
-        col.prop(s, "texel_size")
-        col.prop(s, "height_scale")
+        if geo:
+            col.prop(s, "exaggeration")
+        sub = col.column()
+        sub.active = not geo  # a GeoTIFF gives them (a plain TIFF keeps them: it has no georeferencing)
+        sub.prop(s, "texel_size")
+        sub.prop(s, "height_scale")
         col.prop(s, "height_offset")
         col.prop(s, "tile_size")
     col = layout.column()
