@@ -13,6 +13,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
   ``tessera.displacement_stroke``; the map is also written as ``out/demo_map.exr`` (32-bit float);
 - ``out/demo_terrain.png``: a synthetic ridged terrain (1025², written as a 16-bit PNG height map) added with
   ``tessera.terrain_add`` and meshed adaptively for the scene camera, wireframe on top;
+- ``out/demo_geotiff.png``: a DEM written as two adjacent GeoTIFF tiles (metres, 30 m samples, a lake of no-data),
+  picked together and added as one terrain at true scale with the lake cut out (No-Data: Holes);
 - ``out/demo_loop.png``: Suzanne as Add > Monkey gives it, Loop subdivision level 2 of it, and a cube with its top
   edges marked sharp at Loop level 3 (``tessera.loop_subdivide``);
 - ``out/demo_loop_hce.png``: a Cornell-like box; Suzanne's light baked by Cycles into its HCE, shown on the coarse
@@ -295,6 +297,36 @@ def build_terrain_scene(size=1025):
     ob.data.materials.append(material("Rock", (0.55, 0.5, 0.42, 1.0)))
     wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=0.25)
     return len(ob.data.polygons), 2 * (size - 1) ** 2
+
+
+def build_geotiff_scene(size=513):
+    """A DEM as two adjacent GeoTIFF tiles (int16 metres, 30 m samples, -32768 where a lake has no data), picked
+    together and added as one terrain with the lake cut out; wireframe on top. Returns (triangles, void samples)."""
+    import importlib
+
+    tools = importlib.import_module("bl_ext.tessera_demo.tessera.tools.geotiff_files")
+    clear_scene()
+    bpy.context.scene.pop("tessera_geo_origin", None)
+    heights = np.asarray(_synth().ridged_terrain(size, seed=11)) * 1400.0 + 300.0
+    y, x = np.mgrid[0:size, 0:size] / (size - 1)
+    lake = np.hypot((x - 0.42) * 1.4, y - 0.55) < 0.13
+    top = np.where(lake, -32768, np.round(heights)).astype(np.int16)
+    half = size // 2
+    names = []
+    for name, c0, c1 in (("dem_west.tif", 0, half + 1), ("dem_east.tif", half, size)):  # one shared column
+        tools.write_geotiff(str(OUT / name), top[:, c0:c1], spacing=(30.0, 30.0), nodata=-32768,
+                            corner=(400000.0 + 30.0 * c0, 5100000.0), tile=(128, 128))
+        names.append(name)
+    add_camera((0.0, -14500.0, 9000.0), (0.98, 0.0, 0.0), lens=30).data.clip_end = 60000.0  # a 15 km terrain
+    result = bpy.ops.tessera.terrain_add(filepath=str(OUT / names[0]), directory=str(OUT),
+                                         files=[{"name": n} for n in names], voids="HOLES", tile_size=32,
+                                         epsilon=1.5)
+    if result != {"FINISHED"}:
+        sys.exit(f"demo: terrain_add (GeoTIFF) returned {result}")
+    ob = bpy.context.active_object
+    ob.data.materials.append(material("Ground", (0.5, 0.55, 0.4, 1.0)))
+    wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=4.0)
+    return len(ob.data.polygons), int(lake.sum())
 
 
 def _synth():
@@ -715,6 +747,9 @@ def main():
     tris, full = build_terrain_scene()
     render("demo_terrain.png")
     print(f"demo: terrain for the camera: {tris:,} triangles ({100 * tris / full:.2f}% of the {full:,}-triangle grid)")
+    tris, voids = build_geotiff_scene()
+    render("demo_geotiff.png")
+    print(f"demo: GeoTIFF terrain from two tiles, {voids:,} no-data samples cut out: {tris:,} triangles")
     for name, tris, elapsed in build_loop_scene():
         print(f"demo: Loop subdivision of {name}: {tris:,} triangles in {elapsed:.2f} s")
     render("demo_loop.png")
@@ -737,8 +772,9 @@ def main():
     tris = build_gpu_preview_picture()
     print(f"demo: GPU preview (instanced patterns, adaptive PN, one displaced): {tris:,} triangles drawn")
     for name in ("demo.glb", "demo.obj", "demo.png", "demo_adaptive.png", "demo_tubes.png", "demo_brushes.png",
-                 "demo_map.exr", "demo_terrain.png", "demo_gpu_preview.png", "demo_loop.png", "demo_loop_hce.png",
-                 "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png", "demo_teapot.png", "demo_nailboard.png"):
+                 "demo_map.exr", "demo_terrain.png", "demo_geotiff.png", "demo_gpu_preview.png", "demo_loop.png",
+                 "demo_loop_hce.png", "demo_node_groups.png", "demo_surfaces.png", "demo_lic.png", "demo_teapot.png",
+                 "demo_nailboard.png"):
         path = OUT / name
         if not path.is_file() or path.stat().st_size == 0:
             sys.exit(f"demo: {path} was not written")

@@ -3,7 +3,7 @@ terrain, voids filled or cut, refusals that change nothing, settings that surviv
 
 import numpy as np
 import pytest
-from geotiff_files import write_geotiff
+from tessera.tools.geotiff_files import write_geotiff
 from test_blender_terrain import add_camera, mesh_tris
 
 pytestmark = pytest.mark.blender

@@ -5,7 +5,6 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from geotiff_files import write_geotiff
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import BudgetError, InvalidInputError
 from tessera.kernels.terrain import analysis as ta
@@ -14,6 +13,7 @@ from tessera.kernels.terrain import lod as tl
 from tessera.kernels.terrain import mesh as tm
 from tessera.kernels.terrain import sample_grid, void_fill
 from tessera.kernels.terrain.synth import ridged_terrain
+from tessera.tools.geotiff_files import write_geotiff
 
 NODATA = -32768
 

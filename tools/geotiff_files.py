@@ -1,5 +1,5 @@
-"""GeoTIFF files made in the tests with tifffile (an independent, well-kept writer): known placements, units,
-no-data values, tiled or striped, compressed."""
+"""GeoTIFF files for the tests, the bench and the demo, written with tifffile (an independent, well-kept writer):
+known placements, units, no-data values, tiled or striped, compressed."""
 
 import numpy as np
 import tifffile

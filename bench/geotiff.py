@@ -1,0 +1,126 @@
+"""GeoTIFF elevation data out of core: a 16385² float32 DEM, tiled 256² and deflate-compressed, with voids.
+
+- ``geotiff_out_of_core``: the GeoTIFF read block by block (voids found and filled) and analysed into the tile table,
+  against the baseline of the same heights as a raw .r32 file analysed memory-mapped (the out-of-core path that
+  needs no decoding), same run: wall time of each and their ratio, peak Python-side allocation (tracemalloc)
+  against the size of the map as float32 (1 GiB: what a reader that decodes the whole file, as BlenderGIS does,
+  holds at least), and the files' sizes.
+- ``geotiff_split``: the same DEM cut into four files (adjacent tiles) read as one terrain, against the single file:
+  time ratio and whether the tile tables are identical.
+Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/geotiff.py
+"""
+
+import atexit
+import json
+import os
+import shutil
+import tempfile
+import time
+import tracemalloc
+
+import numpy as np
+from _setup import import_path
+
+import_path()
+from tessera.kernels.terrain import geotiff as gt  # noqa: E402
+from tessera.kernels.terrain import heightmap_io as hio  # noqa: E402
+from tessera.kernels.terrain.analysis import tile_table  # noqa: E402
+from tessera.kernels.terrain.synth import ridged_terrain  # noqa: E402
+from tessera.tools.geotiff_files import write_geotiff  # noqa: E402
+
+SIZE = 16385
+TILE = 256
+
+
+def source_tile():
+    """4097² heights mirrored into a continuous 8194² tile, with a lake."""
+    small = ridged_terrain(4097, seed=3, octaves=7) * 2400.0 + 100.0
+    small[1500:1700, 2000:2300] = np.nan
+    return np.block([[small, small[:, ::-1]], [small[::-1], small[::-1, ::-1]]]).astype(np.float32)
+
+
+def rows_of(tile, y0, y1, x0=0, x1=SIZE):
+    return tile[np.arange(y0, y1) % tile.shape[0]][:, np.arange(x0, x1) % tile.shape[1]]
+
+
+def write_big(folder, tile):
+    """The DEM as a tiled deflate GeoTIFF (tiles made one at a time) and as a raw .r32 (top row first)."""
+    import tifffile
+
+    n = -(-SIZE // TILE)
+
+    def tiles():
+        for ty in range(n):
+            band = rows_of(tile, ty * TILE, min(SIZE, (ty + 1) * TILE))
+            band = np.pad(band, ((0, TILE - band.shape[0]), (0, n * TILE - SIZE)))
+            for tx in range(n):
+                yield np.ascontiguousarray(band[:, tx * TILE:(tx + 1) * TILE])
+
+    geo = os.path.join(folder, "dem.tif")
+    directory = [1, 1, 0, 3, 1024, 0, 1, 1, 1025, 0, 1, 1, 3072, 0, 1, 32633]
+    tifffile.imwrite(geo, tiles(), shape=(SIZE, SIZE), dtype="float32", tile=(TILE, TILE), compression="zlib",
+                     photometric="minisblack", metadata=None,
+                     extratags=[(34735, "H", len(directory), directory, True),
+                                (33550, "d", 3, (30.0, 30.0, 0.0), True),
+                                (33922, "d", 6, (0.0, 0.0, 0.0, 500000.0, 4600000.0, 0.0), True),
+                                (42113, "s", 0, "nan", True)])
+    raw = os.path.join(folder, "dem.r32")
+    with open(raw, "wb") as f:
+        for y0 in range(0, SIZE, 1024):
+            band = rows_of(tile, y0, min(SIZE, y0 + 1024))
+            np.nan_to_num(band, nan=100.0).astype("<f4").tofile(f)  # the raw baseline has no voids to fill
+    return geo, raw
+
+
+def measured(fn):
+    tracemalloc.start()
+    t = time.perf_counter()
+    out = fn()
+    dt = time.perf_counter() - t
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return out, dt, peak
+
+
+def main():
+    folder = tempfile.mkdtemp(prefix="tessera-geotiff-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    tile = source_tile()
+    geo, raw = write_big(folder, tile)
+
+    def from_geotiff():
+        hm, _ = gt.read_geotiff([geo])
+        return tile_table(hm, 64, backend="numpy")
+
+    def from_raw():
+        return tile_table(hio.read_heightmap(raw, raw_size=(SIZE, SIZE)), 64, backend="numpy")
+
+    table, t_geo, peak_geo = measured(from_geotiff)
+    _, t_raw, peak_raw = measured(from_raw)
+    print(json.dumps({"case": "geotiff_out_of_core", "map": f"{SIZE}x{SIZE} float32, tiles {TILE}², deflate",
+                      "geotiff_mib": round(os.path.getsize(geo) / 2**20, 1),
+                      "raw_r32_mib": round(os.path.getsize(raw) / 2**20, 1),
+                      "float32_map_mib": SIZE * SIZE * 4 / 2**20, "geotiff_s": round(t_geo, 2),
+                      "raw_memmap_s": round(t_raw, 2), "time_ratio": round(t_geo / t_raw, 2),
+                      "geotiff_peak_mib": round(peak_geo / 2**20, 1), "raw_peak_mib": round(peak_raw / 2**20, 1),
+                      "finite_tiles": bool(np.isfinite(table.h_min).all())}), flush=True)
+    os.unlink(raw)
+
+    # four adjacent files of a 4097² DEM against the single file
+    part = rows_of(tile, 0, 4097, 0, 4097)
+    single = write_geotiff(os.path.join(folder, "one.tif"), part, nodata="nan", tile=(TILE, TILE))
+    parts = []
+    for i, (r0, r1) in enumerate(((0, 2049), (2049, 4097))):
+        for j, (c0, c1) in enumerate(((0, 2049), (2049, 4097))):
+            parts.append(write_geotiff(os.path.join(folder, f"part{i}{j}.tif"), part[r0:r1, c0:c1], nodata="nan",
+                                       tile=(TILE, TILE), corner=(500000.0 + 30.0 * c0, 4600000.0 - 30.0 * r0)))
+    one, t_one, _ = measured(lambda: tile_table(gt.read_geotiff([single])[0], 64, backend="numpy"))
+    four, t_four, _ = measured(lambda: tile_table(gt.read_geotiff(parts)[0], 64, backend="numpy"))
+    same = all(np.array_equal(getattr(one, k), getattr(four, k)) for k in ("ham_max", "h_min", "h_max", "peak_x"))
+    print(json.dumps({"case": "geotiff_split", "map": "4097x4097 in 4 files", "one_file_s": round(t_one, 2),
+                      "four_files_s": round(t_four, 2), "time_ratio": round(t_four / t_one, 2),
+                      "identical_tables": same}), flush=True)
+
+
+if __name__ == "__main__":
+    main()
