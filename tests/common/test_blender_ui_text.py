@@ -31,6 +31,7 @@ UNITLESS = {
     "max_level": "segments per edge",
     "curvature_gain": "segments per unit of curvature",
     "ham_scale": "a multiplier of the terrain's roughness",
+    "exaggeration": "a multiplier of a GeoTIFF's true heights",
     "mid_level": "a value of the map",
     "strength": "map values or scene units per map value",
     "low": "a value of the map",
