@@ -267,3 +267,32 @@ def test_a_void_too_large_for_the_budget_is_refused_with_the_numbers(tmp_path):
     ring = top[:, :].astype(np.float64)[top != NODATA]
     assert np.ptp(inside) == 0 and ring.min() <= inside[0, 0] <= ring.max()
     assert holes.void_at(np.array([100.0]), np.array([100.0]))[0]
+
+
+@pytest.mark.parametrize("compression, fmt", [("lzw", "int16"), ("lzw", "float"), ("zip", "float"), ("none", "uint16")])
+def test_blocks_and_points_read_every_compression_and_layout(tmp_path, compression, fmt):
+    """TIFFs written by OpenImageIO itself (LZW, deflate with its predictor, none), tiled and striped: bands across
+    block borders and scattered points give the written samples."""
+    import OpenImageIO as oiio
+
+    rng = np.random.default_rng(8)
+    if fmt == "uint16":
+        data = rng.integers(0, 65535, (300, 170)).astype(np.uint16)
+    else:
+        data = (rng.normal(size=(300, 170)) * 900).astype(np.int16 if fmt == "int16" else np.float32)
+    for tiled in (True, False):
+        path = str(tmp_path / f"{compression}_{tiled}.tif")
+        spec = oiio.ImageSpec(170, 300, 1, fmt)
+        spec.attribute("compression", compression)
+        if tiled:
+            spec.tile_width = spec.tile_height = 32
+        out = oiio.ImageOutput.create(path)
+        assert out.open(path, spec) and out.write_image(data[..., None])
+        out.close()
+        layout = sample_grid.tiff_layout(path)
+        assert layout.tiled == tiled and (layout.width, layout.height) == (170, 300)
+        source = sample_grid.TiffSource(path, layout)
+        assert np.array_equal(source.rows(0, 300), data.astype(np.float32))
+        assert np.array_equal(source.rows(250, 290), data[250:290].astype(np.float32))  # across a block border
+        ys, xs = rng.integers(0, 300, 400), rng.integers(0, 170, 400)
+        assert np.array_equal(source.points(ys, xs), data[ys, xs].astype(np.float32))
