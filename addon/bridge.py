@@ -450,6 +450,8 @@ def point_vector_attribute(data, name, count):
 def read_wire_mesh(mesh):
     """Vertex positions (V, 3) float32 and edges (E, 2) int32 of a mesh (its wire, faces ignored)."""
     n_v = len(mesh.vertices)
+    if n_v == 0:  # an empty mesh has no position attribute at all
+        return np.zeros((0, 3), np.float32), np.zeros((0, 2), np.int32)
     positions = _get(mesh.attributes["position"].data, "vector", n_v, np.float32, 3)
     edges = _get(mesh.edges, "vertices", len(mesh.edges), np.int32, 2)
     return positions, edges

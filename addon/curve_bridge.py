@@ -9,6 +9,7 @@ import numpy as np
 
 from ..kernels.common import nurbs
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
+from ..kernels.common.limits import MAX_WORLD_VALUE
 from .bridge import _get
 
 
@@ -83,10 +84,23 @@ class SplineArrays:
     knot_mode: str = ""
 
 
-def read_splines(curve):
-    """The control points of every spline of a `bpy.types.Curve` as `SplineArrays` (object space)."""
+def _check_points(name, k, *arrays):
+    """Refuse spline ``k`` of the curve object ``name`` when a point (or handle, or weight) is at NaN, infinity or
+    beyond `MAX_WORLD_VALUE`."""
+    for values in arrays:
+        if values is None:
+            continue
+        bad = ~(np.abs(values.reshape(len(values), -1)) <= MAX_WORLD_VALUE).all(axis=1)
+        if bad.any():
+            raise InvalidInputError(f"Spline {k} of {name!r} has a point at NaN, infinity or beyond "
+                                    f"{MAX_WORLD_VALUE:g} (point {int(np.argmax(bad))}): move or delete it")
+
+
+def read_splines(curve, name=None):
+    """The control points of every spline of a `bpy.types.Curve` as `SplineArrays` (object space); ``name``: the
+    object's, for messages (default: the curve's)."""
     out = []
-    for s in curve.splines:
+    for k, s in enumerate(curve.splines):
         bezier = s.type == "BEZIER"
         points = s.bezier_points if bezier else s.points
         n = len(points)
@@ -99,6 +113,7 @@ def read_splines(curve):
         else:
             co4 = _get(points, "co", n, np.float32, 4).astype(np.float64)
             co, hl, hr = co4[:, :3], None, None
+        _check_points(name or curve.name, k, co4 if not bezier else co, hl, hr)
         nurbs_spline = s.type == "NURBS"
         out.append(SplineArrays(s.type, co, hl, hr, _control_values(s, "radius"), _control_values(s, "tilt"),
                                 bool(s.use_cyclic_u), s.material_index,
@@ -107,15 +122,16 @@ def read_splines(curve):
     return out
 
 
-def read_surface_splines(curve):
+def read_surface_splines(curve, name=None):
     """The NURBS splines of a SURFACE curve, in object space: ``(surfaces, rows)``. surfaces: (index,
     `kernels.common.nurbs.SurfaceSpline`) for each spline with more than one point in both directions (points (nv,
     nu, 4), u fastest in Blender's list); rows: (index, points (n, 4), `Direction`) for each spline that is a single
-    row (Add > Surface > NURBS Curve or Circle), a curve drawn as edges."""
+    row (Add > Surface > NURBS Curve or Circle), a curve drawn as edges. ``name``: the object's, for messages."""
     surfaces, rows = [], []
     for k, s in enumerate(curve.splines):
         nu, nv = s.point_count_u, s.point_count_v
         co = _get(s.points, "co", len(s.points), np.float32, 4).astype(np.float64)
+        _check_points(name or curve.name, k, co)
         u = nurbs.Direction(s.order_u, nurbs.knot_mode(s.use_endpoint_u, s.use_bezier_u), bool(s.use_cyclic_u))
         if nv <= 1 or nu <= 1:
             if nu <= 1:

@@ -158,7 +158,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
                                    ob.matrix_world)
         out, counts, over = [], [], 0
-        for k, sp in enumerate(curve_bridge.read_splines(ob.data)):
+        for k, sp in enumerate(curve_bridge.read_splines(ob.data, ob.name)):
             if sp.kind in ("BEZIER", "NURBS") and len(sp.co) < 2:
                 raise InvalidInputError(f"Spline {k} of {ob.name!r} has a single point: delete it or add points")
             if sp.kind == "BEZIER":
@@ -205,10 +205,14 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
     def _field(self, context):
         if self.field != "MESH":
             return vf.AnalyticField(self.field, slice_z=self.slice_z, speed=self.speed)
-        ob = bpy.data.objects.get(self.field_object) or context.active_object
+        if self.field_object and self.field_object not in bpy.data.objects:
+            raise InvalidInputError(f"No object named {self.field_object!r} (Grid Object): pick the grid mesh")
+        ob = bpy.data.objects.get(self.field_object) if self.field_object else context.active_object
         if ob is None or ob.type != "MESH":
             raise InvalidInputError("Choose a grid mesh object holding the field (Grid Object), or make one active")
         n = len(ob.data.vertices)
+        if n == 0:
+            raise InvalidInputError(f"The Grid Object {ob.name!r} has no vertices: give it the grid of the field")
         positions, _ = bridge.read_wire_mesh(ob.data)
         vectors = bridge.point_vector_attribute(ob.data, self.attribute, n) * self.speed
         return vf.grid_field_from_points(positions, vectors)
@@ -217,8 +221,9 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
         cam, ob = context.scene.camera, context.active_object
         if cam is None:
             return self.far  # no camera: the sparsest lattice
-        target = ob.matrix_world.translation if ob is not None else (0.0, 0.0, 0.0)
-        return float((cam.matrix_world.translation - target).length)
+        eye = np.array(cam.matrix_world.translation)
+        target = np.array(ob.matrix_world.translation) if ob is not None else np.zeros(3)
+        return float(np.linalg.norm(eye - target))
 
     @guarded
     def execute(self, context, tx):
@@ -274,7 +279,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
     @guarded
     def execute(self, context, tx):
         ob = context.active_object
-        surfaces, rows = curve_bridge.read_surface_splines(ob.data)
+        surfaces, rows = curve_bridge.read_surface_splines(ob.data, ob.name)
         if not surfaces and not rows:
             raise InvalidInputError(f"Surface {ob.name!r} has no spline: add one in Edit Mode, or select another")
         lod = patch_lod(self)

@@ -3,6 +3,8 @@ background) and the baked impostor card."""
 
 import bpy
 
+from ...kernels.common.errors import InvalidInputError
+from ..guarded import check_numbers
 from ..sidebar import Sidebar
 
 
@@ -21,6 +23,10 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
         col.active = s.enabled
         for name in ("relief", "tolerance", "samples", "progressive", "lead"):
             col.prop(s, name)
+        try:
+            check_numbers(s)  # a script can store NaN; the preview then skips the object, and says why here
+        except InvalidInputError as err:
+            col.label(text=str(err), icon="ERROR")
         row = layout.row()
         row.scale_y = 1.4
         row.operator("tessera.impostor_bake", icon="IMAGE_PLANE")

@@ -7,8 +7,10 @@ is drawn in background mode."""
 import bpy
 import numpy as np
 
+from ...kernels.common.errors import InvalidInputError
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.prewarp import fill_holes, forward_splat
+from ..guarded import check_numbers
 from ..viewport import Preview, tag_view3d_redraw
 from . import worker
 from .live import NailboardManager
@@ -82,6 +84,15 @@ def _request(ob, eye, res_screen, fov):
 MANAGER = NailboardManager(_request, resample=worker.resample_images)
 
 
+def _finite(s):
+    """Whether nailboard settings ``s`` hold numbers (a script may store NaN); the panel names a bad one."""
+    try:
+        check_numbers(s)
+    except InvalidInputError:
+        return False
+    return True
+
+
 def _draw(context, region, view, proj):
     from ...gpu_shaders.impostors.draw import BoardDrawData
 
@@ -89,7 +100,7 @@ def _draw(context, region, view, proj):
     fov = 2.0 * np.arctan(1.0 / proj[1, 1])
     for ob in context.visible_objects:
         s = ob.tessera.nailboard
-        if not s.enabled or ob.type != "MESH":
+        if not s.enabled or ob.type != "MESH" or not _finite(s):
             continue
         MANAGER.k, MANAGER.relief_factor, MANAGER.lead = s.tolerance, 0.25 if s.relief else 1.0, s.lead
         live = MANAGER.update(ob, eye, region.height, fov)

@@ -19,7 +19,15 @@ def control_points(ob):
     pos, _ = read_wire_mesh(src.data)
     if len(pos) == 0:
         raise InvalidInputError(f"{src.name!r} has no vertices to put surfaces on")
-    to_local = np.linalg.inv(np.array(ob.matrix_world)) @ np.array(src.matrix_world)
+    bad = ~np.isfinite(pos).all(axis=1)
+    if bad.any():
+        raise InvalidInputError(f"Vertex {int(np.argmax(bad))} of the Control Points {src.name!r} is at NaN or "
+                                "infinity: move or delete it")
+    world = np.array(ob.matrix_world)
+    if not abs(np.linalg.det(world[:3, :3])) > 1e-30:
+        raise InvalidInputError(f"{ob.name!r} is scaled to zero (or flattened): its control points cannot be "
+                                "placed on it. Give it a scale")
+    to_local = np.linalg.inv(world) @ np.array(src.matrix_world)
     return pos.astype(np.float64) @ to_local[:3, :3].T + to_local[:3, 3]
 
 

@@ -43,7 +43,7 @@ def _curvature_lines(ob, settings):
     4.5; poly splines as they are), radius (x Radius, like a bevel) and tilt along each segment."""
     sampling = CurveSampling(mode="CURVATURE", max_segments=settings.max_segments)
     points, radius, tilt, counts, cyclic, materials = [], [], [], [], [], []
-    for sp in curve_bridge.read_splines(ob.data):
+    for sp in curve_bridge.read_splines(ob.data, ob.name):
         if sp.kind == "BEZIER" and len(sp.co) >= 2:
             [a] = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic, sampling)
             pts, rad, til = a.points, a.radius, a.tilt

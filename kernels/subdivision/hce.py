@@ -286,6 +286,9 @@ def pack_container(trees, triangles, channels):
 def unpack_container(blob, triangles):
     """`HceMesh` from `pack_container` bytes, for these coarse triangles; raises `InvalidInputError` when the
     bytes are not an HCE or belong to other triangles (the mesh was edited after the bake)."""
+    if not isinstance(blob, bytes | bytearray | memoryview):
+        raise InvalidInputError(f"The mesh's stored baked lighting holds a {type(blob).__name__}, not the bytes a bake "
+                                "writes: delete its tessera_hce property, or bake the lighting again")
     blob = bytes(blob)
     head = len(MAGIC) + 8 + 16
     if len(blob) < head or not blob.startswith(MAGIC):

@@ -460,3 +460,91 @@ def test_a_refusal_leaves_no_undo_step_and_survives_save_and_reload(clean_scene,
     bpy.ops.wm.open_mainfile(filepath=str(path))
     scene = {name: sorted(b.name for b in getattr(bpy.data, name)) for name in ("objects", "meshes")}
     assert scene == {name: before[0][name] for name in ("objects", "meshes")}  # orphans are not saved
+
+
+def _live_surface(bpy, vertices):
+    """A live parametric surface whose Control Points is a mesh of ``vertices``; returns (surface, points)."""
+    assert bpy.ops.tessera.parametric_surface_add(output="LIVE") == {"FINISHED"}
+    live = bpy.context.active_object
+    me = bpy.data.meshes.new("Points")
+    me.from_pydata(vertices, [], [])
+    points = bpy.data.objects.new("Points", me)
+    bpy.context.scene.collection.objects.link(points)
+    live.tessera.surface.instance_object = points
+    select_only(bpy, live)
+    return live, points
+
+
+@pytest.mark.parametrize("vertices, scale, words", [
+    ([], 1.0, ["'Points'", "no vertices"]),
+    ([(0, 0, 0), (float("nan"), 0, 0), (1, 1, 1)], 1.0, ["Vertex 1", "'Points'", "NaN"]),
+    ([(0, 0, 0), (1, 0, 0)], 0.0, ["scaled to zero", "scale"]),
+])
+def test_live_surface_control_points_are_checked_by_name(clean_scene, bpy_module, vertices, scale, words):
+    bpy = bpy_module
+    live, _ = _live_surface(bpy, vertices)
+    live.scale = (scale,) * 3
+    bpy.context.view_layer.update()
+    refused(bpy, bpy.ops.tessera.parametric_surface_bake, words)
+
+
+def _bezier(bpy, middle):
+    data = bpy.data.curves.new("Bent", "CURVE")
+    data.dimensions = "3D"
+    spline = data.splines.new("BEZIER")
+    spline.bezier_points.add(2)
+    for i, p in enumerate(spline.bezier_points):
+        p.co, p.handle_left, p.handle_right = (i, 0, 0), (i - 0.3, 0.2, 0), (i + 0.3, -0.2, 0)
+    spline.bezier_points[1].co = middle
+    ob = bpy.data.objects.new("Bent", data)
+    bpy.context.scene.collection.objects.link(ob)
+    select_only(bpy, ob)
+    return ob
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), 3e38])
+def test_curve_points_at_nan_or_beyond_the_world_are_refused_where_they_enter(clean_scene, bpy_module, value):
+    bpy = bpy_module
+    _bezier(bpy, (value, 0.0, 0.0))
+    refused(bpy, bpy.ops.tessera.curve_adaptive, ["Spline 0", "'Bent'", "point 1"])
+
+
+def test_vector_field_grid_named_wrong_empty_or_no_active_object(clean_scene, bpy_module):
+    bpy = bpy_module
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    bpy.context.scene.camera = cam
+    cam.location = (0.0, -5.0, 1.0)
+    bpy.context.view_layer.objects.active = None
+    refused(bpy, bpy.ops.tessera.vector_field_texture, ["No object named 'Nope'"], field="MESH", field_object="Nope")
+    empty = bpy.data.objects.new("Grid", bpy.data.meshes.new("Grid"))
+    bpy.context.scene.collection.objects.link(empty)
+    refused(bpy, bpy.ops.tessera.vector_field_texture, ["'Grid'", "no vertices"], field="MESH", field_object="Grid")
+    n = len(bpy.data.images)
+    assert bpy.ops.tessera.vector_field_texture(width=64, height=64) == {"FINISHED"}  # a camera and no active object
+    assert len(bpy.data.images) == n + 1
+
+
+def test_a_foreign_hce_property_is_named_and_the_subdivision_still_runs(clean_scene, bpy_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1)
+    ob = bpy.context.active_object
+    ob.data["tessera_hce"] = "not a bake"
+    assert bpy.ops.tessera.loop_subdivide(levels=1) == {"FINISHED"}
+    from tessera.kernels.common.errors import InvalidInputError
+    from tessera.kernels.subdivision import hce
+
+    with pytest.raises(InvalidInputError, match="holds a str"):
+        hce.unpack_container("not a bake", np.zeros((1, 3), np.int32))
+
+
+def test_a_nan_nailboard_setting_is_skipped_by_the_preview_and_named_by_the_panel(clean_scene, bpy_module,
+                                                                                 addon_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add()
+    s = bpy.context.active_object.tessera.nailboard
+    s.tolerance = float("nan")
+    preview = addon_module("addon.impostors.preview")
+    assert not preview._finite(s)
+    s.tolerance = 2.0
+    assert preview._finite(s)
