@@ -19,6 +19,7 @@ where it reads them.
 
 import functools
 import math
+import re
 import traceback
 
 import bpy
@@ -103,6 +104,26 @@ def failure_message(err):
     return f"Tessera failed: {what} — nothing was changed (details in the system console)"
 
 
+#: OpenCL status names that mean a device (or the host, for PoCL) ran out of memory.
+_CL_OUT_OF_MEMORY = ("MEM_OBJECT_ALLOCATION_FAILURE", "OUT_OF_RESOURCES", "OUT_OF_HOST_MEMORY")
+
+
+def out_of_memory_message(err):
+    """The reason to give when an allocation failed after the estimates let a run start (numpy's MemoryError, an
+    OpenCL device's allocation failure), or None for any other exception."""
+    text = str(err)
+    if isinstance(err, MemoryError):
+        size = re.search(r"allocate ([\d.,]+ ?[KMGT]i?B)", text)
+        where = f"could not allocate {size.group(1).replace('. ', ' ')}" if size else "an allocation failed"
+        return (f"Out of memory: {where}, and nothing was changed. Use smaller settings (fewer levels, a lower Max "
+                "Level, fewer copies), lower the memory budget in the Tessera preferences so that such runs are "
+                "refused before they start, or close other programs")
+    if type(err).__module__.startswith("pyopencl") and any(name in text for name in _CL_OUT_OF_MEMORY):
+        return ("The OpenCL device ran out of memory, and nothing was changed. Use smaller settings, or set OpenCL "
+                "to Off in the Tessera preferences to compute on the CPU with numpy")
+    return None
+
+
 def guarded(execute):
     """Decorate ``execute(self, context, tx)`` into Blender's ``execute(self, context)`` (see the module)."""
 
@@ -119,7 +140,7 @@ def guarded(execute):
         except Exception as err:  # noqa: BLE001 - the guard: no traceback may escape to the user
             traceback.print_exc()
             tx.rollback()
-            self.report({"ERROR"}, failure_message(err))
+            self.report({"ERROR"}, out_of_memory_message(err) or failure_message(err))
             return {"CANCELLED"}
         if "CANCELLED" in result:
             tx.rollback()

@@ -30,13 +30,24 @@ from ..addon.surfaces.settings import (
 )
 from ..addon.surfaces.sources import control_points
 from ..kernels.common import nurbs
-from ..kernels.common.bezier_curves import MAX_TOLERANCE_SEGMENTS, CurveSampling, adaptive_nurbs, adaptive_spline
-from ..kernels.common.errors import BudgetError, GPUContextError, InvalidInputError
+from ..kernels.common.bezier_curves import (
+    MAX_TOLERANCE_SEGMENTS,
+    CurveSampling,
+    adaptive_nurbs,
+    adaptive_spline,
+    offset_copies,
+)
+from ..kernels.common.budget import check_bytes
+from ..kernels.common.errors import GPUContextError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
 from ..kernels.surfaces.domain_mesh import surface_mesh
 from .selection import object_poll, place_mesh, select_only
+
+#: Memory per point of an adaptive polyline: Blender's curve point (position and weight, radius, tilt, flags) and the
+#: float64 arrays it is written from.
+_BYTES_PER_CURVE_POINT = 96
 
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
@@ -120,9 +131,7 @@ class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
         budget = get_preferences(context).memory_budget_bytes
         per = surface_mesh(surface_from(s), s.factor)
         size = len(points) * (per.positions.nbytes + per.triangles.nbytes + per.uvs.nbytes) * 4
-        if budget and size > budget:
-            raise BudgetError(f"{len(points):,} surfaces at factor {s.factor} need about {size / 2**20:,.0f} MiB, "
-                              f"over the memory budget of {budget / 2**20:,.0f} MiB: lower the Factor")
+        check_bytes(size, budget, f"{len(points):,} surfaces at factor {s.factor} would be made", "a lower Factor")
         data = tx.track(bridge.write_mesh(f"{ob.name}.baked", _surface_arrays(per, points)))
         data.shade_smooth()
         new = tx.new_object(f"{ob.name}.baked", data)
@@ -157,30 +166,33 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         if self.mode == "SCREEN":
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
                                    ob.matrix_world)
-        out, counts, over = [], [], 0
+        once = dataclasses.replace(settings, copies=1)  # sampled once; the copies only after the budget allows them
+        sampled, counts, over = [], [], 0
         for k, sp in enumerate(curve_bridge.read_splines(ob.data, ob.name)):
             if sp.kind in ("BEZIER", "NURBS") and len(sp.co) < 2:
                 raise InvalidInputError(f"Spline {k} of {ob.name!r} has a single point: delete it or add points")
             if sp.kind == "BEZIER":
-                made = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic,
-                                       settings, camera)
+                a = adaptive_spline(sp.co, sp.handle_left, sp.handle_right, sp.radius, sp.tilt, sp.cyclic, once,
+                                    camera)[0]
             elif sp.kind == "NURBS":
-                made = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic), sp.radius,
-                                      sp.tilt, settings, camera, what=f"NURBS spline {k}")
+                a = adaptive_nurbs(sp.co, sp.weight, nurbs.Direction(sp.order, sp.knot_mode, sp.cyclic), sp.radius,
+                                   sp.tilt, once, camera, what=f"NURBS spline {k}")[0]
             else:
-                offset = np.asarray(settings.offset, np.float64)
-                for c in range(settings.copies):
-                    out.append(curve_bridge.SplineArrays("POLY", sp.co + offset * c / settings.copies, None, None,
-                                                         sp.radius, sp.tilt, sp.cyclic, sp.material_index))
+                sampled.append((sp.co, sp.radius, sp.tilt, sp.cyclic, sp.material_index))
                 continue
-            for a in made:
-                out.append(curve_bridge.SplineArrays("POLY", a.points, None, None, a.radius, a.tilt, a.cyclic,
-                                                     sp.material_index))
-            counts.append(made[0].counts)
-            if made[0].deviation is not None and settings.mode == "TOLERANCE":
-                over += int((made[0].deviation > settings.tolerance).sum())
-        if not out:
+            sampled.append((a.points, a.radius, a.tilt, a.cyclic, sp.material_index))
+            counts.append(a.counts)
+            if a.deviation is not None and settings.mode == "TOLERANCE":
+                over += int((a.deviation > settings.tolerance).sum())
+        if not sampled:
             raise InvalidInputError(f"Curve {ob.name!r} has no spline to sample: add one, or select another curve")
+        n_points = sum(len(s[0]) for s in sampled) * settings.copies
+        check_bytes(n_points * _BYTES_PER_CURVE_POINT, get_preferences(context).memory_budget_bytes,
+                    f"The polylines would have {n_points:,} points", "fewer Copies, fewer Max Segments or a larger "
+                    "Tolerance")
+        out = [curve_bridge.SplineArrays("POLY", p, None, None, radius, tilt, cyclic, material)
+               for points, radius, tilt, cyclic, material in sampled
+               for p in offset_copies(points, settings.copies, settings.offset)]
         data = tx.track(curve_bridge.write_poly_curve(f"{ob.data.name}.adaptive", out, ob.data.dimensions))
         place_mesh(context, tx, ob, data, "NEW_OBJECT", "adaptive")
         seg = np.concatenate(counts) if counts else np.zeros(0, np.int64)

@@ -11,7 +11,8 @@ from ..addon.guarded import check_numbers, guarded
 from ..addon.preferences import get_preferences
 from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
-from ..kernels.common.errors import BudgetError, EmptyResultError, InvalidInputError
+from ..kernels.common.budget import check_bytes
+from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.terrain.lod import box_distance, select
 from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
@@ -53,12 +54,8 @@ def _bake_into(context, ob, camera, report, tx):
     n_tris = triangle_count(sel)
     if n_tris == 0:  # every tile culled: say which of the camera's settings keeps the terrain out
         raise EmptyResultError(_nothing_seen(hm, table, local_camera))
-    budget = get_preferences(context).memory_budget_bytes
-    if budget and n_tris * _BYTES_PER_TRIANGLE > budget:
-        raise BudgetError(f"The terrain mesh would have {n_tris:,} triangles (about "
-                          f"{n_tris * _BYTES_PER_TRIANGLE / 2**20:,.0f} MiB), over the memory budget of "
-                          f"{budget / 2**20:,.0f} MiB. Raise the error in pixels, use Adaptive levels, or raise "
-                          "the budget in the Tessera preferences.")
+    check_bytes(n_tris * _BYTES_PER_TRIANGLE, get_preferences(context).memory_budget_bytes,
+                f"The terrain mesh would have {n_tris:,} triangles", "a larger Screen Error or Adaptive levels")
     wm.progress_update(85)
     mesh = bake(hm, table, sel)
     tx.track(terrain_data.write_terrain_mesh(ob, f"{ob.name}.terrain", mesh))

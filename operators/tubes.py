@@ -8,7 +8,8 @@ from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
 from ..addon.tubes.settings import TubeOptions, copy_tubes_settings, draw_tubes_settings, kernel_settings
 from ..addon.tubes.sources import SOURCE_TYPES, read_lines
-from ..kernels.common.errors import BudgetError, EmptyResultError
+from ..kernels.common.budget import check_bytes
+from ..kernels.common.errors import EmptyResultError
 from ..kernels.tubes.builder import build_tubes
 from .selection import select_only
 
@@ -86,10 +87,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
         sides = settings.sides if settings.sides_mode == "FIXED" else settings.max_sides
         verts = len(lines.points) * sides * max(1, settings.refine)
         need = verts * (_BYTES_PER_VERTEX + 4 * _BYTES_PER_CORNER + 2 * _BYTES_PER_EDGE)
-        if budget and need > budget:
-            raise BudgetError(f"The tubes would have about {verts:,} vertices and need about {need / 2**20:,.0f} MiB, "
-                              f"over the memory budget of {budget / 2**20:,.0f} MiB. Use fewer sides, or raise "
-                              "the budget in the Tessera preferences.")
+        check_bytes(need, budget, f"The tubes would have about {verts:,} vertices", "fewer sides")
 
     def _place(self, tx, ob, mesh):
         for material in getattr(ob.data, "materials", ()):

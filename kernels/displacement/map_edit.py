@@ -16,7 +16,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..common.errors import BudgetError, InvalidInputError, TesseraError
+from ..common.budget import check_bytes
+from ..common.errors import InvalidInputError, TesseraError
 from ..common.opencl_runtime import backend_runtime
 from ..common.typed_kernel import TypedKernel
 from . import dab_batch
@@ -36,11 +37,7 @@ def check_map_budget(width, height, channels, budget_bytes):
     """Raise `BudgetError` when a ``width`` x ``height`` map with ``channels`` would need more than
     ``budget_bytes`` (0 or None: no limit) while edited."""
     need = int(width) * int(height) * (MAP_BYTES_PER_TEXEL + MAP_BYTES_PER_CHANNEL * int(channels))
-    if budget_bytes and need > budget_bytes:
-        raise BudgetError(f"A {width} x {height} map needs about {need / 2**20:,.0f} MiB while it is edited, over "
-                          f"the memory budget of {budget_bytes / 2**20:,.0f} MiB. Use a smaller map, or raise the "
-                          "budget in the Tessera preferences.")
-    return need
+    return check_bytes(need, budget_bytes, f"A {width} x {height} map would be edited", "a smaller map")
 
 
 def check_map(dmap):

@@ -295,7 +295,7 @@ def loop_subdivide(positions, triangles, levels, creases=None, vertex_sharpness=
     widths = [v.shape[1] for v in point_data.values()]
     est = estimate(len(pos), len(lv.edges), len(tris), levels, sum(widths),
                    sum(v.shape[2] for v in corner_data.values()))
-    check_budget(est, budget_bytes, "the levels")
+    check_budget(est, budget_bytes, "fewer levels")
 
     runtime = _runtime(backend, lv, est)
     fvars = {}

@@ -492,7 +492,7 @@ def _tessellate_once(h, lod, camera, budget_bytes):
     el, inner = patch_levels(h, edges, lod, camera)
     if "TOLERANCE" in lod.metrics:  # a side as fine as the patches beside it: no stretched triangles along it
         el = _sides_keep_up(el, inner, edges)
-    lower = "Max Level, or raise the Tolerance" if "TOLERANCE" in lod.metrics else "Max Level"
+    lower = "a lower Max Level or a larger Tolerance" if "TOLERANCE" in lod.metrics else "a lower Max Level"
     check_budget(estimate(el, inner), budget_bytes, lower)
     mesh = tessellate_patches(h, el, inner, edges)
     if "TOLERANCE" not in lod.metrics:

@@ -20,6 +20,7 @@ never shown.
 
 import numpy as np
 
+from ..common.budget import check_bytes
 from ..common.errors import BudgetError, InvalidInputError
 from .sample_grid import SampleGrid
 
@@ -126,13 +127,14 @@ class FilledGrid(SampleGrid):
         x0, x1 = int(cx.min()) * CELL, min(w, (int(cx.max()) + 1) * CELL)
         wy0, wy1, wx0, wx1 = max(0, y0 - CELL), min(h, y1 + CELL), max(0, x0 - CELL), min(w, x1 + CELL)
         need = (wy1 - wy0) * (wx1 - wx0) * FILL_BYTES_PER_SAMPLE + self._kept
-        if budget_bytes and need > budget_bytes:
-            if self.cut:  # never shown: the analysis sees the mean of the valid ground in the window
-                return y0, x0, np.broadcast_to(self._window_mean(wy0, wy1, wx0, wx1), (y1 - y0, x1 - x0))
-            raise BudgetError(
-                f"A no-data void of {name_size(x1 - x0, y1 - y0)} in {self.name} needs about {need / 2**20:,.0f} MiB "
-                f"to fill, over the memory budget of {budget_bytes / 2**20:,.0f} MiB. Choose Voids: Holes, or raise "
-                "the budget in the Tessera preferences")
+        try:
+            check_bytes(need, budget_bytes, f"A no-data void of {name_size(x1 - x0, y1 - y0)} in {self.name} would "
+                        "be filled", "No-Data: Holes")
+        except BudgetError:
+            if not self.cut:
+                raise
+            # never shown: the analysis sees the mean of the valid ground in the window
+            return y0, x0, np.broadcast_to(self._window_mean(wy0, wy1, wx0, wx1), (y1 - y0, x1 - x0))
         self._kept += (y1 - y0) * (x1 - x0) * 4
         window = np.concatenate([self.raw.band(r, min(wy1, r + CELL))[:, wx0:wx1] for r in range(wy0, wy1, CELL)])
         valid = ~np.isnan(window)

@@ -125,6 +125,60 @@ def test_an_unexpected_failure_is_reported_and_nothing_is_left(clean_scene, bpy_
     assert not [m.name for m in bpy.data.meshes if m.name.endswith(".tubes")]  # both meshes, the failed one too
 
 
+@pytest.mark.parametrize("error, words", [
+    (MemoryError("Unable to allocate 183. MiB for an array with shape (24008000,) and data type float64"),
+     ["Out of memory", "could not allocate 183 MiB", "nothing was changed", "memory budget"]),
+])
+def test_running_out_of_memory_anyway_is_named_and_nothing_is_left(clean_scene, bpy_module, addon_module,
+                                                                   monkeypatch, error, words):
+    """An allocation that fails although the estimate let the run start gives its own reason, not "Tessera failed"."""
+    bpy = bpy_module
+    tubes_op = addon_module("operators.tubes")
+    ob = poly_curve(bpy, [(0, 0, 0), (1, 0, 0)], "A")
+
+    def fails(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(tubes_op, "build_tubes", fails)
+    select_only(bpy, ob)
+    message = refused(bpy, bpy.ops.tessera.tubes, words)
+    assert "Tessera failed" not in message
+
+
+def test_a_run_larger_than_the_free_memory_is_refused_before_it_allocates(tmp_path):
+    """Under an address-space limit (ulimit -v) and with no memory budget, Loop subdivision of a big grid is
+    refused by the estimate, with the free memory in the message: the process neither aborts in PoCL nor fails in
+    numpy."""
+    import subprocess
+    import sys
+
+    from conftest import REPO_DIR
+
+    script = f"""
+import resource, sys
+sys.path.insert(0, {str(REPO_DIR)!r})
+import bpy
+bpy.context.preferences.extensions.repos.new(name="lim", module="lim", custom_directory={str(REPO_DIR)!r},
+                                             source="USER")
+bpy.ops.preferences.addon_enable(module="bl_ext.lim.tessera")
+bpy.context.preferences.addons["bl_ext.lim.tessera"].preferences.memory_budget_mb = 0
+bpy.ops.mesh.primitive_grid_add(x_subdivisions=400, y_subdivisions=400)
+from tessera.kernels.common.budget import _proc_kib
+mapped = _proc_kib("/proc/self/status", "VmSize") * 1024
+resource.setrlimit(resource.RLIMIT_AS, (mapped + 1536 * 2**20, resource.RLIM_INFINITY))
+try:
+    bpy.ops.tessera.loop_subdivide(levels=4)
+    print("RESULT finished")
+except RuntimeError as err:
+    print("RESULT " + str(err).replace(chr(10), " "))
+"""
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=600,
+                          cwd=str(tmp_path))
+    result = [line for line in proc.stdout.splitlines() if line.startswith("RESULT")]
+    assert proc.returncode == 0 and result, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "memory is free" in result[0] and "fewer levels" in result[0], result[0]
+
+
 def _height_image(bpy, size=33):
     img = bpy.data.images.new("hm", size, size, float_buffer=True)
     px = np.zeros((size, size, 4), np.float32)
@@ -548,3 +602,26 @@ def test_a_nan_nailboard_setting_is_skipped_by_the_preview_and_named_by_the_pane
     assert not preview._finite(s)
     s.tolerance = 2.0
     assert preview._finite(s)
+
+
+def test_adaptive_polylines_with_many_copies_are_refused_before_they_are_made(clean_scene, bpy_module):
+    """200 splines at a tolerance their Max Segments cannot reach, 1,000 copies each: refused by the budget, with
+    the points counted, before a copy is made; the same curve with a few copies is made."""
+    bpy = bpy_module
+    data = bpy.data.curves.new("Hair", "CURVE")
+    data.dimensions = "3D"
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        spline = data.splines.new("BEZIER")
+        spline.bezier_points.add(3)
+        for i, p in enumerate(spline.bezier_points):
+            co = rng.normal(size=3) + (i, 0, 0)
+            p.co, p.handle_left, p.handle_right = co, co + rng.normal(size=3), co + rng.normal(size=3)
+    ob = bpy.data.objects.new("Hair", data)
+    bpy.context.scene.collection.objects.link(ob)
+    select_only(bpy, ob)
+    refused(bpy, bpy.ops.tessera.curve_adaptive, ["points", "memory budget", "fewer Copies"], mode="TOLERANCE",
+            tolerance=1e-9, max_segments=1024, copies=1000)
+    assert bpy.ops.tessera.curve_adaptive(tolerance=1e-3, copies=3) == {"FINISHED"}
+    made = bpy.context.active_object
+    assert len(made.data.splines) == 600
