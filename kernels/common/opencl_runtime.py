@@ -21,7 +21,10 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import InvalidInputError, OpenCLUnavailableError, TesseraError
+import numpy as np
+
+from .budget import check_bytes
+from .errors import BudgetError, InvalidInputError, OpenCLUnavailableError, TesseraError
 from .typed_kernel import TypedKernel
 
 log = logging.getLogger(__name__)
@@ -82,6 +85,31 @@ class Runtime:
                         from err
                 self._programs[key] = prg
         return self._programs[key]
+
+    @property
+    def host_memory(self):
+        """Whether the device allocates its buffers in this process's memory (a CPU device such as PoCL)."""
+        return bool(self.device.type & self.cl.device_type.CPU) or bool(self.device.host_unified_memory)
+
+    def buffer(self, flags, size=0, hostbuf=None):
+        """``cl.Buffer(context, flags, size, hostbuf)``, made only once it can be had: at most the device's largest
+        allocation, and on a device that allocates in host memory the bytes the system can still give
+        (`budget.free_bytes`: PoCL ends the whole process when its host allocation fails). Raises `BudgetError`
+        saying what to change; an allocation the driver refuses anyway becomes one too."""
+        nbytes = int(size) if size else int(np.asarray(hostbuf).nbytes) if hostbuf is not None else 0
+        largest = int(self.device.max_mem_alloc_size)
+        if nbytes > largest:
+            raise BudgetError(f"The OpenCL device {self.description} allocates at most {largest / 2**20:,.0f} MiB "
+                              f"at once; this needs {nbytes / 2**20:,.0f} MiB. Use smaller settings, or set OpenCL "
+                              "to Off in the Tessera preferences")
+        if self.host_memory:
+            check_bytes(nbytes, 0, "A buffer of the OpenCL device would be made", "smaller settings")
+        try:
+            return self.cl.Buffer(self.context, flags, size, hostbuf=hostbuf)
+        except self.cl.MemoryError as err:
+            raise BudgetError(f"The OpenCL device {self.description} could not allocate {nbytes / 2**20:,.0f} MiB "
+                              f"({err}). Use smaller settings, or set OpenCL to Off in the Tessera preferences") \
+                from err
 
     def shared(self, host, read_only=False):
         """A buffer on ``host`` memory (``USE_HOST_PTR``: no copy on a CPU device such as PoCL); ``host`` must

@@ -84,14 +84,14 @@ def launch(device, rows, regions):
     ``regions`` on ``device`` (a `MapBuffer`, brought up to date with host edits first). Returns the bounding box;
     nothing is read back."""
     rt = device.runtime
-    cl, mf = rt.cl, rt.cl.mem_flags
+    mf = rt.cl.mem_flags
     regions = np.asarray(regions, np.int64).reshape(-1, 4)
     box = (int(regions[:, 0].min()), int(regions[:, 1].min()), int(regions[:, 2].max()), int(regions[:, 3].max()))
     size = bin_size(regions)
     bin_start, bin_dabs, bins_x = bins(regions, box, size)
     floats = np.stack([r[0] for r in rows])
     ints = np.stack([r[1] for r in rows])
-    inputs = [cl.Buffer(rt.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
+    inputs = [rt.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
               for a in (floats, ints, bin_start, bin_dabs)]
     x0, y0, x1, y1 = box
     h, w, channels = device.host.shape

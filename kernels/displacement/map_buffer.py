@@ -50,7 +50,7 @@ class MapBuffer:
         self.runtime = runtime
         self.host = dmap
         cl = runtime.cl
-        self.buf = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=dmap)
+        self.buf = runtime.buffer(cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=dmap)
         self._scratch = None
         self._scratch_bytes = 0
         self._stamp = (None, None)  # (host array, device buffer) of the last stamp
@@ -140,7 +140,7 @@ class MapBuffer:
         origin, size = self._rect(region)
         nbytes = size[0] * size[1]
         if nbytes > self._scratch_bytes:
-            self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, nbytes)
+            self._scratch = self.runtime.buffer(cl.mem_flags.READ_WRITE, nbytes)
             self._scratch_bytes = nbytes
         cl.enqueue_copy(self.runtime.queue, self._scratch, self.buf, src_origin=origin, dst_origin=(0, 0),
                         region=size, src_pitches=(self.row_bytes,), dst_pitches=(size[0],))
@@ -157,10 +157,10 @@ class MapBuffer:
         self._check_not_deferred("A whole-map smooth")
         self.sync()
         if self._scratch_bytes != self.host.nbytes:
-            self._scratch = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE, self.host.nbytes)
+            self._scratch = self.runtime.buffer(cl.mem_flags.READ_WRITE, self.host.nbytes)
             self._scratch_bytes = self.host.nbytes
         bad = np.zeros(1, np.int32)
-        d_bad = cl.Buffer(self.runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=bad)
+        d_bad = self.runtime.buffer(cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=bad)
         n = w * c
         kernel = self.runtime.kernel(MAP_PROGRAM, "smooth_all")
         kernel(self.runtime.queue, ((n + 7) // 8, h), None, self.buf, self._scratch, d_bad, np.int32(n), np.int32(h),
@@ -177,6 +177,6 @@ class MapBuffer:
         """Device copy of a stamp map; the last one is kept while the same array is used."""
         if self._stamp[0] is not stamp:
             cl = self.runtime.cl
-            self._stamp = (stamp, cl.Buffer(self.runtime.context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR,
+            self._stamp = (stamp, self.runtime.buffer(cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR,
                                             hostbuf=stamp))
         return self._stamp[1]

@@ -442,25 +442,24 @@ def _run_opencl(runtime, dmap, region, name, args, halo, device, pull=True):
     an uploaded tile."""
     cl = runtime.cl
     mf = cl.mem_flags
-    ctx = runtime.context
     x0, y0, x1, y1 = region
     w, h, channels = x1 - x0, y1 - y0, dmap.shape[2]
     if device is not None:
         buf, base, mem_w = device.sync(), (y0 * dmap.shape[1] + x0) * channels, dmap.shape[1]
     else:
         tile = dmap[y0:y1, x0:x1].copy()  # scratch (a copy even when the region is the whole map)
-        buf, base, mem_w = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w
+        buf, base, mem_w = runtime.buffer(mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=tile), 0, w
     extra = []
     if name == "smooth":
         hx0, hy0, hx1, hy1 = halo
         if device is not None:
             src = device.snapshot(halo)
         else:
-            src = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
+            src = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(dmap[hy0:hy1, hx0:hx1]))
         extra = [src, np.int32(hx1 - hx0), np.int32(hy1 - hy0), np.int32(hx0), np.int32(hy0)]
     if name == "stamp":
         st = args[0]
-        st_buf = device.stamp_buffer(st) if device is not None else cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR,
+        st_buf = device.stamp_buffer(st) if device is not None else runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR,
                                                                               hostbuf=st)
         extra = [st_buf, np.int32(st.shape[1]), np.int32(st.shape[0])]
         args = args[1:]
@@ -488,9 +487,9 @@ def morph(a, b, time, backend="auto"):
     cl = runtime.cl
     mf = cl.mem_flags
     out = np.empty_like(a)
-    d_a = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
-    d_b = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=b)
-    d_out = cl.Buffer(runtime.context, mf.WRITE_ONLY, out.nbytes)
+    d_a = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a)
+    d_b = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=b)
+    d_out = runtime.buffer(mf.WRITE_ONLY, out.nbytes)
     runtime.kernel(ref.MAP_PROGRAM, "morphing")(runtime.queue, (a.size,), None, d_a, d_b, d_out, np.int64(a.size),
                                           np.float32(t))
     cl.enqueue_copy(runtime.queue, out, d_out)
@@ -544,7 +543,7 @@ def apply_custom(dmap, kernel, runtime, region=None, args=((0, 0, 0, 0),) * 4, d
     vals = [_f4(_finite(f"arg{i + 1}", a)) for i, a in enumerate(args)]
     tile = dmap[y0:y1, x0:x1].copy()  # scratch: never a view of the map, even when the region is all of it
     cl = runtime.cl
-    d_tile = cl.Buffer(runtime.context, cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
+    d_tile = runtime.buffer(cl.mem_flags.READ_WRITE | cl.mem_flags.COPY_HOST_PTR, hostbuf=tile)
     kernel(runtime.queue, (x1 - x0, y1 - y0), None, d_tile, np.int64(0), np.int32(x1 - x0), np.int32(dmap.shape[2]),
            np.int32(x0), np.int32(y0), np.int32(x1 - x0), np.int32(y1 - y0), *vals)
     cl.enqueue_copy(runtime.queue, tile, d_tile)

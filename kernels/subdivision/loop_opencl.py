@@ -37,12 +37,12 @@ class _Run:
         self.queue = runtime.queue
 
     def buf(self, nbytes):
-        return self.cl.Buffer(self.rt.context, self.cl.mem_flags.READ_WRITE, max(int(nbytes), 1))
+        return self.rt.buffer(self.cl.mem_flags.READ_WRITE, max(int(nbytes), 1))
 
     def upload(self, array):
         a = np.ascontiguousarray(array)
         mf = self.cl.mem_flags
-        return self.cl.Buffer(self.rt.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a if a.size else np.zeros(1))
+        return self.rt.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a if a.size else np.zeros(1))
 
     def fill(self, buf, value, count, dtype):
         self.cl.enqueue_fill_buffer(self.queue, buf, np.array(value, dtype), 0, int(count) * np.dtype(dtype).itemsize)

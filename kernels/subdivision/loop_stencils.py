@@ -106,10 +106,10 @@ def apply_opencl(runtime, table, values):
         values = values[:, None]
 
     def upload(a, dtype):
-        return cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a, dtype))
+        return runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.ascontiguousarray(a, dtype))
 
     out = np.empty((table.n_vertices, values.shape[1]))
-    dst = cl.Buffer(runtime.context, mf.WRITE_ONLY, out.nbytes)
+    dst = runtime.buffer(mf.WRITE_ONLY, out.nbytes)
     n_f, width_p = table.patch.shape
     kernel = runtime.kernel("subdivision/loop_stencil", "apply_stencils")
     i64, f64 = np.int64, np.float64

@@ -12,9 +12,9 @@ def ham_on_device(runtime, heights, inv_texel=1.0):
     h = np.ascontiguousarray(heights, np.float32)
     rows, width = h.shape
     mf = cl.mem_flags
-    d_h = cl.Buffer(runtime.context, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=h)
-    d_m = cl.Buffer(runtime.context, mf.READ_WRITE, h.nbytes)
-    d_ham = cl.Buffer(runtime.context, mf.READ_WRITE, h.nbytes)
+    d_h = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=h)
+    d_m = runtime.buffer(mf.READ_WRITE, h.nbytes)
+    d_ham = runtime.buffer(mf.READ_WRITE, h.nbytes)
     sobel = runtime.kernel("terrain/terrain_ham", "sobel_mag")
     size = (width, rows)
     sobel(runtime.queue, size, None, d_h, d_m, np.int32(width), np.int32(rows), np.float32(inv_texel))
@@ -40,7 +40,7 @@ def analyse_on_device(runtime, hm, table):
     ntx, nty = table.counts
     rows, width = table.shape
     outs = [np.empty((nty, ntx), np.float32) for _ in range(3)] + [np.empty((nty, ntx), np.int32) for _ in range(2)]
-    bufs = [cl.Buffer(runtime.context, cl.mem_flags.WRITE_ONLY, o.nbytes) for o in outs]
+    bufs = [runtime.buffer(cl.mem_flags.WRITE_ONLY, o.nbytes) for o in outs]
     stats = runtime.kernel("terrain/terrain_ham", "tile_stats")
     stats(runtime.queue, (ntx, nty), None, d_ham, d_h, np.int32(width), np.int32(rows), np.int32(table.tile_size),
           np.int32(ntx), np.int32(nty), *bufs)

@@ -70,14 +70,13 @@ def gather_weighted_opencl(runtime, values, idx, weights):
     if n == 0:
         return out
     mf = cl.mem_flags
-    ctx = runtime.context
     vals = np.ascontiguousarray(values, dtype=np.float32)
     ids = np.ascontiguousarray(idx, dtype=np.int32)
     wts = np.ascontiguousarray(weights, dtype=np.float32)
-    d_vals = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=vals)
-    d_ids = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=ids)
-    d_wts = cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=wts)
-    d_out = cl.Buffer(ctx, mf.WRITE_ONLY, out.nbytes)
+    d_vals = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=vals)
+    d_ids = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=ids)
+    d_wts = runtime.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=wts)
+    d_out = runtime.buffer(mf.WRITE_ONLY, out.nbytes)
     kernel = runtime.kernel("tessellation/gather_weighted", "gather_weighted")
     kernel(runtime.queue, (n,), None, d_vals, np.int32(channels), d_ids, d_wts, np.int32(taps), d_out, np.int32(n))
     cl.enqueue_copy(runtime.queue, out, d_out)

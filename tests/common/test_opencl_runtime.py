@@ -212,3 +212,26 @@ def test_warm_up_builds_every_shipped_program(opencl):
     built = dict(runtime._programs)
     assert {(name, ()) for name in names} <= set(built)
     assert all(runtime.program(name) is built[(name, ())] for name in names)
+
+
+@pytest.mark.opencl
+def test_device_buffers_are_refused_before_the_allocator_can_fail(opencl, monkeypatch):
+    """PoCL ends the process when a host allocation fails: every device buffer is checked first, against the
+    device's largest allocation and, on a device in host memory, against the memory the system can still give."""
+    from tessera.kernels.common import budget
+    from tessera.kernels.common.errors import BudgetError
+
+    mf = opencl.cl.mem_flags
+    small = opencl.buffer(mf.READ_WRITE, 4096)
+    assert small.size == 4096
+    largest = int(opencl.device.max_mem_alloc_size)
+    with pytest.raises(BudgetError, match="allocates at most"):
+        opencl.buffer(mf.READ_WRITE, largest + 1)
+    if opencl.host_memory:
+        monkeypatch.setattr(budget, "free_bytes", lambda: 2**20)
+        with pytest.raises(BudgetError, match="memory is free"):
+            opencl.buffer(mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=np.zeros(2**19))  # 4 MiB
+        # an operation on the device refuses the same way, before any kernel runs
+        with pytest.raises(BudgetError, match="memory is free"):
+            interpolate.gather_weighted_opencl(opencl, np.zeros((300000, 3), np.float32),
+                                               np.zeros((300000, 3), np.int64), np.ones((300000, 3), np.float32))
