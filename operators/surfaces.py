@@ -48,6 +48,9 @@ from .selection import object_poll, place_mesh, select_only
 #: Memory per point of an adaptive polyline: Blender's curve point (position and weight, radius, tilt, flags) and the
 #: float64 arrays it is written from.
 _BYTES_PER_CURVE_POINT = 96
+#: Memory per pixel of a vector-field texture: the splat sums and counts (float64), the RGBA pixels written, and
+#: Blender's float image with its packed copy.
+_BYTES_PER_FIELD_PIXEL = 96
 
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
@@ -167,7 +170,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
             camera = object_camera(camera_for(context, self.camera_source, "Sampling for the screen"),
                                    ob.matrix_world)
         once = dataclasses.replace(settings, copies=1)  # sampled once; the copies only after the budget allows them
-        sampled, counts, over = [], [], 0
+        sampled, counts, over, worst = [], [], 0, (0.0, 0)
         for k, sp in enumerate(curve_bridge.read_splines(ob.data, ob.name)):
             if sp.kind in ("BEZIER", "NURBS") and len(sp.co) < 2:
                 raise InvalidInputError(f"Spline {k} of {ob.name!r} has a single point: delete it or add points")
@@ -184,6 +187,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
             counts.append(a.counts)
             if a.deviation is not None and settings.mode == "TOLERANCE":
                 over += int((a.deviation > settings.tolerance).sum())
+                worst = max(worst, (float(a.deviation.max(initial=0.0)) / settings.tolerance, k))
         if not sampled:
             raise InvalidInputError(f"Curve {ob.name!r} has no spline to sample: add one, or select another curve")
         n_points = sum(len(s[0]) for s in sampled) * settings.copies
@@ -198,8 +202,8 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         seg = np.concatenate(counts) if counts else np.zeros(0, np.int64)
         words = (f"{len(seg):,} curve segments -> {int(seg.sum()):,} ({int(seg.min())}-{int(seg.max())} each)"
                  if len(seg) else "no curve segment")
-        note = (f"; {over} segment(s) stay over the tolerance at Max Segments {settings.max_segments}: raise Max "
-                "Segments or the Tolerance") if over else ""
+        note = (f"; {over} segment(s) stay over the tolerance at Max Segments {settings.max_segments}, the worst "
+                f"{worst[0]:,.1f} times over in spline {worst[1]}: raise Max Segments or the Tolerance") if over else ""
         self.report({"WARNING" if over else "INFO"}, f"{len(out):,} polylines: {words}{note}")
         return {"FINISHED"}
 
@@ -241,6 +245,8 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
     def execute(self, context, tx):
         if self.near >= self.far:
             raise InvalidInputError(f"Near ({self.near:g}) must be less than Far ({self.far:g})")
+        check_bytes(self.width * self.height * _BYTES_PER_FIELD_PIXEL, get_preferences(context).memory_budget_bytes,
+                    f"A {self.width} x {self.height} texture would be made", "a smaller Width and Height")
         field = self._field(context)
         per_side = vf.seeds_per_side(self.seeds, self._camera_distance(context), self.near, self.far)
         points, values = vf.seed_points(per_side, self.noise_seed)

@@ -161,7 +161,7 @@ class CurveSampling:
 class AdaptiveSpline:
     """One output polyline: points (n, 3), radius (n,), tilt (n,) float64, cyclic; counts (S,) segments per Bézier
     segment of its source; deviation (S,) float64: the largest distance measured between each segment and its
-    chords (NURBS splines sampled to a tolerance), else None."""
+    chords (sampled to a tolerance or for the screen), else None."""
 
     points: np.ndarray
     radius: np.ndarray
@@ -190,11 +190,14 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
     control = segment_controls(co, handle_left, handle_right, cyclic)
     if len(control) == 0:
         raise InvalidInputError("A Bézier spline needs at least two points")
+    deviation = None
     if settings.mode == "CURVATURE":
         counts = curvature_counts(control, t_max=settings.max_segments)
     else:
         counts = np.minimum(tolerance_counts(control, _world_tolerance(control, settings, camera)),
                             settings.max_segments)
+        # the bound above meets the tolerance; what Max Segments leaves over it is measured, for the report
+        deviation = rb.chord_deviation(np.concatenate([control, np.ones(control.shape[:2] + (1,))], -1), counts)
     s = sample(control, counts, cyclic)
     n = len(np.asarray(co))
     k = (s.segment + 1) % n
@@ -204,8 +207,8 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
         return v[s.segment] + s.t * (v[k] - v[s.segment])
 
     r, tl = along(radius), along(tilt)
-    return [AdaptiveSpline(p, r, tl, bool(cyclic), counts) for p in offset_copies(s.points, settings.copies,
-                                                                                     settings.offset)]
+    return [AdaptiveSpline(p, r, tl, bool(cyclic), counts, deviation)
+            for p in offset_copies(s.points, settings.copies, settings.offset)]
 
 
 def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, what="NURBS spline"):

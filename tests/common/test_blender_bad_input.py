@@ -625,3 +625,14 @@ def test_adaptive_polylines_with_many_copies_are_refused_before_they_are_made(cl
     assert bpy.ops.tessera.curve_adaptive(tolerance=1e-3, copies=3) == {"FINISHED"}
     made = bpy.context.active_object
     assert len(made.data.splines) == 600
+
+
+def test_a_tolerance_max_segments_cannot_reach_says_where_and_by_how_much(clean_scene, bpy_module, capfd):
+    bpy = bpy_module
+    _bezier(bpy, (1.0, 2.0, 0.0))
+    capfd.readouterr()
+    assert bpy.ops.tessera.curve_adaptive(mode="TOLERANCE", tolerance=1e-6, max_segments=6) == {"FINISHED"}
+    captured = capfd.readouterr()
+    lines = (captured.out + captured.err).splitlines()
+    line = next((line for line in lines if "over the tolerance" in line), lines)
+    assert line.startswith("Warning") and "times over in spline 0" in line and "raise Max Segments" in line

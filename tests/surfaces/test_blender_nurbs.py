@@ -229,7 +229,7 @@ def test_blenders_own_conversion_lies_on_the_same_surface(clean_scene, bpy_modul
 
 @pytest.mark.parametrize("change, words", [
     (lambda s: s.points[1].co.__setitem__(3, 0.0), "weights of zero or less"),
-    (lambda s: s.points[2].co.__setitem__(0, float("nan")), "NaN or infinite"),
+    (lambda s: s.points[2].co.__setitem__(0, float("nan")), "Spline 0 of .SurfSphere. has a point at NaN"),
 ])
 def test_bad_surface_splines_are_refused_and_nothing_is_made(clean_scene, bpy_module, change, words):
     bpy = bpy_module
