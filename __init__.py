@@ -11,6 +11,7 @@ _modules = (
     "addon.viewport",
     "addon.preferences",
     "addon.opencl_warmup",
+    "addon.render_jobs",
     "addon.properties",
     "addon.displacement.maps",
     "operators.tessellation",

@@ -467,6 +467,15 @@ def read_image_pixels(image, channels=None):
     return pixels.reshape(h, w, c)
 
 
+def pack_float_image(image):
+    """Pack a float image into the .blend as OpenEXR with its channels kept apart (alpha mode Channel Packed: no
+    premultiplication on the way in or out), so its values come back bit for bit after save and reload, colours
+    under a zero alpha included. Set its pixels first (`write_image_pixels`)."""
+    image.alpha_mode = "CHANNEL_PACKED"
+    image.file_format = "OPEN_EXR"
+    image.pack()
+
+
 def write_image_pixels(image, pixels):
     """Replace every pixel of ``image`` with ``pixels`` ((H, W, C) float32 as `read_image_pixels` gives) and
     tell Blender the image changed. One ``foreach_set``."""

@@ -98,6 +98,16 @@ def check_numbers(struct):
                                         f"{prop.hard_max:g}; got {v!r}")
 
 
+def check_editable(block, change, instead):
+    """Refuse to change a data-block that comes from a library (linked, or not editable here): `InvalidInputError`
+    naming it, its library, ``change`` (what would be changed) and ``instead`` (what the user can do)."""
+    if getattr(block, "is_editable", True) and getattr(block, "library", None) is None:
+        return
+    library = getattr(block, "library", None)
+    where = f"linked from {library.filepath}" if library is not None else "not editable in this file"
+    raise InvalidInputError(f"{block.name!r} is {where}, so {change} cannot be saved. {instead}")
+
+
 def failure_message(err):
     """What the user reads for an unexpected exception."""
     what = str(err) or type(err).__name__

@@ -1,13 +1,50 @@
 """``tessera.impostor_bake``: the active object baked into an octahedral impostor (colour, normal and depth atlases
 rendered by Cycles in a worker process) on a card that faces the camera, for EEVEE and Cycles renders;
-``tessera.impostor_export``: such a card written to glTF (`addon.impostors.export`)."""
+``tessera.impostor_export``: such a card written to glTF (`addon.impostors.export`).
+
+In the UI the bake runs in the background (`addon.render_jobs`): the operator returns at once, a timer follows the
+worker, the status bar shows the views done, Esc stops it and leaves nothing. Scripts, ``blender -b`` and the redo
+panel run it to the end with progress lines; the redo panel renders again only when a setting that changes the
+render changed (Blend Views and Dilation reuse the last views)."""
+
+import hashlib
 
 import bpy
+import numpy as np
 
-from ..addon.guarded import guarded
-from ..addon.impostors.bake import atlas_images, bake_atlas, make_card
+from ..addon.guarded import check_numbers, guarded
+from ..addon.impostors.bake import atlas_images, check_atlas_size, dilated, make_card, read_atlas, start_atlas
 from ..addon.impostors.export import export_card, impostor_info
+from ..addon.preferences import get_preferences
+from ..addon.render_jobs import render_device
 from .selection import object_poll, select_only
+
+#: The last atlas rendered (before dilation), by what its render depended on: the redo panel reuses it.
+_last = {"key": None, "atlas": None, "device": ""}
+#: Atlases at most this large are kept for the redo panel.
+_KEEP_BYTES = 256 * 2**20
+
+
+def _render_key(context, ob, op):
+    """What a bake's views depend on: the object (its evaluated geometry, transform, materials), the lights and world
+    of the scene, and the settings that change the render."""
+    digest = hashlib.sha256()
+    evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
+    try:
+        mesh = evaluated.to_mesh()
+        pos = np.empty(len(mesh.vertices) * 3, np.float32)
+        mesh.vertices.foreach_get("co", pos)
+        digest.update(pos.tobytes())
+    finally:
+        evaluated.to_mesh_clear()
+    digest.update(np.array(ob.matrix_world, np.float64).tobytes())
+    for o in context.view_layer.objects:
+        if o.type == "LIGHT" and not o.hide_render:
+            digest.update(o.name.encode() + np.array(o.matrix_world, np.float64).tobytes())
+    names = [m.name for m in getattr(ob.data, "materials", ()) if m is not None]
+    world = context.scene.world.name if context.scene.world else ""
+    return (ob.session_uid, digest.hexdigest(), tuple(names), world, op.grid, op.tile, op.samples, op.hemi,
+            str(render_device(context)))
 
 
 class TESSERA_OT_impostor_bake(bpy.types.Operator):
@@ -39,15 +76,97 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         return object_poll(cls, context, {"MESH", "CURVE", "SURFACE", "META", "FONT"},
                            "Select an object with geometry in Object Mode")
 
+    def _start(self, context):
+        """Check the size, then start the worker: the `AtlasJob`, or a `TesseraError`."""
+        check_numbers(self)
+        check_atlas_size(self.grid, self.tile, get_preferences(context).memory_budget_bytes)
+        return start_atlas(context.active_object, self.grid, self.tile, self.samples, self.hemi,
+                           render_device(context))
+
+    def invoke(self, context, event):
+        """In the UI: start the bake and follow it from a timer (the UI never waits); elsewhere: `execute`."""
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        started = self._begin(context)
+        if started is not None:
+            return started
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.25, window=context.window)
+        wm.modal_handler_add(self)
+        wm.progress_begin(0, self._job.job.total)
+        self._status(context)
+        return {"RUNNING_MODAL"}
+
+    @guarded
+    def _begin_guarded(self, context, tx):
+        self._key = _render_key(context, context.active_object, self)
+        self._job = self._start(context)
+        return {"FINISHED"}
+
+    def _begin(self, context):
+        """Start the job; None when it started, else the operator's result (the refusal is reported)."""
+        self._job = None
+        result = self._begin_guarded(context)
+        return None if self._job is not None else result
+
+    def _status(self, context):
+        job = self._job.job
+        done = job.progress()
+        context.window_manager.progress_update(done)
+        device = job.device()
+        on = f" on {device}" if device else ""
+        context.workspace.status_text_set(f"Baking impostor: view {done} of {job.total}{on} — Esc to cancel")
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._job.job.cancel()
+            self._end(context)
+            self.report({"WARNING"}, "Impostor bake cancelled: nothing was made")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        if self._job.job.running():
+            self._status(context)
+            return {"RUNNING_MODAL"}
+        self._end(context)
+        return self._finish(context)
+
+    @guarded
+    def _finish(self, context, tx):
+        atlas = read_atlas(self._job)
+        _last.update(key=self._key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas,
+                     device=self._job.job.device())
+        return self._make(context, tx, atlas, _last["device"])
+
     @guarded
     def execute(self, context, tx):
+        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines; the last views are reused
+        when nothing the render depends on changed."""
         ob = context.active_object
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        try:
-            atlas = bake_atlas(ob, self.grid, self.tile, self.samples, self.hemi, dilation=self.dilation)
-        finally:
-            wm.progress_end()
+        key = _render_key(context, ob, self)
+        if _last["key"] == key and _last["atlas"] is not None:
+            atlas, device = _last["atlas"], _last["device"]
+        else:
+            aj = self._start(context)
+            try:
+                aj.job.wait(None, "Baking impostor views")
+            except BaseException:
+                aj.job.cancel()
+                raise
+            atlas, device = read_atlas(aj), aj.job.device()
+            _last.update(key=key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas, device=device)
+        return self._make(context, tx, atlas, device)
+
+    def _make(self, context, tx, atlas, device):
+        """The card and its images from a rendered atlas (dilated here: the kept atlas stays as rendered)."""
+        ob = context.active_object
+        atlas = dilated(atlas, self.dilation)
         name = f"{ob.name} impostor"
         images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}
         card = make_card(name, atlas, images, context.scene.camera, self.blend)
@@ -57,7 +176,8 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         context.collection.objects.link(card)
         select_only(context, [card])
         note = "" if context.scene.camera else " (no scene camera: add a Track To constraint to the camera)"
-        self.report({"INFO"}, f"{name}: {self.grid}x{self.grid} views of {self.tile}px{note}")
+        on = f", rendered on {device}" if device else ""
+        self.report({"INFO"}, f"{name}: {self.grid}x{self.grid} views of {self.tile}px{on}{note}")
         return {"FINISHED"}
 
 

@@ -4,6 +4,7 @@ Replace), the result placed beside the source or swapped into it, and the result
 import bpy
 
 from ..addon import bridge
+from ..addon.guarded import check_editable
 
 
 def select_only(context, objects):
@@ -42,6 +43,9 @@ def read_source(context, ob, output):
     """`bridge.read_mesh` of what the operator works on: the object with its modifiers evaluated for a new
     object, its own mesh data for ``output == "REPLACE"``. Returns ``(arrays, info, marks)`` (marks:
     `bridge.read_edge_marks`)."""
+    if output == "REPLACE":
+        check_editable(ob, "its mesh", "Choose Output: New Object, or make it local (Object › Relations › Make "
+                                       "Local)")
     if output == "NEW_OBJECT":
         evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
         source = evaluated.to_mesh()

@@ -8,8 +8,9 @@ import bpy
 import numpy as np
 
 from ..addon import bridge
-from ..addon.guarded import guarded
+from ..addon.guarded import check_editable, guarded
 from ..addon.preferences import get_preferences
+from ..addon.render_jobs import render_device
 from ..addon.subdivision.bake import bake_colours
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
@@ -115,6 +116,8 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     @guarded
     def execute(self, context, tx):
         ob = context.active_object
+        check_editable(ob.data, "baked lighting stored on its mesh", "Make the object and its mesh local "
+                                                                     "(Object › Relations › Make Local) first")
         t0 = time.perf_counter()
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -143,7 +146,9 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
         tx.on_rollback(lambda: ob.data.__setitem__(HCE_PROPERTY, old) if old is not None
                        else ob.data.pop(HCE_PROPERTY, None))
         nodes = sum(len(t.subdivided) for t in trees)
-        self.report({"INFO"}, f"Baked lighting: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
+        device = render_device(context)
+        on = f"GPU ({device['type']})" if device["gpu"] else "CPU"
+        self.report({"INFO"}, f"Baked lighting on the {on}: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
                               f"{np.mean([len(t.normals) for t in trees]):.1f} extra normals each, "
                               f"{len(blob) / 1024:,.0f} KiB, {time.perf_counter() - t0:.1f} s")
         return {"FINISHED"}

@@ -275,7 +275,8 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
         rgba = np.ones((self.height, self.width, 4), np.float32)
         rgba[..., :3] = grey[..., None]
         bridge.write_image_pixels(image, rgba)
-        image.pack()
+        bridge.pack_float_image(image)
+        image.use_fake_user = True  # made to be used: kept in the file until the user deletes it
         self.report({"INFO"}, f"{image.name}: {per_side}² seeds x {self.steps} steps on the {backend}")
         return {"FINISHED"}
 

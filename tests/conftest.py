@@ -42,10 +42,22 @@ def tier_unavailable(reason):
     pytest.skip(reason)
 
 
+#: Job folders of background renders (`addon.render_jobs`) that were there before the tests: any other is a leftover.
+_JOB_PREFIXES = ("tessera-impostor-", "tessera-board-")
+_JOB_FOLDERS_BEFORE = {n for n in os.listdir(tempfile.gettempdir()) if n.startswith(_JOB_PREFIXES)}
+
+
 def pytest_sessionfinish(session, exitstatus):
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    left = sorted(n for n in os.listdir(tempfile.gettempdir())
+                  if n.startswith(_JOB_PREFIXES) and n not in _JOB_FOLDERS_BEFORE)
+    if left and session.exitstatus == 0:  # every job's folder goes when its result is read, on failure and on cancel
+        if reporter:
+            reporter.write_line(f"the tests left {len(left)} render-job folder(s) in the temp folder: {left[:5]}",
+                                red=True)
+        session.exitstatus = 1
     if not CI:
         return
-    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
     skipped = reporter.stats.get("skipped", []) if reporter else []
     if skipped and session.exitstatus == 0:
         reporter.write_line(f"CI=true: {len(skipped)} test(s) were skipped; every tier must run in CI", red=True)

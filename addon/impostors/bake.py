@@ -1,24 +1,31 @@
 """Baked impostors (issue "Nailboards", item 4): an object rendered by Cycles from N x N directions of an octahedral
 (or hemi-octahedral) atlas (`kernels.impostors.octahedral`) into colour, normal and depth atlases, and a card that
 faces the camera whose material picks the view of the camera's direction: the impostor works in EEVEE and Cycles
-renders without the object. All views are rendered by one worker process, one after the other."""
+renders without the object. All views are rendered by one worker process, one after the other, as a job of
+`addon.render_jobs` (`start_atlas` returns at once; `read_atlas` assembles the views once it is done); the size is
+checked against the memory first (`check_atlas_size`)."""
 
 import os
-import subprocess
-import tempfile
 from dataclasses import dataclass
 
 import bpy
 import numpy as np
 
+from ...kernels.common.budget import check_bytes
 from ...kernels.common.errors import TesseraError
 from ...kernels.common.image_io import read_channels
 from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
+from .. import bridge
 from ..node_groups import Graph
+from ..render_jobs import RenderJob, job_folder, remove_folder
 from .export import PROPERTY
 from .worker import start_worker, world_box, write_job
+
+#: Memory per atlas texel: the colour, normal and depth atlases as assembled (float32 RGBA, RGB, float64), their three
+#: RGBA float images in Blender and the packed copies of those images.
+ATLAS_BYTES_PER_TEXEL = 140
 
 
 @dataclass
@@ -45,59 +52,107 @@ def view_camera(direction, centre, size):
     return centre + f * size, -f, np.cross(f, right)
 
 
-def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=3600, dilation=0):
-    """Render ``ob`` (world space) from every view of the atlas and assemble the atlases: an `Atlas`. dilation:
-    texels the colours and normals of each view spread into the empty texels around it (`dilate_views`)."""
+def check_atlas_size(grid, tile, budget_bytes):
+    """Refuse (`BudgetError`, with the sizes) an atlas of ``grid`` x ``grid`` views of ``tile`` pixels that the memory
+    budget or the free memory cannot hold, before anything is rendered."""
+    s = int(grid) * int(tile)
+    check_bytes(s * s * ATLAS_BYTES_PER_TEXEL, budget_bytes,
+                f"The impostor's atlases would be {s:,} x {s:,} texels ({int(grid) ** 2:,} views of {int(tile)} x "
+                f"{int(tile)} pixels)", "fewer Views or a smaller View Size")
+
+
+@dataclass
+class AtlasJob:
+    """An atlas being rendered: the `render_jobs.RenderJob`, its views (dicts with ``out``, the EXR of view (j, i)
+    named ``view_j_i.exr``), and what the atlas needs to be assembled."""
+
+    job: RenderJob
+    views: list
+    centre: np.ndarray
+    size: float
+    grid: int
+    tile: int
+    hemi: bool
+
+
+def start_atlas(ob, grid=8, tile=128, samples=16, hemi=False, device=None):
+    """Start rendering ``ob`` (world space) from every view of the atlas in a worker process: an `AtlasJob`, at once.
+    device: the Cycles device (`render_jobs.render_device`; default: the user's)."""
     lo, hi = world_box(ob)
     centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
     if not size > 0:
         raise TesseraError(f"{ob.name!r} has no extent to bake")
-    folder = tempfile.mkdtemp(prefix="tessera-impostor-")
-    dirs = view_directions(grid, hemi)
-    views = []
-    for j in range(grid):
-        for i in range(grid):
-            loc, fwd, up = view_camera(dirs[j, i], centre, size)
-            views.append({"location": loc.tolist(), "forward": fwd.tolist(), "up": up.tolist(),
-                          "out": os.path.join(folder, f"view_{j}_{i}.exr")})
-    process = start_worker(write_job(ob, folder, tile, samples, size, 2.0 * size, views),
-                           os.path.join(folder, "worker.log"))
+    folder = job_folder("impostor")
     try:
-        process.wait(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.wait()
-        raise TesseraError(f"Baking the impostor took longer than {timeout} s and was stopped") from None
-    if process.returncode != 0:
-        tail = open(os.path.join(folder, "worker.log"), encoding="utf-8", errors="replace").read()[-600:]
-        raise TesseraError(f"Baking the impostor failed (exit {process.returncode}): {tail}")
-    s = grid * tile
-    colour, normal, depth = np.zeros((s, s, 4), np.float32), np.zeros((s, s, 3), np.float32), np.ones((s, s))
-    for view in views:
-        j, i = (int(x) for x in os.path.basename(view["out"])[5:-4].split("_"))
-        r, g, b, a, z, nx, ny, nz = read_channels(view["out"], "impostor view", (
-            "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
-        rows, cols = slice(j * tile, (j + 1) * tile), slice(i * tile, (i + 1) * tile)
-        alpha = np.maximum(a, ALPHA_FLOOR)[..., None]
-        colour[rows, cols] = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1)
-        normal[rows, cols] = np.stack([nx, ny, nz], -1)
-        depth[rows, cols] = np.where(a > 0.5, np.clip(z / size - 0.5, 0, 1), 1.0)
-    if dilation:
-        covered = colour[..., 3] > 0
-        colour[..., :3] = dilate_views(colour[..., :3], covered, grid, dilation)
-        normal = dilate_views(normal, covered, grid, dilation)
-    return Atlas(colour, normal, depth, centre, size, int(grid), bool(hemi))
+        dirs = view_directions(grid, hemi)
+        views = []
+        for j in range(grid):
+            for i in range(grid):
+                loc, fwd, up = view_camera(dirs[j, i], centre, size)
+                views.append({"location": loc.tolist(), "forward": fwd.tolist(), "up": up.tolist(),
+                              "out": os.path.join(folder, f"view_{j}_{i}.exr")})
+        log = os.path.join(folder, "worker.log")
+        process = start_worker(write_job(ob, folder, tile, samples, size, 2.0 * size, views, device), log)
+    except BaseException:
+        remove_folder(folder)
+        raise
+    return AtlasJob(RenderJob(process, folder, len(views), log), views, centre, size, int(grid), int(tile), bool(hemi))
 
 
-def _image(name, pixels):
-    """A packed float image of ``pixels`` (H, W, C <= 4), the channels padded to RGBA."""
+def read_atlas(aj):
+    """The `Atlas` of a finished `AtlasJob` (undilated); the job's folder is removed, read or failed."""
+    try:
+        aj.job.check("Baking the impostor")
+        grid, tile, size = aj.grid, aj.tile, aj.size
+        s = grid * tile
+        colour, normal, depth = np.zeros((s, s, 4), np.float32), np.zeros((s, s, 3), np.float32), np.ones((s, s))
+        for view in aj.views:
+            j, i = (int(x) for x in os.path.basename(view["out"])[5:-4].split("_"))
+            r, g, b, a, z, nx, ny, nz = read_channels(view["out"], "impostor view", (
+                "Combined.R", "Combined.G", "Combined.B", "Combined.A", "Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"))
+            rows, cols = slice(j * tile, (j + 1) * tile), slice(i * tile, (i + 1) * tile)
+            alpha = np.maximum(a, ALPHA_FLOOR)[..., None]
+            colour[rows, cols] = np.concatenate([np.stack([r, g, b], -1) / alpha, a[..., None]], -1)
+            normal[rows, cols] = np.stack([nx, ny, nz], -1)
+            depth[rows, cols] = np.where(a > 0.5, np.clip(z / size - 0.5, 0, 1), 1.0)
+    finally:
+        aj.job.close()
+    return Atlas(colour, normal, depth, aj.centre, size, grid, aj.hemi)
+
+
+def dilated(atlas, dilation):
+    """``atlas`` with each view's colours and normals spread ``dilation`` texels into the empty texels around it
+    (`dilate_views`; alpha and depth unchanged): a new `Atlas` (the given one is not changed)."""
+    if not dilation:
+        return atlas
+    covered = atlas.colour[..., 3] > 0
+    colour = atlas.colour.copy()
+    colour[..., :3] = dilate_views(atlas.colour[..., :3], covered, atlas.grid, dilation)
+    normal = dilate_views(atlas.normal, covered, atlas.grid, dilation)
+    return Atlas(colour, normal, atlas.depth, atlas.centre, atlas.size, atlas.grid, atlas.hemi)
+
+
+def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=None, dilation=0, report=None):
+    """Render ``ob`` from every view of the atlas and assemble the atlases, waiting for the worker (scripts,
+    background mode; ``report(line)`` gets a progress line per view): an `Atlas`. dilation: see `dilated`."""
+    aj = start_atlas(ob, grid, tile, samples, hemi)
+    try:
+        aj.job.wait(report, "Baking impostor views", timeout)
+    except BaseException:
+        aj.job.cancel()
+        raise
+    return dilated(read_atlas(aj), dilation)
+
+
+def packed_float_image(name, pixels):
+    """A float image of ``pixels`` (H, W, C <= 4; the channels padded to RGBA), packed into the .blend
+    (`bridge.pack_float_image`: bit for bit after save and reload)."""
     h, w, c = pixels.shape
     rgba = np.ones((h, w, 4), np.float32)
     rgba[..., :c] = pixels
     image = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
-    image.pixels.foreach_set(rgba.ravel())
-    image.update()
-    image.pack()
+    bridge.write_image_pixels(image, rgba)
+    bridge.pack_float_image(image)
     return image
 
 
@@ -184,7 +239,11 @@ def make_card(name, atlas, images, scene_camera, blend=True):
     me.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
     uv = me.uv_layers.new(name="UVMap")
     uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32))
-    me.materials.append(card_material(name, images["colour"], atlas.grid, atlas.hemi, blend))
+    mat = card_material(name, images["colour"], atlas.grid, atlas.hemi, blend)
+    for k, key in enumerate(("normal", "depth")):  # kept by the material (saved with it) for the exporters
+        node = mat.node_tree.nodes.new("ShaderNodeTexImage")
+        node.image, node.label, node.location = images[key], f"{key.title()} atlas (for export)", (-1200, -300 * k)
+    me.materials.append(mat)
     card = bpy.data.objects.new(name, me)
     card.location = tuple(atlas.centre)
     card[PROPERTY] = {"grid": int(atlas.grid), "hemi": bool(atlas.hemi), "size": float(atlas.size),
@@ -196,8 +255,8 @@ def make_card(name, atlas, images, scene_camera, blend=True):
 
 
 def atlas_images(name, atlas):
-    return {"colour": _image(f"{name} colour", atlas.colour),
-            "normal": _image(f"{name} normal", atlas.normal * 0.5 + 0.5),
-            "depth": _image(f"{name} depth", atlas.depth[..., None])}
+    return {"colour": packed_float_image(f"{name} colour", atlas.colour),
+            "normal": packed_float_image(f"{name} normal", atlas.normal * 0.5 + 0.5),
+            "depth": packed_float_image(f"{name} depth", atlas.depth[..., None])}
 
 

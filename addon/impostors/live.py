@@ -14,16 +14,20 @@
   down to `RESAMPLE_TO` times what it needs when a ``resample(images, resolution)`` is given (on a worker thread,
   swapped in when done): every frame pre-warps all the texels of the board drawn, so it then costs what a board made
   for this view would; the full board stays in the cache, and serves again if the view comes back.
+- a render that fails is told once (``LiveBoard.failed``, shown by the panel) and asked for again only after a
+  back-off that doubles with each failure (`RETRY_S` up to `RETRY_MAX_S`), never per frame.
 The renderer is `addon.impostors.worker.request_board` (a separate process); the manager only needs its job's
 ``done()`` and ``result()``.
 """
 
+import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ...kernels.common import workers
+from ...kernels.common.errors import TesseraError
 from ...kernels.impostors.validity import Board, check, sprite_resolution
 from .worker import world_box
 
@@ -43,8 +47,23 @@ class LiveBoard:
     previewing: bool = False  # drawn from the pending job's preview until its full render is there
     resampling: tuple = None  # (future of the resampled images, the images and Board it resamples, its resolution)
     keep: Board = None  # a board whose resampling failed: drawn as it is
+    failed: str = ""  # why the last render failed ("" when it did not)
+    failures: int = 0  # failures in a row
+    retry_at: float = 0.0  # no new render is asked for before this time (time.monotonic)
+
+    @property
+    def state(self):
+        """What the panel says: "Rendering", "Ready", "Waiting for the first render", or "Failed: ..."."""
+        if self.pending is not None:
+            return "Rendering (quick preview shown)" if self.previewing else "Rendering"
+        if self.failed:
+            return f"Failed, retrying in {max(0.0, self.retry_at - time.monotonic()):.0f} s: {self.failed}"
+        return "Ready" if self.images is not None else "Waiting for the first render"
 
 
+#: Seconds before a failed render is asked for again, doubled with each failure in a row, at most `RETRY_MAX_S`.
+RETRY_S = 2.0
+RETRY_MAX_S = 300.0
 #: A board this many times finer than the eye needs is resampled ...
 RESAMPLE_AT = 4
 #: ... to this many times what it needs (the margin keeps it valid while the camera comes a little closer).
@@ -73,11 +92,20 @@ class NailboardManager:
         live.eyes = (live.eyes + [eye])[-3:]
         matrix = np.array(ob.matrix_world).tobytes()
         if live.pending is not None and live.pending.done():
-            live.images, live.board, live.draw = live.pending.result(), live.pending_board, None
-            self.cache[(ob.session_uid, live.matrix, live.board.eye.tobytes())] = (live.images, live.board)
-            while len(self.cache) > self.cache_size:
-                self.cache.popitem(last=False)
-            live.pending, live.previewing = None, False
+            job, live.pending, live.previewing = live.pending, None, False
+            try:
+                images = job.result()
+            except TesseraError as err:  # told once; asked for again after the back-off
+                live.failures += 1
+                live.failed = str(err).strip().splitlines()[0][:300] if str(err).strip() else "the render failed"
+                live.retry_at = time.monotonic() + min(RETRY_MAX_S, RETRY_S * 2 ** (live.failures - 1))
+                print(f"Tessera: the nailboard of {ob.name!r} could not be rendered: {err}")
+            else:
+                live.images, live.board, live.draw = images, live.pending_board, None
+                live.failed, live.failures = "", 0
+                self.cache[(ob.session_uid, live.matrix, live.board.eye.tobytes())] = (live.images, live.board)
+                while len(self.cache) > self.cache_size:
+                    self.cache.popitem(last=False)
         elif live.pending is not None and not live.previewing:
             early = getattr(live.pending, "preview", lambda: None)()
             if early is not None:
@@ -98,7 +126,7 @@ class NailboardManager:
             if hit is not None:
                 live.images, live.board, live.draw = hit[0], hit[1], None
                 self.cache_hits += 1
-            else:
+            elif time.monotonic() >= live.retry_at:
                 self._ask(ob, live, eye, res_screen, fov)
         elif self.resample is not None and not live.previewing:
             self._resample(live, eye, res_screen, fov)

@@ -6,6 +6,7 @@ import bpy
 from ...kernels.common.errors import InvalidInputError
 from ..guarded import check_numbers
 from ..sidebar import Sidebar
+from .preview import MANAGER
 
 
 class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
@@ -27,6 +28,10 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
             check_numbers(s)  # a script can store NaN; the preview then skips the object, and says why here
         except InvalidInputError as err:
             col.label(text=str(err), icon="ERROR")
+        if s.enabled:
+            live = MANAGER.boards.get(context.active_object.session_uid)
+            state = live.state if live is not None else "Waiting for the first render"
+            col.label(text=state, icon="ERROR" if state.startswith("Failed") else "INFO")
         row = layout.row()
         row.scale_y = 1.4
         row.operator("tessera.impostor_bake", icon="IMAGE_PLANE")

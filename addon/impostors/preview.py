@@ -118,6 +118,12 @@ def _draw(context, region, view, proj):
         live.draw.draw(proj @ view)
 
 
-PREVIEW = Preview(_draw, topic=TOPIC, on_settings=lambda ob: MANAGER.boards.pop(getattr(ob, "session_uid", None),
-                                                                                  None))
+def _forget(ob):
+    """Settings of ``ob`` changed: its boards go, and a render still running for them is stopped (its folder too)."""
+    live = MANAGER.boards.pop(getattr(ob, "session_uid", None), None)
+    if live is not None and live.pending is not None:
+        live.pending.cancel()
+
+
+PREVIEW = Preview(_draw, topic=TOPIC, on_settings=_forget)
 register, unregister = PREVIEW.register, PREVIEW.unregister

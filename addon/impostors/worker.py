@@ -10,7 +10,7 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
+from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +23,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
+from ..render_jobs import job_folder, remove_folder, render_device
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
 
@@ -48,7 +49,7 @@ def worker_command(job_file):
     return [sys.executable, str(SCRIPT), "--", str(job_file)]
 
 
-def write_job(ob, folder, resolution, samples, scale, clip, views):
+def write_job(ob, folder, resolution, samples, scale, clip, views, device=None):
     """Write a render job for the worker into ``folder`` and return the job file's path.
 
     ``scene.blend`` holds ``ob`` with what it depends on (mesh, materials, images, the objects its modifiers use),
@@ -56,7 +57,8 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
     absolute paths), so the main thread's pause does not grow with the scene the way saving a copy of the file does.
     ``job.json`` names them, with the world matrix of every object (the worker places them in a scene of their own,
     unparented) and the views: dicts of ``location``, ``forward``, ``up`` (3 floats each) and ``out`` (an EXR path),
-    and optionally ``preview``: ``{"samples", "out"}``, a quicker render of the view written first.
+    and optionally ``preview``: ``{"samples", "out"}``, a quicker render of the view written first; ``device``: the
+    Cycles device to render on (`render_jobs.render_device`; default: the user's).
     """
     if ob.mode == "EDIT":  # what is being edited is not in the mesh until flushed (saving a file would flush it)
         ob.update_from_editmode()
@@ -72,7 +74,7 @@ def write_job(ob, folder, resolution, samples, scale, clip, views):
            "world": None if scene.world is None else scene.world.name,
            "matrices": {o.name: [list(row) for row in o.matrix_world] for o in (ob, *lights)},
            "resolution": int(resolution), "samples": int(samples), "scale": float(scale), "clip": float(clip),
-           "views": views}
+           "views": views, "device": device if device is not None else render_device()}
     path = os.path.join(folder, "job.json")
     with open(path, "w", encoding="utf-8") as f:
         json.dump(job, f)
@@ -140,10 +142,15 @@ class BoardJob:
         return self._images.result()
 
     def _read(self):
-        if self.process.returncode != 0 or not os.path.isfile(self.out):
-            tail = Path(self.folder, "worker.log").read_text(errors="replace")[-600:]
-            raise TesseraError(f"Rendering the board failed (exit {self.process.returncode}): {tail}")
-        return self._read_images(self.out)
+        try:
+            if self.process.returncode != 0 or not os.path.isfile(self.out):
+                tail = Path(self.folder, "worker.log").read_text(errors="replace")[-600:]
+                raise TesseraError(f"Rendering the board failed (exit {self.process.returncode}): {tail}")
+            if self._preview is not None:
+                futures.wait([self._preview])  # the preview's reading is done with the folder too
+            return self._read_images(self.out)
+        finally:
+            remove_folder(self.folder)  # read or failed: nothing of the job stays on disk
 
     def _read_images(self, path):
         r, g, b, a, z, nx, ny, nz = read_channels(path, "board render", (
@@ -155,8 +162,14 @@ class BoardJob:
         return BoardImages(self.setup, colours, d, np.stack([nx, ny, nz], -1), present)
 
     def cancel(self):
+        """Stop the worker; the folder goes once the process is gone (now, or when `done` next finds it ended)."""
         if self.process.poll() is None:
             self.process.kill()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                return
+        remove_folder(self.folder)
 
 
 def resample_images(images, resolution):
@@ -191,7 +204,7 @@ def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=No
     (`BoardJob.preview`), then renders it in full."""
     if setup is None:
         setup = board_setup(*world_box(ob), eye, res_screen, fov, rounding)
-    folder = tempfile.mkdtemp(prefix="tessera-board-")
+    folder = job_folder("board")
     out = os.path.join(folder, "board.exr")
     view = {"location": [float(x) for x in setup.camera_location], "forward": [float(x) for x in setup.camera_forward],
             "up": [float(x) for x in setup.camera_up], "out": out}
@@ -199,6 +212,10 @@ def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=No
     if progressive and samples >= PROGRESSIVE_MIN_SAMPLES:
         preview_out = os.path.join(folder, "preview.exr")
         view["preview"] = {"samples": preview_samples(samples), "out": preview_out}
-    job = write_job(ob, folder, setup.resolution, samples, setup.size, 2 * setup.size, [view])
-    return BoardJob(setup, start_worker(job, os.path.join(folder, "worker.log")), folder, out, preview_out)
+    try:
+        job = write_job(ob, folder, setup.resolution, samples, setup.size, 2 * setup.size, [view])
+        return BoardJob(setup, start_worker(job, os.path.join(folder, "worker.log")), folder, out, preview_out)
+    except BaseException:
+        remove_folder(folder)
+        raise
 

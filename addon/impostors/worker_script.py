@@ -17,6 +17,30 @@ import bpy
 from mathutils import Matrix, Vector
 
 
+def use_device(scene, device):
+    """Render on the Cycles device the user chose (``device``: `addon.render_jobs.render_device`), else the CPU; says
+    which in a ``TESSERA_DEVICE`` line."""
+    scene.cycles.device = "CPU"
+    if device and device.get("gpu"):
+        try:
+            prefs = bpy.context.preferences.addons["cycles"].preferences
+            prefs.compute_device_type = device["type"]
+            (getattr(prefs, "refresh_devices", None) or prefs.get_devices)()
+            wanted = set(device.get("devices") or ())
+            used = []
+            for d in prefs.devices:
+                d.use = d.type != "CPU" and (not wanted or d.id in wanted)
+                if d.use:
+                    used.append(d.name)
+            if used:
+                scene.cycles.device = "GPU"
+                print(f"TESSERA_DEVICE GPU ({device['type']}): {', '.join(used)}", flush=True)
+                return
+        except (KeyError, TypeError, AttributeError, RuntimeError) as err:
+            print(f"Tessera: the GPU device could not be set up ({err}); rendering on the CPU", flush=True)
+    print("TESSERA_DEVICE CPU", flush=True)
+
+
 def setup(job):
     if bpy.data.filepath != job["blend"]:
         bpy.ops.wm.open_mainfile(filepath=job["blend"])
@@ -30,7 +54,7 @@ def setup(job):
     if job["world"] is not None:
         scene.world = bpy.data.worlds[job["world"]]
     scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
+    use_device(scene, job.get("device"))
     scene.cycles.samples = int(job["samples"])
     scene.render.resolution_x = scene.render.resolution_y = int(job["resolution"])
     scene.render.resolution_percentage = 100
@@ -75,9 +99,10 @@ def main(argv):
     with open(argv[0], encoding="utf-8") as f:
         job = json.load(f)
     scene = setup(job)
-    for view in job["views"]:
+    for k, view in enumerate(job["views"], 1):
         render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"],
                     view.get("preview"))
+        print(f"TESSERA_PROGRESS {k}/{len(job['views'])}", flush=True)
 
 
 main(sys.argv[sys.argv.index("--") + 1:])

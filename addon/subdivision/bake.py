@@ -80,8 +80,7 @@ def bake_colours(context, ob, positions, triangles, material_index, samples, alb
         temp.matrix_world = ob.matrix_world.copy()
         with _restored(scene, ob):
             scene.render.engine = "CYCLES"
-            scene.cycles.samples = int(samples)
-            scene.cycles.device = "CPU"
+            scene.cycles.samples = int(samples)  # the device stays the user's (GPU where the scene renders on it)
             scene.render.bake.margin = 0
             scene.render.bake.use_clear = True
             scene.render.bake.target = "IMAGE_TEXTURES"

@@ -97,13 +97,13 @@ def test_a_progressive_board_writes_its_preview_first(clean_scene, bpy_module, a
     ball = bpy.context.active_object
     job = worker.request_board(ball, np.array([0.0, -5.0, 1.0]), res_screen=120, fov=np.radians(40),
                                samples=worker.PROGRESSIVE_MIN_SAMPLES)
-    final = job.result(timeout=240)
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 240
     while job.preview() is None and time.monotonic() < deadline:  # read on a worker thread, started by poll()
         job.poll()
         time.sleep(0.01)
     early = job.preview()
-    assert early is not None
+    final = job.result(timeout=240)  # the folder goes once the final images are read: the preview was read first
+    assert early is not None and not os.path.exists(job.folder)
     assert early.setup is final.setup and early.colours.shape == final.colours.shape
     inside = final.present & early.present
     assert inside.sum() >= 0.97 * max(final.present.sum(), early.present.sum()) > 0

@@ -1,0 +1,205 @@
+"""Background renders: the one mechanism every render Tessera runs in a worker process goes through (impostor atlases,
+nailboards, and any later one).
+
+- **Folders**: each job works in a folder of its own, ``tessera-<kind>-*`` in the system's temporary directory, with
+  the id of the process that made it (`job_folder`). The folder is removed as soon as the job's result is read, on
+  failure and on cancel (`RenderJob.close`), for every job still open when the add-on is disabled or Blender exits
+  (`close_all`), and folders that a Blender which crashed left behind are removed at the next enable
+  (`remove_stale_folders`: only Tessera's kinds, only when their process is gone or they are old).
+- **Progress**: the worker prints ``TESSERA_PROGRESS k/n`` after each view and ``TESSERA_DEVICE ...`` once it knows
+  what it renders on; `RenderJob.progress` reads them from the log without blocking (the UI polls from a timer), and
+  `RenderJob.wait` follows them to the end where nothing can poll (``blender -b``, the ``bpy`` module), printing a
+  line per step so scripts show progress.
+- **Device**: `render_device` gives the worker the Cycles device the user chose in the preferences (GPU where one is
+  configured and the scene renders on it), the CPU when nothing else is set.
+"""
+
+import atexit
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+
+import bpy
+
+from ..kernels.common.errors import TesseraError
+
+#: The kinds of job folders; only these are ever removed as stale.
+KINDS = ("impostor", "board")
+#: A folder of a process that is gone is stale after this many seconds; any folder of ours after `STALE_AGE_S`.
+ORPHAN_AGE_S = 60.0
+STALE_AGE_S = 24 * 3600.0
+_OWNER = "owner.pid"
+_PROGRESS = re.compile(rb"TESSERA_PROGRESS (\d+)/(\d+)")
+_DEVICE = re.compile(rb"TESSERA_DEVICE ([^\r\n]+)")
+
+_open_jobs = {}  # folder -> RenderJob (or None while the job is being set up)
+
+
+def job_folder(kind):
+    """A new folder for a job of ``kind`` (one of `KINDS`), owned by this process until `remove_folder`."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown job kind {kind!r}")
+    folder = tempfile.mkdtemp(prefix=f"tessera-{kind}-")
+    with open(os.path.join(folder, _OWNER), "w", encoding="ascii") as f:
+        f.write(str(os.getpid()))
+    _open_jobs[folder] = None
+    return folder
+
+
+def remove_folder(folder):
+    """Remove a job folder and forget it (nothing happens when it is gone already)."""
+    _open_jobs.pop(folder, None)
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+def open_folders():
+    """The job folders this process has not removed yet."""
+    return list(_open_jobs)
+
+
+def _alive(pid):
+    if os.name != "posix":
+        return True  # no cheap check: only age decides
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # it exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_folders(root=None, now=None):
+    """Remove the job folders (of `KINDS`) that no running process owns: their process is gone and they are older than
+    `ORPHAN_AGE_S`, or they are older than `STALE_AGE_S`. Returns the folders removed."""
+    root = root or tempfile.gettempdir()
+    now = time.time() if now is None else now
+    removed = []
+    try:
+        names = os.listdir(root)
+    except OSError:
+        return removed
+    for name in names:
+        if not any(name.startswith(f"tessera-{kind}-") for kind in KINDS):
+            continue
+        folder = os.path.join(root, name)
+        if folder in _open_jobs or not os.path.isdir(folder):
+            continue
+        try:
+            age = now - os.path.getmtime(folder)
+            with open(os.path.join(folder, _OWNER), encoding="ascii") as f:
+                owner = int(f.read().strip() or 0)
+        except (OSError, ValueError):
+            owner = 0
+            try:
+                age = now - os.path.getmtime(folder)
+            except OSError:
+                continue
+        if age > STALE_AGE_S or (age > ORPHAN_AGE_S and not (owner and _alive(owner))):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed.append(folder)
+    return removed
+
+
+def render_device(context=None):
+    """The Cycles device the user chose, for a worker: ``{"type": "NONE" | "CUDA" | "OPTIX" | "HIP" | "METAL" |
+    "ONEAPI", "devices": [ids of the devices in use], "gpu": whether the scene renders on the GPU}``. A worker given
+    ``gpu`` False, or type NONE, renders on the CPU."""
+    context = context or bpy.context
+    scene_gpu = getattr(getattr(context.scene, "cycles", None), "device", "CPU") == "GPU"
+    addon = context.preferences.addons.get("cycles")
+    prefs = getattr(addon, "preferences", None)
+    kind = getattr(prefs, "compute_device_type", "NONE") if prefs is not None else "NONE"
+    devices = [d.id for d in getattr(prefs, "devices", ()) if getattr(d, "use", False) and d.type != "CPU"] \
+        if prefs is not None else []
+    return {"type": kind or "NONE", "devices": devices, "gpu": bool(scene_gpu and kind not in ("", "NONE"))}
+
+
+class RenderJob:
+    """A worker process rendering into ``folder``: ``total`` steps (views); ``log`` the file its output goes to."""
+
+    def __init__(self, process, folder, total, log):
+        self.process, self.folder, self.total, self.log = process, folder, int(total), log
+        _open_jobs[folder] = self
+
+    def _log_bytes(self):
+        try:
+            with open(self.log, "rb") as f:
+                return f.read()
+        except OSError:
+            return b""
+
+    def progress(self):
+        """Steps done so far (from the worker's log; never blocks): int."""
+        done = _PROGRESS.findall(self._log_bytes())
+        return int(done[-1][0]) if done else 0
+
+    def device(self):
+        """What the worker said it renders on, or "" before it says."""
+        found = _DEVICE.search(self._log_bytes())
+        return found.group(1).decode("utf-8", "replace").strip() if found else ""
+
+    def running(self):
+        return self.process.poll() is None
+
+    def check(self, what):
+        """Raise `TesseraError` with the end of the worker's log when it failed (``what``: "Baking the impostor")."""
+        code = self.process.poll()
+        if code is not None and code != 0:
+            tail = self._log_bytes()[-600:].decode("utf-8", "replace")
+            raise TesseraError(f"{what} failed (exit {code}): {tail}")
+
+    def wait(self, report=None, what="Rendering", timeout=None):
+        """Follow the job to its end where nothing polls it (background mode, the ``bpy`` module): ``report(line)``
+        gets a line per step done (default: print). Raises `TesseraError` on failure or after ``timeout`` seconds."""
+        report = report or (lambda line: print(line, flush=True))
+        start, shown = time.monotonic(), 0
+        while self.running():
+            done = self.progress()
+            if done != shown:
+                shown = done
+                report(f"Tessera: {what} {done}/{self.total}")
+            if timeout is not None and time.monotonic() - start > timeout:
+                self.cancel()
+                raise TesseraError(f"{what} took longer than {timeout:g} s and was stopped")
+            time.sleep(0.1)
+        if self.progress() != shown:
+            report(f"Tessera: {what} {self.progress()}/{self.total}")
+        self.check(what)
+
+    def cancel(self):
+        """Stop the worker and remove the folder: nothing of the job is left."""
+        if self.process.poll() is None:
+            self.process.kill()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
+        remove_folder(self.folder)
+
+    def close(self):
+        """The result is read (or the job failed): remove the folder."""
+        remove_folder(self.folder)
+
+
+def close_all():
+    """Stop every open job and remove every job folder of this process (the add-on is disabled, Blender exits)."""
+    for folder, job in list(_open_jobs.items()):
+        if job is not None:
+            job.cancel()
+        else:
+            remove_folder(folder)
+
+
+atexit.register(close_all)
+
+
+def register():
+    remove_stale_folders()
+
+
+def unregister():
+    close_all()

@@ -1,0 +1,210 @@
+"""Background renders as jobs (tier: blender): a size check before anything starts, a worker that returns at once and
+reports its progress and device, cancel that leaves nothing, folders removed when read and when stale, failures told
+once with a back-off, the redo panel reusing what did not change, bakes that survive save and reload bit for bit, and
+linked data refused."""
+
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from test_blender_bake import baked_box
+
+pytestmark = pytest.mark.blender
+
+
+def _box(bpy):
+    bpy.ops.mesh.primitive_cube_add(size=1.0, scale=(2.0, 0.6, 0.4))
+    return bpy.context.active_object
+
+
+def _tessera_folders():
+    import tempfile
+
+    root = tempfile.gettempdir()
+    return {n for n in os.listdir(root) if n.startswith(("tessera-impostor-", "tessera-board-"))}
+
+
+def test_a_bake_too_large_is_refused_with_its_sizes_before_anything_starts(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    _box(bpy)
+    before = _tessera_folders()
+    t = time.perf_counter()
+    with pytest.raises(RuntimeError) as err:
+        bpy.ops.tessera.impostor_bake(grid=32, tile=2048)
+    message = str(err.value)
+    assert "65,536 x 65,536 texels" in message and "1,024 views of 2048 x 2048" in message, message
+    assert "fewer Views or a smaller View Size" in message
+    assert time.perf_counter() - t < 30  # nothing was rendered
+    assert _tessera_folders() == before
+    assert not addon_module("addon.render_jobs").open_folders()
+
+
+def test_an_atlas_job_returns_at_once_reports_progress_and_device_and_leaves_no_folder(clean_scene, bpy_module,
+                                                                                     addon_module):
+    bpy = bpy_module
+    bake = addon_module("addon.impostors.bake")
+    jobs = addon_module("addon.render_jobs")
+    box = _box(bpy)
+    aj = bake.start_atlas(box, grid=2, tile=16, samples=1)
+    assert os.path.isdir(aj.job.folder) and aj.job.folder in jobs.open_folders()
+    lines = []
+    aj.job.wait(lines.append, "Baking impostor views", timeout=300)
+    assert lines[-1] == "Tessera: Baking impostor views 4/4" and aj.job.progress() == 4
+    assert aj.job.device() == "CPU"  # no GPU is configured here: the worker says where it rendered
+    atlas = bake.read_atlas(aj)
+    assert atlas.colour.shape == (32, 32, 4) and (atlas.colour[..., 3] > 0.5).any()
+    assert not os.path.exists(aj.job.folder) and aj.job.folder not in jobs.open_folders()
+
+
+def test_cancel_stops_the_worker_and_leaves_nothing(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bake = addon_module("addon.impostors.bake")
+    aj = bake.start_atlas(_box(bpy), grid=4, tile=64, samples=256)
+    aj.job.cancel()
+    assert aj.job.process.poll() is not None and not os.path.exists(aj.job.folder)
+    assert not addon_module("addon.render_jobs").open_folders()
+
+
+def test_the_users_render_device_goes_to_the_worker(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    jobs = addon_module("addon.render_jobs")
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "GPU"
+    device = jobs.render_device()
+    prefs = bpy.context.preferences.addons["cycles"].preferences
+    assert device["type"] == prefs.compute_device_type
+    assert device["gpu"] == (prefs.compute_device_type != "NONE")  # a GPU scene renders on the CPU without one
+    scene.cycles.device = "CPU"
+    assert not jobs.render_device()["gpu"]
+
+
+def test_stale_folders_are_removed_by_name_owner_and_age(tmp_path, addon_module):
+    jobs = addon_module("addon.render_jobs")
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    now = time.time()
+
+    def folder(name, owner, age):
+        path = tmp_path / name
+        path.mkdir()
+        (path / "view.exr").write_bytes(b"x")
+        if owner is not None:
+            (path / "owner.pid").write_text(str(owner))
+        os.utime(path, (now - age, now - age))
+        return path
+
+    orphan = folder("tessera-impostor-orphan", dead.pid, 120)
+    young = folder("tessera-board-young", dead.pid, 5)  # its process may have just died: kept a while
+    mine = folder("tessera-board-mine", os.getpid(), 120)  # a live process owns it
+    ancient = folder("tessera-board-ancient", os.getpid(), 3 * 24 * 3600)
+    other = folder("tessera-tests-other", dead.pid, 3 * 24 * 3600)  # not a kind of ours
+    removed = jobs.remove_stale_folders(str(tmp_path), now)
+    assert sorted(removed) == sorted([str(orphan), str(ancient)])
+    assert young.exists() and mine.exists() and other.exists() and not orphan.exists()
+
+
+def test_a_failed_board_is_told_once_and_asked_again_after_a_back_off(clean_scene, bpy_module, addon_module,
+                                                                     monkeypatch):
+    bpy = bpy_module
+    live_mod = addon_module("addon.impostors.live")
+    board = addon_module("kernels.impostors.board")
+    TesseraError = addon_module("kernels.common.errors").TesseraError  # noqa: N806 - the add-on's own class
+
+    class FailedJob:
+        def __init__(self, setup):
+            self.setup = setup
+
+        def done(self):
+            return True
+
+        def result(self):
+            raise TesseraError("Rendering the board failed (exit 1): simulated")
+
+        def cancel(self):
+            pass
+
+    asked = []
+
+    def request(ob, eye, res_screen, fov):
+        asked.append(eye)
+        return FailedJob(board.board_setup(np.full(3, -1.0), np.ones(3), eye, res_screen, fov))
+
+    clock = [1000.0]
+    monkeypatch.setattr(live_mod.time, "monotonic", lambda: clock[0])
+    m = live_mod.NailboardManager(request)
+    ob = _box(bpy)
+    eye = np.array([0.0, -6.0, 1.0])
+    for _ in range(50):  # fifty frames: one request, one failure, no exception
+        live = m.update(ob, eye, 600, np.radians(50))
+    assert len(asked) == 1 and live.failures == 1 and live.state.startswith("Failed")
+    clock[0] += live_mod.RETRY_S + 0.1
+    m.update(ob, eye, 600, np.radians(50))
+    m.update(ob, eye, 600, np.radians(50))
+    assert len(asked) == 2 and live.failures == 2  # asked again after the back-off, which then doubles
+    assert live.retry_at - clock[0] == pytest.approx(2 * live_mod.RETRY_S)
+
+
+def test_the_redo_panel_renders_again_only_when_the_render_changes(clean_scene, bpy_module, addon_module,
+                                                                 monkeypatch):
+    bpy = bpy_module
+    bake = addon_module("addon.impostors.bake")
+    started = []
+    real = bake.start_worker
+    monkeypatch.setattr(bake, "start_worker", lambda *a: started.append(1) or real(*a))
+    box = _box(bpy)
+    for settings in ({}, {"dilation": 0, "blend": False}, {"samples": 2}):
+        bpy.context.view_layer.objects.active = box
+        assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=settings.pop("samples", 1),
+                                             **settings) == {"FINISHED"}
+    assert len(started) == 2  # Dilation and Blend Views reuse the views; Samples renders again
+
+
+def _pixels(image):
+    px = np.empty(image.size[0] * image.size[1] * 4, np.float32)
+    image.pixels.foreach_get(px)
+    return px
+
+
+def test_what_tessera_makes_survives_save_and_reload_bit_for_bit(clean_scene, bpy_module, tmp_path):
+    bpy = bpy_module
+    _, _, card = baked_box(bpy, tile=16)
+    names = sorted({n.image.name for n in card.data.materials[0].node_tree.nodes if getattr(n, "image", None)})
+    known = set(bpy.data.images.keys())
+    assert bpy.ops.tessera.vector_field_texture(width=32, height=32) == {"FINISHED"}
+    names += sorted(set(bpy.data.images.keys()) - known)
+    assert len(names) == 4  # colour, normal and depth atlases; the texture
+    before = {n: _pixels(bpy.data.images[n]) for n in names}
+    path = str(tmp_path / "made.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    for name, px in before.items():
+        image = bpy.data.images.get(name)
+        assert image is not None, f"{name} was lost"
+        assert _pixels(image).tobytes() == px.tobytes(), name
+
+
+def test_linked_data_is_refused_by_name(clean_scene, bpy_module, tmp_path):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1)
+    source = bpy.context.active_object
+    source.name = source.data.name = "Rock"
+    library = str(tmp_path / "library.blend")
+    bpy.data.libraries.write(library, {source}, fake_user=True)
+    bpy.data.objects.remove(source)
+    with bpy.data.libraries.load(library, link=True) as (data_from, data_to):
+        data_to.objects = ["Rock"]
+    rock = data_to.objects[0]
+    bpy.context.scene.collection.objects.link(rock)
+    bpy.context.view_layer.objects.active = rock
+    rock.select_set(True)
+    n = len(bpy.data.meshes)
+    for op, kw in ((bpy.ops.tessera.loop_subdivide, {"levels": 1, "output": "REPLACE"}),
+                   (bpy.ops.tessera.bake_lighting_hce, {"depth": 1})):
+        with pytest.raises(RuntimeError, match="'Rock' is linked from .*library.blend"):
+            op(**kw)
+    assert len(bpy.data.meshes) == n and rock.data.library is not None
+    assert bpy.ops.tessera.loop_subdivide(levels=1, output="NEW_OBJECT") == {"FINISHED"}  # a local copy is fine
