@@ -17,6 +17,7 @@ from ..addon.impostors.bake import atlas_images, check_atlas_size, dilated, make
 from ..addon.impostors.export import export_card, impostor_info
 from ..addon.preferences import get_preferences
 from ..addon.render_jobs import render_device
+from ..kernels.common.errors import TesseraError
 from .selection import object_poll, select_only
 
 #: The last atlas rendered (before dilation), by what its render depended on: the redo panel reuses it.
@@ -99,6 +100,7 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
     @guarded
     def _begin_guarded(self, context, tx):
+        self._name = context.active_object.name  # the object baked, whatever is active when the views are in
         self._key = _render_key(context, context.active_object, self)
         self._job = self._start(context)
         return {"FINISHED"}
@@ -142,7 +144,10 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         atlas = read_atlas(self._job)
         _last.update(key=self._key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas,
                      device=self._job.job.device())
-        return self._make(context, tx, atlas, _last["device"])
+        ob = bpy.data.objects.get(self._name)
+        if ob is None:
+            raise TesseraError(f"{self._name!r} was deleted while its views were rendered: nothing was made")
+        return self._make(context, tx, atlas, _last["device"], ob)
 
     @guarded
     def execute(self, context, tx):
@@ -161,11 +166,10 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
                 raise
             atlas, device = read_atlas(aj), aj.job.device()
             _last.update(key=key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas, device=device)
-        return self._make(context, tx, atlas, device)
+        return self._make(context, tx, atlas, device, ob)
 
-    def _make(self, context, tx, atlas, device):
-        """The card and its images from a rendered atlas (dilated here: the kept atlas stays as rendered)."""
-        ob = context.active_object
+    def _make(self, context, tx, atlas, device, ob):
+        """``ob``'s card and its images from a rendered atlas (dilated here: the kept atlas stays as rendered)."""
         atlas = dilated(atlas, self.dilation)
         name = f"{ob.name} impostor"
         images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}

@@ -161,6 +161,10 @@ def test_the_redo_panel_renders_again_only_when_the_render_changes(clean_scene, 
         assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=settings.pop("samples", 1),
                                              **settings) == {"FINISHED"}
     assert len(started) == 2  # Dilation and Blend Views reuse the views; Samples renders again
+    bpy.context.view_layer.objects.active = box
+    # invoked where there is no window (background mode, the bpy module): to the end, as a script runs it
+    assert bpy.ops.tessera.impostor_bake("INVOKE_DEFAULT", grid=2, tile=16, samples=3) == {"FINISHED"}
+    assert len(started) == 3
 
 
 def _pixels(image):
