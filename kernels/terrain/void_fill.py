@@ -70,9 +70,14 @@ def _upsample(coarse, shape):
 
 
 def label_cells(mask):
-    """8-connected components of a small bool array: (labels (same shape) int32, 0 outside, 1.. inside; count)."""
+    """8-connected components of a small bool array: (labels (same shape) int32, 0 outside, 1.. inside; count).
+
+    Each cell starts with its own index as label; every round takes the least label among the 3 x 3 neighbours, then
+    jumps each label to the label of the cell it names (pointer jumping: a label always names a cell of the same
+    component), so a long winding component settles in few rounds."""
     h, w = mask.shape
-    big = np.iinfo(np.int32).max
+    big = h * w + 1
+    inside = mask.ravel()
     lab = np.where(mask, np.arange(1, h * w + 1, dtype=np.int64).reshape(h, w), big)
     while True:
         p = np.pad(lab, 1, constant_values=big)
@@ -80,15 +85,22 @@ def label_cells(mask):
         for dy in (0, 1, 2):
             for dx in (0, 1, 2):
                 np.minimum(low, p[dy:dy + h, dx:dx + w], out=low)
-        low = np.where(mask, low, big)
+        flat = np.where(mask, low, big).ravel()
+        while True:
+            jumped = flat.copy()
+            jumped[inside] = flat[flat[inside] - 1]
+            if np.array_equal(jumped, flat):
+                break
+            flat = jumped
+        low = flat.reshape(h, w)
         if np.array_equal(low, lab):
             break
         lab = low
     ids, out = np.unique(np.where(mask, lab, 0), return_inverse=True)
     out = out.reshape(h, w).astype(np.int32)
-    if ids[0] != 0:  # every cell holds a void
+    if ids[0] != 0:  # every cell holds a void: no 0 among the labels
         out += 1
-    return out, int(mask.any() and (len(ids) - (ids[0] == 0)))
+    return out, len(ids) - 1 if ids[0] == 0 else len(ids)
 
 
 class FilledGrid(SampleGrid):
