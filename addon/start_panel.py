@@ -1,11 +1,14 @@
 """Sidebar › Tessera › Start Here: the panel that keeps the Tessera tab in the sidebar when nothing Tessera works on
 is active, with the creators (Add › Tessera), what to select for the other tools, and a link to the manual."""
 
+import textwrap
+
 import bpy
 
 from .manifest import website
 from .menus import ADD_MENU, ICONS
 from .sidebar import Sidebar
+from .viewport import stopped_previews
 
 #: What to select for each of Tessera's tools (shown when nothing fitting is active).
 SELECT_HINTS = (
@@ -40,5 +43,28 @@ class TESSERA_PT_start(Sidebar, bpy.types.Panel):
             layout.operator("wm.url_open", text="Manual", icon="HELP").url = website()
 
 
-classes = (TESSERA_PT_start,)
+class TESSERA_PT_gpu_notice(bpy.types.Panel):
+    """Shown while a viewport preview has stopped because a shader does not compile on this GPU driver: why, once."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Tessera"
+    bl_idname = "TESSERA_PT_gpu_notice"
+    bl_label = "Preview Stopped"
+    bl_order = 0
+
+    @classmethod
+    def poll(cls, context):
+        return bool(stopped_previews())
+
+    def draw(self, context):
+        col = self.layout.column(align=True)
+        for topic, message in stopped_previews().items():
+            col.label(text=f"The {topic} preview stopped drawing:", icon="ERROR")
+            for line in textwrap.wrap(message, 60):
+                col.label(text=line)
+        col.label(text="Operators still work: they compute on the CPU.")
+
+
+classes = (TESSERA_PT_gpu_notice, TESSERA_PT_start)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import bpy
 
 from ..gpu_shaders import loader
-from ..kernels.common.errors import TesseraError
+from ..kernels.common.errors import GPUShaderError, TesseraError
 
 _previews = []  # every registered Preview
 _subscribers = {}  # topic -> [callback(owner)]
@@ -143,8 +143,9 @@ class PreviewCache:
 
 # --- previews ------------------------------------------------------------------------------------------------
 
-def _view_draw(draw):
-    """A POST_VIEW handler calling ``draw(context, region, view, projection)`` (numpy 4x4s) with depth test on."""
+def _view_draw(preview):
+    """A POST_VIEW handler calling the preview's ``draw(context, region, view, projection)`` (numpy 4x4s) with depth
+    test on; nothing once the preview has stopped on a shader that does not compile (`Preview.stop`)."""
 
     def handler():
         import gpu
@@ -152,12 +153,12 @@ def _view_draw(draw):
 
         context = bpy.context
         region, rv3d = context.region, context.region_data
-        if region is None or rv3d is None:
+        if region is None or rv3d is None or preview.stopped:
             return
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
         try:
-            draw(context, region, np.array(rv3d.view_matrix), np.array(rv3d.window_matrix))
+            preview.run(context, region, np.array(rv3d.view_matrix), np.array(rv3d.window_matrix))
         finally:
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
@@ -185,6 +186,21 @@ class Preview:
         self.on_settings = on_settings or self.forget
         self.cache = PreviewCache()
         self._handler = None
+        self.stopped = ""  # why the preview stopped drawing (a shader that does not compile here), or ""
+
+    def stop(self, err):
+        """Stop drawing for the session, telling why once (the sidebar's GPU notice shows it)."""
+        if not self.stopped:
+            self.stopped = str(err)
+            print(f"Tessera: the {self.topic or 'viewport'} preview stopped: {err}. The operators compute on the CPU.")
+            tag_view3d_redraw()
+
+    def run(self, context, region, view, projection):
+        """Draw once; a shader that does not compile stops the preview (told once), never raises per frame."""
+        try:
+            self.draw(context, region, view, projection)
+        except GPUShaderError as err:
+            self.stop(err)
 
     def forget(self, ob):
         if isinstance(ob, bpy.types.Object):
@@ -197,6 +213,9 @@ class Preview:
         if entry is None and not self.cache.failed(ob):
             try:
                 entry = self.cache.put(ob, build())
+            except GPUShaderError as err:  # not this object's fault: the whole preview stops
+                self.cache.fail(ob, str(err))
+                self.stop(err)
             except TesseraError as err:
                 self.cache.fail(ob, str(err))
         return entry
@@ -210,7 +229,7 @@ class Preview:
         if self.topic is not None:
             subscribe(self.topic, self.on_settings)
         if not bpy.app.background and self._handler is None:
-            self._handler = bpy.types.SpaceView3D.draw_handler_add(_view_draw(self.draw), (), "WINDOW", "POST_VIEW")
+            self._handler = bpy.types.SpaceView3D.draw_handler_add(_view_draw(self), (), "WINDOW", "POST_VIEW")
 
     def unregister(self):
         """Undo `register` and forget every upload."""
@@ -224,6 +243,11 @@ class Preview:
             _previews.remove(self)
         if not _previews and _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
             bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
+
+
+def stopped_previews():
+    """Why previews stopped drawing: {topic: message} (empty when all draw)."""
+    return {preview.topic or "viewport": preview.stopped for preview in _previews if preview.stopped}
 
 
 def clear_previews():

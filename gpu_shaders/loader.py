@@ -5,14 +5,22 @@ the files; inputs, outputs and uniforms are declared in the create-info. Nothing
 `shader` compiles on first use (which needs a GPU context, see `addon.gpu_context`). GLSL files are named by
 their path under ``gpu_shaders/`` (``"tubes/tube_vert.glsl"``). `batch` keeps the refinement-pattern batches the
 previews draw instanced; `clear` forgets shaders and batches together.
+
+Every shader is compiled here and nowhere else (`_compile`). A shader that fails is remembered per backend (OpenGL,
+Vulkan, Metal) for the session and raised as a `GPUShaderError` naming the backend and the shader, with the start
+of the driver's log, every time it is asked for, without compiling it again: a preview stops on it once
+(`addon.viewport`), an operator's GPU path falls back to numpy.
 """
 
 from pathlib import Path
+
+from ..kernels.common.errors import GPUShaderError
 
 GLSL_DIR = Path(__file__).parent
 _sources = {}
 _shaders = {}
 _batches = {}
+_failed = {}  # (backend, shader name) -> GPUShaderError
 
 
 def source(name):
@@ -27,13 +35,47 @@ def sources(*names):
     return "\n".join(source(name) for name in names)
 
 
-def shader(name, describe):
-    """Compiled shader ``name``; ``describe()`` returns its `gpu.types.GPUShaderCreateInfo` on first use."""
-    if name not in _shaders:
-        import gpu
+def backend():
+    """The GPU backend Blender draws with: "OPENGL", "VULKAN", "METAL" (OpenGL where Blender cannot say)."""
+    import gpu
 
-        _shaders[name] = gpu.shader.create_from_info(describe())
+    try:
+        return str(gpu.platform.backend_type_get())
+    except (AttributeError, RuntimeError):
+        return "OPENGL"
+
+
+def _compile(info):
+    """The one place a shader is compiled (from its create-info)."""
+    import gpu
+
+    return gpu.shader.create_from_info(info)
+
+
+def shader(name, describe):
+    """Compiled shader ``name``; ``describe()`` returns its `gpu.types.GPUShaderCreateInfo` on first use. Raises
+    `GPUShaderError` when it does not compile on this backend (then and on every later call, without compiling it
+    again)."""
+    if name in _shaders:
+        return _shaders[name]
+    key = (backend(), name)
+    if key in _failed:
+        raise _failed[key]
+    try:
+        _shaders[name] = _compile(describe())
+    except Exception as err:  # noqa: BLE001 - Blender raises a bare Exception carrying the compiler's log
+        log = " ".join(str(err).split())
+        failed = GPUShaderError(f"Tessera's {name!r} shader does not compile on this {key[0].title()} driver "
+                                f"({log[:300] or type(err).__name__})")
+        _failed[key] = failed
+        print(f"Tessera: {failed}")  # once: the failure is remembered
+        raise failed from err
     return _shaders[name]
+
+
+def failures():
+    """The shaders that failed to compile this session: {(backend, name): message}."""
+    return {key: str(err) for key, err in _failed.items()}
 
 
 def batch(key, build):

@@ -38,7 +38,7 @@ from ..kernels.common.bezier_curves import (
     offset_copies,
 )
 from ..kernels.common.budget import check_bytes
-from ..kernels.common.errors import GPUContextError, InvalidInputError
+from ..kernels.common.errors import GPUContextError, GPUShaderError, InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
 from ..kernels.surfaces import vector_field as vf
@@ -254,15 +254,19 @@ class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
         if backend != "CPU":
             try:
                 ensure_gpu_context()
+                from ..gpu_shaders.surfaces.lic import lic_on_gpu, lic_shaders
+
+                lic_shaders()
                 backend = "GPU"
+            except GPUShaderError as err:  # the driver cannot compile it: the numpy reference makes the same image
+                self.report({"WARNING"}, f"{err}; computed on the CPU with numpy")
+                backend = "CPU"
             except GPUContextError as err:
                 if backend == "GPU":
                     raise
                 self.report({"INFO"}, f"{err}; using numpy")
                 backend = "CPU"
         if backend == "GPU":
-            from ..gpu_shaders.surfaces.lic import lic_on_gpu
-
             total, count = lic_on_gpu(field, points, values, self.width, self.height, self.step, self.steps)
         else:
             total, count = vf.splat(vf.advect(points, field, self.step, self.steps), values, self.width,

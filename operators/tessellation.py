@@ -17,7 +17,7 @@ from ..addon.tessellation.settings import (
     surface_options,
 )
 from ..kernels.common.budget import check_budget
-from ..kernels.common.errors import GPUContextError
+from ..kernels.common.errors import GPUContextError, GPUShaderError
 from ..kernels.tessellation.adaptive import adaptive_levels
 from ..kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
 from .selection import mesh_poll, place_mesh, read_source
@@ -107,10 +107,12 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
             return None
         try:
             ensure_gpu_context()
-        except GPUContextError as err:
-            notes.append(f"No GPU for the compute path ({err}); evaluated on the CPU")
+            from ..gpu_shaders.tessellation.draw import compute_shader, evaluate_on_gpu
+
+            compute_shader()
+        except (GPUContextError, GPUShaderError) as err:
+            notes.append(f"No GPU for the compute path ({err}); evaluated on the CPU with numpy")
             return None
-        from ..gpu_shaders.tessellation.draw import evaluate_on_gpu
 
         method, alpha, quadratic = self.method, self.alpha, self.pn_normals == "QUADRATIC"
         return lambda ref, inputs: evaluate_on_gpu(ref, inputs, method, alpha, quadratic)

@@ -84,6 +84,11 @@ def _read_points(texture, n):
     return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[:n].copy()
 
 
+def lic_shaders():
+    """The advection and splat shaders of `lic_on_gpu`, compiled (a `GPUShaderError` when this backend cannot)."""
+    return loader.shader("lic_advect", _describe_advect), loader.shader("lic_splat", _describe_splat)
+
+
 def lic_on_gpu(field, points, values, width, height, step, steps, keep_points=False):
     """The texture of `kernels.surfaces.vector_field.lic_image`'s splats, on the GPU: ``(total (H, W), count
     (H, W))`` float32 sums and counts, and with ``keep_points`` the points after the last step (N, 2). points (N, 2),
@@ -98,8 +103,7 @@ def lic_on_gpu(field, points, values, width, height, step, steps, keep_points=Fa
     ping = rgba_texture(rows)
     pong = gpu.types.GPUTexture((TEX_WIDTH, tex_h), format="RGBA32F")
     grid = _grid_texture(field)
-    advect = loader.shader("lic_advect", _describe_advect)
-    splat = loader.shader("lic_splat", _describe_splat)
+    advect, splat = lic_shaders()
     batch = batch_for_shader(splat, "POINTS", {"id": np.arange(n, dtype=np.float32)})
     offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA32F")
     try:

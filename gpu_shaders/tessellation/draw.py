@@ -137,6 +137,11 @@ class PatchDrawData:
             _pattern_batch(shader, key, wireframe).draw_instanced(shader, instance_start=0, instance_count=count)
 
 
+def compute_shader():
+    """The compute shader of `evaluate_on_gpu`, compiled (a `GPUShaderError` when this backend cannot)."""
+    return loader.shader("patch_compute", _describe_compute)
+
+
 def evaluate_on_gpu(ref, inputs, method="PN", alpha=0.75, pn_quadratic=True):
     """Positions and unit point normals of every vertex of ``ref`` by the compute shader.
 
@@ -152,7 +157,7 @@ def evaluate_on_gpu(ref, inputs, method="PN", alpha=0.75, pn_quadratic=True):
     height = max(1, -(-n // TEX_WIDTH))
     out_p = gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F")
     out_n = gpu.types.GPUTexture((TEX_WIDTH, height), format="RGBA32F")
-    shader = loader.shader("patch_compute", _describe_compute)
+    shader = compute_shader()
     shader.bind()
     _set_surface(shader, method, pn_quadratic, ref.spacing == "FRACTIONAL_EVEN", control)
     shader.uniform_int("vertex_count", n)

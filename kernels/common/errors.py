@@ -21,6 +21,10 @@ class GPUContextError(TesseraError):
     """No GPU context could be created (background mode without EGL/Mesa or a GPU)."""
 
 
+class GPUShaderError(TesseraError):
+    """A shader did not compile on this GPU backend (remembered: it is not compiled again in this session)."""
+
+
 class EmptyResultError(TesseraError):
     """The input is valid but gives nothing to make (curves without length, a terrain the camera does not see);
     the message says what to change."""
