@@ -1,5 +1,5 @@
 void main()
 {
-  float lit = lit_range.x + lit_range.y * shade;
-  frag_color = vec4(color.rgb * lit, color.a);
+  float lit = shading.lit_range.x + shading.lit_range.y * shade;
+  frag_color = vec4(shading.color.rgb * lit, shading.color.a);
 }

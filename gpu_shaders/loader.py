@@ -21,6 +21,9 @@ _sources = {}
 _shaders = {}
 _batches = {}
 _failed = {}  # (backend, shader name) -> GPUShaderError
+_blocks = {}  # bytes of a uniform buffer -> its GPUUniformBuf (the most recent few)
+#: Uniform buffers kept (a frame's draws share one per distinct content; older ones go first).
+KEEP_BLOCKS = 64
 
 
 def source(name):
@@ -86,7 +89,24 @@ def batch(key, build):
     return _batches[key]
 
 
+def block(data):
+    """A `gpu.types.GPUUniformBuf` holding ``data`` (float32, a multiple of 16 bytes), one per distinct content
+    (never changed after it is made, so a draw never sees another draw's values)."""
+    key = bytes(memoryview(data))
+    buf = _blocks.pop(key, None)
+    if buf is None:
+        import gpu
+
+        buf = gpu.types.GPUUniformBuf(data)
+    _blocks[key] = buf  # the most recent last
+    while len(_blocks) > KEEP_BLOCKS:
+        del _blocks[next(iter(_blocks))]
+    return buf
+
+
 def clear():
-    """Forget compiled shaders and pattern batches (their GPU context is gone, e.g. after unregister)."""
+    """Forget compiled shaders, pattern batches and uniform buffers (their GPU context is gone, e.g. after
+    unregister)."""
     _batches.clear()
     _shaders.clear()
+    _blocks.clear()

@@ -10,21 +10,40 @@ import numpy as np
 from ..kernels.common.tolerances import FLOAT32_TINY
 from . import loader
 
+#: The view and shading constants every drawing shader shares, as the uniform buffer ``shading`` (std140, every member
+#: a whole vec4 or mat4): the push constants stay within the 128 bytes Vulkan and Metal guarantee. GLSL reads
+#: ``shading.view_projection``, ``shading.color``, ``shading.light_dir.xyz``, ``shading.lit_range.xy``.
+VIEW_STRUCT = ("struct TesseraView {\n  mat4 view_projection;\n  vec4 color;\n  vec4 light_dir;\n  vec4 lit_range;\n"
+               "};\n")
+HEADLIGHT = (0.3, -0.5, 0.81)
+
+
+def add_view_block(info):
+    """Declare the shared `VIEW_STRUCT` uniform buffer ``shading`` (binding 0) on a create-info."""
+    info.typedef_source(VIEW_STRUCT)
+    info.uniform_buf(0, "TesseraView", "shading")
+
+
+def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT, lit_range=(1.0, 0.0)):
+    """The ``shading`` uniform buffer for these values; view_projection (4, 4) row-major."""
+    data = np.zeros(28, np.float32)
+    data[:16] = np.asarray(view_projection, np.float32).T.ravel()  # GLSL's matrices are column-major
+    data[16:20] = color
+    data[20:23] = light_dir
+    data[24:26] = lit_range
+    return loader.block(data)
+
 
 def shaded_create_info(name, *vertex_files):
-    """A create-info with the shading every Tessera check shader shares: a ``shade`` varying, the push
-    constants ``view_projection``, ``color``, ``light_dir``, ``lit_range`` and ``flat_mesh_frag.glsl``.
-    The vertex stage is ``vertex_files`` joined in order. The caller adds its vertex inputs, other constants
-    and samplers."""
+    """A create-info with the shading every Tessera check shader shares: a ``shade`` varying, the ``shading``
+    uniform buffer (`add_view_block`) and ``flat_mesh_frag.glsl``. The vertex stage is ``vertex_files`` joined in
+    order. The caller adds its vertex inputs, push constants and samplers."""
     import gpu
 
     iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
     iface.smooth("FLOAT", "shade")
     info = gpu.types.GPUShaderCreateInfo()
-    info.push_constant("MAT4", "view_projection")
-    info.push_constant("VEC4", "color")
-    info.push_constant("VEC3", "light_dir")
-    info.push_constant("VEC2", "lit_range")
+    add_view_block(info)
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
     info.vertex_source(loader.sources(*vertex_files))
@@ -33,12 +52,10 @@ def shaded_create_info(name, *vertex_files):
 
 
 def set_shading(shader, view_projection, color, lit):
-    """Bind ``shader`` and set the shared constants; view_projection: (4, 4) row-major."""
+    """Bind ``shader`` and its shared ``shading`` block; view_projection: (4, 4) row-major."""
     shader.bind()
-    shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
-    shader.uniform_float("color", tuple(color))
-    shader.uniform_float("light_dir", (0.3, -0.5, 0.81))
-    shader.uniform_float("lit_range", (0.25, 0.75) if lit else (1.0, 0.0))
+    shader.uniform_block("shading", view_block(view_projection, tuple(color), HEADLIGHT,
+                                               (0.25, 0.75) if lit else (1.0, 0.0)))
 
 
 def _describe_flat_mesh():

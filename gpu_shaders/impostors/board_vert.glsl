@@ -3,5 +3,5 @@ void main()
 {
   texel = corner;
   vec3 world = origin + corner.x * axis_a + corner.y * axis_b;
-  gl_Position = view_projection * vec4(world, 1.0);
+  gl_Position = shading.view_projection * vec4(world, 1.0);
 }

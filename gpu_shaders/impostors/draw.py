@@ -6,6 +6,7 @@ so the board composites per texel with the rest of the scene (it intersects and 
 import numpy as np
 
 from .. import loader
+from ..offscreen import add_view_block, view_block
 from ..textures import image_texture
 
 
@@ -15,12 +16,11 @@ def _describe():
     iface = gpu.types.GPUStageInterfaceInfo("tessera_board_iface")
     iface.smooth("VEC2", "texel")
     info = gpu.types.GPUShaderCreateInfo()
-    info.push_constant("MAT4", "view_projection")
+    add_view_block(info)
     info.push_constant("VEC3", "origin")
     info.push_constant("VEC3", "axis_a")
     info.push_constant("VEC3", "axis_b")
     info.push_constant("VEC3", "normal_f")
-    info.push_constant("VEC3", "light_dir")
     info.push_constant("INT", "lit")
     info.sampler(0, "FLOAT_2D", "offsets")
     info.sampler(1, "FLOAT_2D", "colours")
@@ -52,8 +52,9 @@ class BoardDrawData:
         self.set_splat(splat)
 
     def set_splat(self, splat):
-        """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel."""
-        self.offsets = image_texture(splat.offsets, "RG32F")
+        """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel; its holes (NaN) as -1, an
+        address no texel has (the shader tests for it: no NaN comparison on the GPU)."""
+        self.offsets = image_texture(np.nan_to_num(np.asarray(splat.offsets, np.float32), nan=-1.0), "RG32F")
 
     def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
         """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major."""
@@ -69,10 +70,9 @@ class BoardDrawData:
 
         batch = loader.batch(("nailboard", w, h), build)
         shader.bind()
-        shader.uniform_float("view_projection", np.asarray(view_projection, np.float32).T.ravel().tolist())
+        shader.uniform_block("shading", view_block(view_projection, light_dir=tuple(light_dir)))
         f = self.frame
-        for name, value in (("origin", f.origin), ("axis_a", f.a), ("axis_b", f.b), ("normal_f", f.f),
-                            ("light_dir", light_dir)):
+        for name, value in (("origin", f.origin), ("axis_a", f.a), ("axis_b", f.b), ("normal_f", f.f)):
             shader.uniform_float(name, tuple(float(x) for x in value))
         shader.uniform_int("lit", 1 if lit else 0)
         shader.uniform_sampler("offsets", self.offsets)

@@ -5,6 +5,7 @@ when ``lit_range`` is (1, 0)."""
 import numpy as np
 
 from .. import loader
+from ..offscreen import add_view_block, view_block
 
 CLAY = (0.72, 0.72, 0.72, 1.0)
 
@@ -16,9 +17,8 @@ def _describe():
     iface.smooth("FLOAT", "shade")
     iface.smooth("VEC4", "vertex_color")
     info = gpu.types.GPUShaderCreateInfo()
-    info.push_constant("MAT4", "model_view_projection")
+    add_view_block(info)
     info.push_constant("MAT4", "model_view")
-    info.push_constant("VEC2", "lit_range")
     info.vertex_in(0, "VEC3", "pos")
     info.vertex_in(1, "VEC3", "nor")
     info.vertex_in(2, "VEC4", "col")
@@ -54,9 +54,8 @@ class LoopDrawData:
         lit = not self.baked if lit is None else lit
         shader.bind()
         mvp = np.asarray(projection, np.float32) @ np.asarray(model_view, np.float32)
-        shader.uniform_float("model_view_projection", mvp.T.ravel().tolist())
+        shader.uniform_block("shading", view_block(mvp, lit_range=(0.3, 0.7) if lit else (1.0, 0.0)))
         shader.uniform_float("model_view", np.asarray(model_view, np.float32).T.ravel().tolist())
-        shader.uniform_float("lit_range", (0.3, 0.7) if lit else (1.0, 0.0))
         self._batch.draw(shader)
 
 

@@ -2,7 +2,7 @@
  * from the view-space normal, both sides lit. */
 void main()
 {
-  gl_Position = model_view_projection * vec4(pos, 1.0);
+  gl_Position = shading.view_projection * vec4(pos, 1.0);
   vec3 n = normalize(mat3(model_view) * nor);
   shade = abs(n.z);
   vertex_color = col;

@@ -4,8 +4,8 @@
 void main()
 {
   vec3 p = surface_point(kind, uv, shape);
-  gl_Position = view_projection * vec4(control_point(first_instance + gl_InstanceID).xyz + p, 1.0);
-  if (lit_range.y == 0.0) {
+  gl_Position = shading.view_projection * vec4(control_point(first_instance + gl_InstanceID).xyz + p, 1.0);
+  if (shading.lit_range.y == 0.0) {
     shade = 1.0;
     return;
   }
@@ -15,5 +15,5 @@ void main()
   vec3 n = cross(du, dv);
   float len = length(n);
   n = len > 1e-20 ? n / len : normalize(p + vec3(0.0, 0.0, 1e-6));
-  shade = abs(dot(n, light_dir));
+  shade = abs(dot(n, shading.light_dir.xyz));
 }

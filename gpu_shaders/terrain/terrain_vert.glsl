@@ -51,10 +51,10 @@ void main()
   vec2 s = rect.xy + uv * (rect.zw - rect.xy);
   float z = height_at(s);
   vec3 world = vec3((s - grid.xy) * grid.zw, z);
-  gl_Position = view_projection * vec4(world, 1.0);
+  gl_Position = shading.view_projection * vec4(world, 1.0);
   /* central differences over height_stride samples, each scaled by the other axis' texel (x: grid.z, y: grid.w) */
   vec3 n = normalize(vec3((height_at(s - vec2(height_stride, 0.0)) - height_at(s + vec2(height_stride, 0.0))) * grid.w,
                           (height_at(s - vec2(0.0, height_stride)) - height_at(s + vec2(0.0, height_stride))) * grid.z,
                           2.0 * grid.z * grid.w * height_stride));
-  shade = abs(dot(n, light_dir));
+  shade = abs(dot(n, shading.light_dir.xyz));
 }

@@ -51,38 +51,39 @@ vec3 edge_position(vec3 pa, vec3 pb, vec3 na, vec3 nb, float aa, float ab, float
   return p;
 }
 
-vec3 face_position(vec3 p[3], vec3 n[3], float a[3], vec3 b)
+/* Corners as separate parameters, not arrays (Blender's Metal translation does not rewrite array parameters). */
+vec3 face_position(vec3 p0, vec3 p1, vec3 p2, vec3 n0, vec3 n1, vec3 n2, vec3 a, vec3 b)
 {
   if (method == 2) {
-    vec3 b210 = tangent_point(p[0], p[1], n[0]), b120 = tangent_point(p[1], p[0], n[1]);
-    vec3 b021 = tangent_point(p[1], p[2], n[1]), b012 = tangent_point(p[2], p[1], n[2]);
-    vec3 b102 = tangent_point(p[2], p[0], n[2]), b201 = tangent_point(p[0], p[2], n[0]);
+    vec3 b210 = tangent_point(p0, p1, n0), b120 = tangent_point(p1, p0, n1);
+    vec3 b021 = tangent_point(p1, p2, n1), b012 = tangent_point(p2, p1, n2);
+    vec3 b102 = tangent_point(p2, p0, n2), b201 = tangent_point(p0, p2, n0);
     vec3 e = (b210 + b120 + b021 + b012 + b102 + b201) / 6.0;
-    vec3 b111 = e + (e - (p[0] + p[1] + p[2]) / 3.0) / 2.0;
-    return b.x * b.x * b.x * p[0] + b.y * b.y * b.y * p[1] + b.z * b.z * b.z * p[2] +
+    vec3 b111 = e + (e - (p0 + p1 + p2) / 3.0) / 2.0;
+    return b.x * b.x * b.x * p0 + b.y * b.y * b.y * p1 + b.z * b.z * b.z * p2 +
            3.0 * b.x * b.x * b.y * b210 + 3.0 * b.x * b.y * b.y * b120 + 3.0 * b.y * b.y * b.z * b021 +
            3.0 * b.y * b.z * b.z * b012 + 3.0 * b.x * b.z * b.z * b102 + 3.0 * b.x * b.x * b.z * b201 +
            6.0 * b.x * b.y * b.z * b111;
   }
-  vec3 q = b.x * p[0] + b.y * p[1] + b.z * p[2];
+  vec3 q = b.x * p0 + b.y * p1 + b.z * p2;
   if (method == 1) {
-    float alpha = b.x * a[0] + b.y * a[1] + b.z * a[2];
-    q += alpha * (b.x * b.y * phong_pair(p[0], p[1], n[0], n[1]) + b.y * b.z * phong_pair(p[1], p[2], n[1], n[2]) +
-                  b.z * b.x * phong_pair(p[2], p[0], n[2], n[0]));
+    float alpha = b.x * a.x + b.y * a.y + b.z * a.z;
+    q += alpha * (b.x * b.y * phong_pair(p0, p1, n0, n1) + b.y * b.z * phong_pair(p1, p2, n1, n2) +
+                  b.z * b.x * phong_pair(p2, p0, n2, n0));
   }
   return q;
 }
 
 /* The normal field (PN quadratic, or linear) at barycentrics b from corner normals s: unit. */
-vec3 face_normal(vec3 p[3], vec3 s[3], vec3 b)
+vec3 face_normal(vec3 p0, vec3 p1, vec3 p2, vec3 s0, vec3 s1, vec3 s2, vec3 b)
 {
   if (method == 2 && pn_quadratic != 0) {
-    return safe_normalize(b.x * b.x * s[0] + b.y * b.y * s[1] + b.z * b.z * s[2] +
-                          b.x * b.y * reflected_mid_normal(p[0], p[1], s[0], s[1]) +
-                          b.y * b.z * reflected_mid_normal(p[1], p[2], s[1], s[2]) +
-                          b.z * b.x * reflected_mid_normal(p[2], p[0], s[2], s[0]));
+    return safe_normalize(b.x * b.x * s0 + b.y * b.y * s1 + b.z * b.z * s2 +
+                          b.x * b.y * reflected_mid_normal(p0, p1, s0, s1) +
+                          b.y * b.z * reflected_mid_normal(p1, p2, s1, s2) +
+                          b.z * b.x * reflected_mid_normal(p2, p0, s2, s0));
   }
-  return safe_normalize(b.x * s[0] + b.y * s[1] + b.z * s[2]);
+  return safe_normalize(b.x * s0 + b.y * s1 + b.z * s2);
 }
 
 /* Evaluate pattern vertex `code` of triangle `tri` with its levels `lev` (f0, f1, f2, f_inner) and segment
@@ -138,9 +139,9 @@ void evaluate(int tri, vec4 code, vec4 lev, vec4 counts, bool shading_normals, o
       b[(c + 1) % 3] = b_next;
       b[(c + 2) % 3] = off;
     }
-    pos = face_position(p, n, a, b);
+    pos = face_position(p[0], p[1], p[2], n[0], n[1], n[2], vec3(a[0], a[1], a[2]), b);
   }
-  nor = face_normal(p, s, b);
+  nor = face_normal(p[0], p[1], p[2], s[0], s[1], s[2], b);
 }
 
 /* Corner UVs of `tri` interpolated at barycentric `b`. */

@@ -47,6 +47,6 @@ void main()
       pos += d.x * t + d.y * bt + d.z * nor;
     }
   }
-  gl_Position = view_projection * vec4(pos, 1.0);
-  shade = abs(dot(nor, light_dir));
+  gl_Position = shading.view_projection * vec4(pos, 1.0);
+  shade = abs(dot(nor, shading.light_dir.xyz));
 }

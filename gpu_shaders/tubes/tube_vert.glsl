@@ -21,7 +21,7 @@ void main()
   float radius = centre.w;
   if (clamp_radius.x > 0.0) {
     /* world size of one pixel at the centre's depth ([Nunes 2011] eq. 4-3..4-5), kept as the ring's inscribed radius */
-    vec4 clip = view_projection * vec4(centre.xyz, 1.0);
+    vec4 clip = shading.view_projection * vec4(centre.xyz, 1.0);
     if (clip.w > 0.0) {
       float z = clip.z / clip.w;
       vec4 a = inverse_view_projection * vec4(0.0, 0.0, z, 1.0);
@@ -34,6 +34,6 @@ void main()
     }
   }
   vec3 world = centre.xyz + radius * radial;
-  gl_Position = view_projection * vec4(world, 1.0);
-  shade = abs(dot(radial, light_dir));
+  gl_Position = shading.view_projection * vec4(world, 1.0);
+  shade = abs(dot(radial, shading.light_dir.xyz));
 }
