@@ -19,6 +19,7 @@ lint: setup
 test: setup
 	$(PY) -m ruff check .
 	$(PY) -m pytest
+	TESSERA_GPU_BACKEND=VULKAN $(PY) -m pytest -q -m gpu
 
 test-all:
 	@bash tools/matrix.sh

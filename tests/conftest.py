@@ -20,6 +20,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 CI = os.environ.get("CI", "").strip().lower() in ("1", "true", "yes")
+#: The GPU backend the gpu tier runs on: OPENGL (llvmpipe), or VULKAN (lavapipe, `tools/gpu_backend.py`).
+GPU_BACKEND = os.environ.get("TESSERA_GPU_BACKEND", "OPENGL").strip().upper()
 _TMP = Path(tempfile.mkdtemp(prefix="tessera-tests-"))
 REPO_DIR = _TMP / "repo"  # holds the symlink "tessera" -> source tree
 REPO_DIR.mkdir()
@@ -86,6 +88,13 @@ def bpy_module():
         import bpy
     except ImportError as err:
         tier_unavailable(f"the bpy module is not installed ({err})")
+    if GPU_BACKEND == "VULKAN":  # the gpu tier's Vulkan run: before any GPU context exists
+        from tessera.tools.gpu_backend import use_vulkan
+
+        try:
+            use_vulkan()
+        except RuntimeError as err:
+            tier_unavailable(f"Vulkan cannot be selected: {err}")
     return bpy
 
 

@@ -69,6 +69,22 @@ if [ -f /usr/include/opensubdiv/far/topologyRefiner.h ] && command -v g++ >/dev/
   echo "setup: built $osd_lib"
 fi
 
+# Mesa's lavapipe (Vulkan on the CPU) for the gpu tier's Vulkan run, unpacked into out/vulkan so the system's Mesa
+# stays as it is; tools/gpu_backend.py points Blender's own Vulkan loader at it.
+vk_dir=out/vulkan
+if [ ! -f "$vk_dir/lvp_icd.json" ] && command -v apt-get >/dev/null 2>&1 && command -v dpkg >/dev/null 2>&1; then
+  mkdir -p "$vk_dir/debs"
+  if (cd "$vk_dir/debs" && apt-get download -qq mesa-vulkan-drivers >/dev/null 2>&1); then
+    dpkg -x "$vk_dir"/debs/mesa-vulkan-drivers_*.deb "$vk_dir/root"
+    lvp=$(find "$(pwd)/$vk_dir/root" -name libvulkan_lvp.so | head -1)
+    printf '{"file_format_version": "1.0.0", "ICD": {"api_version": "1.1.0", "library_path": "%s"}}\n' "$lvp" \
+      > "$vk_dir/lvp_icd.json"
+    echo "setup: Mesa lavapipe (Vulkan on the CPU) unpacked in $vk_dir"
+  else
+    echo "setup: could not download mesa-vulkan-drivers: the gpu tier's Vulkan run is unavailable"
+  fi
+fi
+
 version=${1:-}
 if [ -z "$version" ]; then  # the newest Blender whose Python is here
   if find_python 3.13 >/dev/null; then version=5.2; else version=5.0; fi
