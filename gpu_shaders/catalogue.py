@@ -17,6 +17,7 @@ SHADERS = (
     ("patch_preview", "tessellation.draw", "_describe_preview"),
     ("patch_compute", "tessellation.draw", "_describe_compute"),
     ("terrain_preview", "terrain.draw", "_describe"),
+    ("texture_copy", "textures", "_describe_copy"),
 )
 
 

@@ -88,7 +88,7 @@ def evaluate_stencils_on_gpu(table, positions):
     coarse positions (V, 3), by the compute shader: one invocation per coarse triangle. Needs a GPU context."""
     import gpu
 
-    from ..textures import TEX_WIDTH, rgba_texture
+    from ..textures import TEX_WIDTH, read_after_compute, rgba_texture
 
     if table.n_vertices >= 2**24 or len(positions) >= 2**24:
         raise ValueError("the GPU stencil path keeps ids as exact float32: at most 16.7M vertices")
@@ -108,6 +108,4 @@ def evaluate_stencils_on_gpu(table, positions):
         shader.uniform_sampler(name, tex)
     shader.image("out_positions", out)
     gpu.compute.dispatch(shader, -(-n_f // 64), 1, 1)
-    buf = out.read()
-    buf.dimensions = out.width * out.height * 4
-    return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[: table.n_vertices, :3].copy()
+    return read_after_compute(out, table.n_vertices)[:, :3].copy()

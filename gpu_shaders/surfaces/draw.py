@@ -15,7 +15,7 @@ from ...kernels.surfaces.domain_mesh import domain_pattern
 from ...kernels.surfaces.parametric import SURFACES
 from .. import loader
 from ..offscreen import set_shading, shaded_create_info
-from ..textures import TEX_WIDTH, rgba_texture
+from ..textures import TEX_WIDTH, read_after_compute, rgba_texture
 
 KINDS = {cls: i for i, cls in enumerate(SURFACES.values())}
 
@@ -145,6 +145,4 @@ def evaluate_on_gpu(surface, control_points, factor):
     shader.uniform_sampler("control_points", control)
     shader.image("out_positions", out)
     gpu.compute.dispatch(shader, TEX_WIDTH // 64, height, 1)
-    buf = out.read()
-    buf.dimensions = out.width * out.height * 4  # multi-dimensional Buffers export wrong strides
-    return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[:n, :3].copy()
+    return read_after_compute(out, n)[:, :3].copy()

@@ -7,7 +7,7 @@ import numpy as np
 
 from ...kernels.surfaces.vector_field import AnalyticField, GridField
 from .. import loader
-from ..textures import TEX_WIDTH, image_texture, rgba_texture
+from ..textures import TEX_WIDTH, image_texture, read_after_compute, rgba_texture
 
 FIELD_CODES = {"ABC": 0, "VORTEX": 1}
 
@@ -79,9 +79,7 @@ def _grid_texture(field):
 
 
 def _read_points(texture, n):
-    buf = texture.read()
-    buf.dimensions = texture.width * texture.height * 4  # multi-dimensional Buffers export wrong strides
-    return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[:n].copy()
+    return read_after_compute(texture, n)
 
 
 def lic_shaders():

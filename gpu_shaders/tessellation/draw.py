@@ -12,7 +12,7 @@ import numpy as np
 from ...kernels.tessellation import patch_instances as pi
 from .. import loader
 from ..offscreen import set_shading, shaded_create_info
-from ..textures import TEX_WIDTH, rgba_texture
+from ..textures import TEX_WIDTH, read_after_compute, rgba_texture
 
 METHOD_CODES = {"LINEAR": 0, "PHONG": 1, "PN": 2}
 DISPLACE_CODES = {"HEIGHT": 1, "VECTOR": 2, "TANGENT": 3}
@@ -165,10 +165,4 @@ def evaluate_on_gpu(ref, inputs, method="PN", alpha=0.75, pn_quadratic=True):
     shader.image("out_positions", out_p)
     shader.image("out_normals", out_n)
     gpu.compute.dispatch(shader, TEX_WIDTH // 64, height, 1)
-    return _read(out_p, n), _read(out_n, n)
-
-
-def _read(texture, n):
-    buf = texture.read()
-    buf.dimensions = texture.width * texture.height * 4  # multi-dimensional Buffers export wrong strides
-    return np.asarray(memoryview(buf), dtype=np.float32).reshape(-1, 4)[:n, :3].copy()
+    return read_after_compute(out_p, n)[:, :3].copy(), read_after_compute(out_n, n)[:, :3].copy()
