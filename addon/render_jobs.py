@@ -49,6 +49,12 @@ def job_folder(kind):
     return folder
 
 
+def track(folder, job):
+    """Count ``job`` (anything with ``cancel()``: a nailboard's job) as the job of ``folder``, so that `close_all`
+    stops it with the add-on or Blender."""
+    _open_jobs[folder] = job
+
+
 def remove_folder(folder):
     """Remove a job folder and forget it (nothing happens when it is gone already)."""
     _open_jobs.pop(folder, None)

@@ -23,7 +23,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
-from ..render_jobs import job_folder, remove_folder, render_device
+from ..render_jobs import job_folder, remove_folder, render_device, track
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
 
@@ -107,6 +107,7 @@ class BoardJob:
     def __init__(self, setup, process, folder, out, preview_out=None):
         self.setup, self.process, self.folder, self.out = setup, process, folder, out
         self.preview_out = preview_out
+        track(folder, self)  # stopped with the add-on or Blender if still running
         self._images = None  # the reading of the images (a future), started once the process has finished
         self._preview = None  # the reading of the preview's images, started once its file is there
 
