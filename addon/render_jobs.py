@@ -49,6 +49,17 @@ def job_folder(kind):
     return folder
 
 
+def stop_process(process, timeout=10.0):
+    """Kill a worker process still running and wait for it: whether it has ended."""
+    if process.poll() is None:
+        process.kill()
+        try:
+            process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return False
+    return True
+
+
 def track(folder, job):
     """Count ``job`` (anything with ``cancel()``: a nailboard's job) as the job of ``folder``, so that `close_all`
     stops it with the add-on or Blender."""
@@ -178,12 +189,7 @@ class RenderJob:
 
     def cancel(self):
         """Stop the worker and remove the folder: nothing of the job is left."""
-        if self.process.poll() is None:
-            self.process.kill()
-            try:
-                self.process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                pass
+        stop_process(self.process)
         remove_folder(self.folder)
 
     def close(self):

@@ -23,7 +23,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
-from ..render_jobs import job_folder, remove_folder, render_device, track
+from ..render_jobs import job_folder, remove_folder, render_device, stop_process, track
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
 
@@ -163,14 +163,10 @@ class BoardJob:
         return BoardImages(self.setup, colours, d, np.stack([nx, ny, nz], -1), present)
 
     def cancel(self):
-        """Stop the worker; the folder goes once the process is gone (now, or when `done` next finds it ended)."""
-        if self.process.poll() is None:
-            self.process.kill()
-            try:
-                self.process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                return
-        remove_folder(self.folder)
+        """Stop the worker and remove the folder once the process is gone (a process that does not end in time leaves
+        it to the sweep at the next start)."""
+        if stop_process(self.process):
+            remove_folder(self.folder)
 
 
 def resample_images(images, resolution):
