@@ -31,14 +31,12 @@ def test_a_bake_too_large_is_refused_with_its_sizes_before_anything_starts(clean
     bpy = bpy_module
     _box(bpy)
     before = _tessera_folders()
-    t = time.perf_counter()
     with pytest.raises(RuntimeError) as err:
         bpy.ops.tessera.impostor_bake(grid=32, tile=2048)
     message = str(err.value)
     assert "65,536 x 65,536 texels" in message and "1,024 views of 2048 x 2048" in message, message
     assert "fewer Views or a smaller View Size" in message
-    assert time.perf_counter() - t < 30  # nothing was rendered
-    assert _tessera_folders() == before
+    assert _tessera_folders() == before  # refused before a job (folder, worker) was started
     assert not addon_module("addon.render_jobs").open_folders()
 
 
