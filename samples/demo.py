@@ -289,14 +289,19 @@ def build_terrain_scene(size=1025):
     out.close()
     add_camera((0.0, -640.0, 260.0), (1.2, 0.0, 0.0), lens=30)
     bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 1280, 620
-    result = bpy.ops.tessera.terrain_add(filepath=path, texel_size=1.0, height_scale=180.0, tile_size=32,
-                                         epsilon=2.0)
+    ob = _terrain(bpy.ops.tessera.terrain_add(filepath=path, texel_size=1.0, height_scale=180.0, tile_size=32,
+                                              epsilon=2.0), "Rock", (0.55, 0.5, 0.42, 1.0), 0.25)
+    return len(ob.data.polygons), 2 * (size - 1) ** 2
+
+
+def _terrain(result, name, rgba, wire):
+    """The terrain ``tessera.terrain_add`` just made (its ``result`` checked), with a material and a wireframe."""
     if result != {"FINISHED"}:
         sys.exit(f"demo: terrain_add returned {result}")
     ob = bpy.context.active_object
-    ob.data.materials.append(material("Rock", (0.55, 0.5, 0.42, 1.0)))
-    wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=0.25)
-    return len(ob.data.polygons), 2 * (size - 1) ** 2
+    ob.data.materials.append(material(name, rgba))
+    wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=wire)
+    return ob
 
 
 def build_geotiff_scene(size=513):
@@ -318,14 +323,9 @@ def build_geotiff_scene(size=513):
                             corner=(400000.0 + 30.0 * c0, 5100000.0), tile=(128, 128))
         names.append(name)
     add_camera((0.0, -14500.0, 9000.0), (0.98, 0.0, 0.0), lens=30).data.clip_end = 60000.0  # a 15 km terrain
-    result = bpy.ops.tessera.terrain_add(filepath=str(OUT / names[0]), directory=str(OUT),
-                                         files=[{"name": n} for n in names], voids="HOLES", tile_size=32,
-                                         epsilon=1.5)
-    if result != {"FINISHED"}:
-        sys.exit(f"demo: terrain_add (GeoTIFF) returned {result}")
-    ob = bpy.context.active_object
-    ob.data.materials.append(material("Ground", (0.5, 0.55, 0.4, 1.0)))
-    wire_overlay(ob, material("Wire", (0.05, 0.05, 0.08, 1.0)), thickness=4.0)
+    ob = _terrain(bpy.ops.tessera.terrain_add(filepath=str(OUT / names[0]), directory=str(OUT),
+                                              files=[{"name": n} for n in names], voids="HOLES", tile_size=32,
+                                              epsilon=1.5), "Ground", (0.5, 0.55, 0.4, 1.0), 4.0)
     return len(ob.data.polygons), int(lake.sum())
 
 

@@ -14,6 +14,7 @@ from tessera.kernels.terrain import mesh as tm
 from tessera.kernels.terrain import sample_grid, void_fill
 from tessera.kernels.terrain.synth import ridged_terrain
 from tessera.tools.geotiff_files import write_geotiff
+from test_terrain_lod import _random_camera
 
 NODATA = -32768
 
@@ -116,14 +117,6 @@ def test_voids_never_become_heights(tmp_path, dtype, fill):
     assert np.array_equal(rows, h)
 
 
-def _camera(rng, hm):
-    half = (hm.width - 1) * hm.texel_size * 0.5
-    eye = rng.uniform(-2 * half, 2 * half, 3)
-    eye[2] = rng.uniform(500, 3 * half)
-    target = np.append(rng.uniform(-half, half, 2), 1000.0)
-    return Camera.looking_at(eye, target, fov_deg=rng.uniform(25, 70), width=640, height=360, far=40 * half)
-
-
 def test_holes_cut_exactly_the_triangles_on_voids_from_random_cameras(tmp_path):
     top = _with_voids(_dem(), NODATA).astype(np.int16)
     path = write_geotiff(str(tmp_path / "h.tif"), top, nodata=NODATA)
@@ -134,7 +127,7 @@ def test_holes_cut_exactly_the_triangles_on_voids_from_random_cameras(tmp_path):
     assert np.array_equal(ta_fill.ham_max, ta_holes.ham_max)  # the analysis sees the same filled ground
     rng = np.random.default_rng(5)
     for _ in range(6):
-        cam = _camera(rng, filled)
+        cam = _random_camera(rng, filled, lowest=500.0, target_z=1000.0, far=40.0)  # over 1 km of relief
         sel = tl.select(filled, ta_fill, cam, tl.TerrainLod(levels="FRACTIONAL", culling=False))
         a, b = tm.bake(filled, ta_fill, sel), tm.bake(holes, ta_fill, sel)
         corners = a.samples[a.triangles]  # (m, 3, 2)

@@ -19,12 +19,14 @@ def _terrain(size=257, seed=0):
     return hio.from_array(h.astype(np.float32), texel_size=2.0)
 
 
-def _random_camera(rng, hm):
+def _random_camera(rng, hm, lowest=20.0, target_z=0.0, far=20.0):
+    """A camera somewhere over the terrain (at least ``lowest`` up) looking at a point of it at height ``target_z``;
+    the clip end ``far`` half-widths away."""
     half = (hm.width - 1) * hm.texel_size * 0.5
     eye = rng.uniform(-2 * half, 2 * half, 3)
-    eye[2] = rng.uniform(20, 3 * half)
-    target = np.append(rng.uniform(-half, half, 2), 0.0)
-    return Camera.looking_at(eye, target, fov_deg=rng.uniform(25, 70), width=640, height=360, far=20 * half)
+    eye[2] = rng.uniform(lowest, 3 * half)
+    target = np.append(rng.uniform(-half, half, 2), target_z)
+    return Camera.looking_at(eye, target, fov_deg=rng.uniform(25, 70), width=640, height=360, far=far * half)
 
 
 def _boundary_edges(tris):
