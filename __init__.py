@@ -42,6 +42,7 @@ _modules = (
     "addon.impostors.preview",
     "addon.displacement.brush_cursor",
     "addon.displacement.brush_tool",
+    "addon.command_line",
 )
 
 

@@ -205,7 +205,10 @@ def _set_custom_normals(mesh, normals, domain="CORNER"):
 
 
 def _add_geometry(mesh, positions, corner_verts, loop_starts):
-    """Allocate and fill vertices (V, 3) float32, corners (L,) int32 and faces (F,) int32 loop starts."""
+    """Allocate and fill vertices (V, 3) float32, corners (L,) int32 and faces (F,) int32 loop starts. An empty mesh
+    (V = 0: a block of a terrain the camera does not see) stays empty: Blender has no position attribute then."""
+    if len(positions) == 0:
+        return
     mesh.vertices.add(len(positions))
     mesh.loops.add(len(corner_verts))
     mesh.polygons.add(len(loop_starts))

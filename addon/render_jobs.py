@@ -77,7 +77,7 @@ def open_folders():
     return list(_open_jobs)
 
 
-def _alive(pid):
+def is_alive(pid):
     if os.name != "posix":
         return True  # no cheap check: only age decides
     try:
@@ -115,7 +115,7 @@ def remove_stale_folders(root=None, now=None):
                 age = now - os.path.getmtime(folder)
             except OSError:
                 continue
-        if age > STALE_AGE_S or (age > ORPHAN_AGE_S and not (owner and _alive(owner))):
+        if age > STALE_AGE_S or (age > ORPHAN_AGE_S and not (owner and is_alive(owner))):
             shutil.rmtree(folder, ignore_errors=True)
             removed.append(folder)
     return removed

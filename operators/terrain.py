@@ -5,6 +5,7 @@ import os
 import time
 
 import bpy
+import numpy as np
 
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import check_numbers, guarded
@@ -41,9 +42,36 @@ def _nothing_seen(hm, table, camera):
             "off Frustum Culling")
 
 
-def _bake_into(context, ob, camera, report, tx):
+#: A terrain's whole tile grid as a `block` (column, row, columns, rows of an even split).
+WHOLE = (0, 0, 1, 1)
+
+
+def _block_property():
+    return bpy.props.IntVectorProperty(
+        name="Block", size=4, default=WHOLE, min=0, max=4096, options={"SKIP_SAVE"},
+        description="Mesh one block of an even split of the terrain's tiles: column, row, columns, rows (0, 0, 2, 2 "
+                    "is the lower-left quarter). Blocks of one split meet without cracks, so render-farm tasks can "
+                    "each mesh one; 0, 0, 1, 1 meshes the whole terrain")
+
+
+def block_tiles(block, counts):
+    """Tile columns and rows of ``block`` (column, row, columns, rows) on a ``counts`` = (ntx, nty) grid: two
+    ``range``s. Raises `InvalidInputError` for a block outside its split."""
+    col, row, cols, rows = (int(v) for v in block)
+    if cols < 1 or rows < 1 or not (0 <= col < cols and 0 <= row < rows):
+        raise InvalidInputError(f"Block {col}, {row} of a {cols} x {rows} split does not exist: the column must be "
+                                "below the columns and the row below the rows, both at least 1")
+    ntx, nty = counts
+    return range(ntx * col // cols, ntx * (col + 1) // cols), range(nty * row // rows, nty * (row + 1) // rows)
+
+
+def _bake_into(context, ob, camera, report, tx, block=WHOLE):
     """Select levels for ``camera``, check the budget, bake and write the mesh (its new mesh tracked by the
-    `Transaction` ``tx``). Returns the selection. Raises `EmptyResultError` when the camera sees no tile."""
+    `Transaction` ``tx``). Returns the selection. Raises `EmptyResultError` when the camera sees no tile.
+
+    ``block`` (column, row, columns, rows) meshes only that block's tiles of an even split: levels are chosen for
+    the whole terrain first, so the blocks of one split weld into exactly the whole terrain's mesh. A block the
+    camera does not see gets an empty mesh."""
     s = ob.tessera.terrain
     wm = context.window_manager
     hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)))
@@ -51,8 +79,14 @@ def _bake_into(context, ob, camera, report, tx):
     local_camera = object_camera(camera, ob.matrix_world) if camera else None
     sel = select(hm, table, local_camera, lod_settings(s))
     t_select = time.perf_counter() - t0
+    whole = tuple(block) == WHOLE
+    if not whole:
+        xs, ys = block_tiles(block, table.counts)
+        inside = np.zeros_like(sel.culled)
+        inside[ys.start:ys.stop, xs.start:xs.stop] = True
+        sel.culled |= ~inside
     n_tris = triangle_count(sel)
-    if n_tris == 0:  # every tile culled: say which of the camera's settings keeps the terrain out
+    if n_tris == 0 and whole:  # every tile culled: say which of the camera's settings keeps the terrain out
         raise EmptyResultError(_nothing_seen(hm, table, local_camera))
     check_bytes(n_tris * _BYTES_PER_TRIANGLE, get_preferences(context).memory_budget_bytes,
                 f"The terrain mesh would have {n_tris:,} triangles", "a larger Screen Error or Adaptive levels")
@@ -61,6 +95,8 @@ def _bake_into(context, ob, camera, report, tx):
     tx.track(terrain_data.write_terrain_mesh(ob, f"{ob.name}.terrain", mesh))
     full = 2 * (hm.width - 1) * (hm.height - 1)
     view = "for the camera" if camera is not None else "view-independent (no camera)"
+    if not whole:
+        view += f", block {block[0]}, {block[1]} of {block[2]} x {block[3]}"
     report({"INFO"}, f"Terrain {view}: {len(mesh.triangles):,} triangles, {100 * len(mesh.triangles) / full:.2f}% "
                      f"of the full grid; {int(sel.culled.sum())} of {sel.culled.size} tiles culled; "
                      f"levels selected in {t_select * 1e3:.1f} ms")
@@ -99,6 +135,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     # several files picked at once (the adjacent tiles of one elevation model) become one terrain
     files: bpy.props.CollectionProperty(type=bpy.types.OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})
     directory: bpy.props.StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"})
+    block: _block_property()
 
     @classmethod
     def poll(cls, context):
@@ -132,7 +169,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
             ob.tessera.terrain.is_terrain = True
             ob.location = context.scene.cursor.location
             context.collection.objects.link(ob)
-            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx)
+            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx, self.block)
             geo = terrain_data.georeference(ob)
             if geo is not None:
                 _place(context, ob, geo, self.report)
@@ -148,6 +185,8 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
     bl_idname = "tessera.terrain_bake"
     bl_label = "Bake Terrain for Camera"
     bl_options = {"REGISTER", "UNDO"}
+
+    block: _block_property()
 
     @classmethod
     def poll(cls, context):
@@ -165,7 +204,7 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
         wm.progress_begin(0, 100)
         try:
             camera = camera_for(context, ob.tessera.terrain.camera_source, "Baking a terrain for a camera")
-            _bake_into(context, ob, camera, self.report, tx)
+            _bake_into(context, ob, camera, self.report, tx, self.block)
         finally:
             wm.progress_end()
         return {"FINISHED"}

@@ -3,6 +3,7 @@ Tessera have the ``bpy`` wheel of each supported Blender but no Blender executab
 
 Handled, in Blender's own order (arguments act as they come): ``-b``/``--background``, ``--factory-startup``,
 ``--command``/``-c extension ...`` (Blender's own extension command-line handler, as ``blender -c extension`` runs it),
+``-c ID ...`` for a command an enabled add-on registered (``blender -c tessera ...``),
 a ``.blend`` to open, ``--python FILE``, ``-o``/``--render-output``, ``-E``/``--engine``, ``-f``/``--render-frame``
 and ``-a``/``--render-anim``. As Blender does at startup, the user's preferences are loaded and the add-ons they
 enable are enabled (unless ``--factory-startup``; on 4.2, whose module cannot reload preferences, the extensions
@@ -55,10 +56,33 @@ def _render(frames):
         print(f"Saved: '{path}'")
 
 
+def _command(name, args):
+    """``-c NAME ARGS``: an add-on's registered command, run after startup (Blender's ``bpy.utils.register_cli_command``
+    registry, recorded here as the enabled add-ons register into it). Exit code 1 when no add-on registered it."""
+    import bpy
+
+    commands = {}
+    register = bpy.utils.register_cli_command
+
+    def recording(command_id, execute):
+        commands[command_id] = execute
+        return register(command_id, execute)
+
+    bpy.utils.register_cli_command = recording
+    try:
+        _startup(False)
+    finally:
+        bpy.utils.register_cli_command = register
+    if name not in commands:
+        print(f"Error: command {name!r} not found", file=sys.stderr)
+        return 1
+    return commands[name](args)
+
+
 def main(argv):
     if argv[:1] in (["--command"], ["-c"]):
         if argv[1:2] != ["extension"]:
-            raise SystemExit(f"blender_cli: no command {argv[1:2]} here (only 'extension')")
+            return _command(argv[1], argv[2:])
         import bpy  # noqa: F401 (bl_pkg needs Blender's modules)
         from bl_pkg import bl_extension_cli
 

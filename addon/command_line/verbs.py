@@ -1,0 +1,333 @@
+"""The verbs of ``blender -c tessera VERB ...``: each runs one Tessera operator through its guarded path, on the objects
+or files named, and writes the results through Blender's exporters (`files`).
+
+Per-object verbs (tessellate, tubes, loop, surface, impostors) run their operator once per source object, each alone
+selected and active, so the same object gives the same result whether it is baked with others or in a task of its
+own. ``terrain`` meshes height maps (one block of a split with ``--block``, for each frame of ``--frames``). ``join``
+puts the meshes of several outputs together and welds the vertices that coincide exactly (the blocks of a terrain).
+
+A run either writes every output or none: when one object fails the others are still tried (every failure is
+reported), then nothing is written and the exit code is 1.
+"""
+
+import argparse
+import fnmatch
+import os
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+
+import bpy
+
+from . import files
+from .options import add_options, chosen, settable
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Verb:
+    """A command-line verb: the operator it runs, the object types it takes (``kinds``; those taken when no
+    ``--objects`` is given: ``default_kinds``), operator options the command line sets itself (``fixed``)."""
+
+    name: str
+    operator: str
+    summary: str
+    kinds: frozenset = frozenset()
+    default_kinds: frozenset = frozenset()
+    fixed: dict = field(default_factory=dict)
+    outputs: tuple = ()  # formats this verb writes, when not every Blender exporter
+
+
+_GEOMETRY = frozenset({"MESH", "CURVE", "SURFACE", "META", "FONT"})
+VERBS = {v.name: v for v in (
+    Verb("tessellate", "tessera.tessellate", "Smooth meshes with PN triangles or Phong, uniformly or for the camera",
+         frozenset({"MESH"}), frozenset({"MESH"}), {"output": "NEW_OBJECT"}),
+    Verb("tubes", "tessera.tubes", "Build tubes around curves, hair curves (and meshes' edges, when named)",
+         frozenset({"CURVE", "CURVES", "MESH"}), frozenset({"CURVE", "CURVES"})),
+    Verb("loop", "tessera.loop_subdivide", "Smooth triangle meshes with Loop subdivision",
+         frozenset({"MESH"}), frozenset({"MESH"}), {"output": "NEW_OBJECT"}),
+    Verb("surface", "tessera.surface_tessellate", "Turn NURBS and Bezier surface objects into meshes, to a tolerance",
+         frozenset({"SURFACE"}), frozenset({"SURFACE"})),
+    Verb("impostors", "tessera.impostor_bake", "Render objects from many directions with Cycles onto impostor cards",
+         _GEOMETRY, _GEOMETRY, outputs=(".blend", ".glb")),
+    Verb("terrain", "tessera.terrain_add", "Mesh height maps and GeoTIFF elevation data for the scene camera"),
+)}
+_TERRAIN_BAKE = Verb("terrain", "tessera.terrain_bake", "Mesh a terrain again for the camera")
+#: Operator options the command line sets itself or that need a window.
+_NOT_OPTIONS = {"output", "camera_source", "filepath", "tile_files", "source", "image_name"}
+
+
+class Usage(Exception):
+    """Bad arguments (exit code 2)."""
+
+
+class Stopped(Exception):
+    """The process was asked to stop (SIGTERM, as farm managers send): unwind, removing partial files."""
+
+
+#: Set when a stop was asked for (an operator that the signal interrupted reports a failure; this tells them apart).
+stopping = set()
+
+
+def stop(signum, frame):
+    stopping.add(signum)
+    raise Stopped(f"stopped by signal {signum}; nothing was written")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise Usage(f"{self.prog}: {message}")
+
+
+def _say(line):
+    print(f"tessera: {line}", file=sys.stderr, flush=True)
+
+
+def parser_for(verb):
+    """The argparse parser of ``verb`` (a `Verb`), with its operator's settings as options."""
+    p = _Parser(prog=f"blender -c tessera {verb.name}", description=verb.summary + ".", allow_abbrev=False)
+    if verb.name == "terrain":
+        p.add_argument("inputs", nargs="+", metavar="FILE",
+                       help="height maps (the first is the map, the rest its neighbouring tiles, in one folder), and "
+                            "at most one .blend: the scene whose camera the terrain is meshed for")
+        p.add_argument("--frames", metavar="A-B", help="mesh for the camera at each frame from A to B (one output "
+                                                       "per frame: put {frame} or #### in the output name)")
+    else:
+        p.add_argument("inputs", nargs="*", metavar="FILE",
+                       help="a .blend to open and/or mesh files to import (OBJ, PLY, STL, glTF, USD, Alembic, FBX); "
+                            "none: the file already open")
+        p.add_argument("--objects", metavar="NAMES",
+                       help="the objects to work on, comma-separated, * and ? as wildcards (default: every "
+                            + "/".join(sorted(verb.default_kinds)).lower() + " object)")
+    p.add_argument("-o", "--out", metavar="FILE", required=True,
+                   help="where to write the results: .blend (the whole scene) or "
+                        + ", ".join(verb.outputs or sorted(files.EXPORTERS))
+                        + "; {object} in the name writes one file per source object")
+    p.add_argument("--camera", metavar="NAME", help="the camera object to use as the scene camera")
+    p.add_argument("--frame", type=int, metavar="N", help="the scene frame (for an animated camera)")
+    p.add_argument("--json", nargs="?", const="-", metavar="FILE",
+                   help="print a JSON summary as the last line of the output (or write it to FILE)")
+    add_options(p, settable(verb.operator, _NOT_OPTIONS | set(verb.fixed)))
+    return p
+
+
+@dataclass
+class Summary:
+    """What a run did, for ``--json``."""
+
+    verb: str
+    ok: bool = False
+    results: list = field(default_factory=list)  # {"source", "objects", "vertices", "faces", "seconds"}
+    failures: list = field(default_factory=list)  # {"source", "error"}
+    outputs: list = field(default_factory=list)
+    seconds: float = 0.0
+
+
+def _counts(objects):
+    v = f = 0
+    for ob in objects:
+        if ob.type == "MESH":
+            v, f = v + len(ob.data.vertices), f + len(ob.data.polygons)
+    return v, f
+
+
+def _run_operator(verb, kwargs, source, summary, edits=None):
+    """Run ``verb``'s operator; returns the objects it added, or ``edits`` (the objects it changes) when given; None
+    on failure (recorded in ``summary``)."""
+    module, name = verb.operator.split(".")
+    before = set(bpy.data.objects)
+    t0 = time.perf_counter()
+    try:
+        getattr(getattr(bpy.ops, module), name)(**kwargs)
+    except RuntimeError as err:  # the operator's report: what to change
+        if stopping:
+            raise Stopped(f"stopped by signal {min(stopping)}; nothing was written")
+        message = str(err).strip()
+        message = message[len("Error: "):] if message.startswith("Error: ") else message
+        summary.failures.append({"source": source, "error": message})
+        _say(f"{source}: FAILED: {message}")
+        return None
+    made = edits if edits is not None else [ob for ob in bpy.data.objects if ob not in before]
+    vertices, faces = _counts(made)
+    seconds = time.perf_counter() - t0
+    summary.results.append({"source": source, "objects": [ob.name for ob in made], "vertices": vertices,
+                            "faces": faces, "seconds": round(seconds, 3)})
+    _say(f"{source} -> {', '.join(ob.name for ob in made) or 'nothing'} ({vertices:,} vertices, {faces:,} faces) "
+         f"in {seconds:.2f} s")
+    return made
+
+
+def split_patterns(text):
+    """``"Tree*,Rock[,]1"`` -> ``["Tree*", "Rock[,]1"]``: commas separate, except inside ``[...]``."""
+    return [s.strip() for s in re.split(r",(?![^\[]*\])", text) if s.strip()]
+
+
+def targets(verb, patterns):
+    """The source objects of a per-object verb: named by ``patterns`` (comma-separated wildcards) or by kind."""
+    scene_objects = list(bpy.context.scene.objects)
+    if not patterns:
+        found = [ob for ob in scene_objects if ob.type in verb.default_kinds]
+        if not found:
+            raise Usage(f"Nothing to {verb.name}: the scene has no {'/'.join(sorted(verb.default_kinds)).lower()} "
+                        "object (name others with --objects)")
+        return found
+    found = []
+    for pattern in split_patterns(patterns):
+        hits = [ob for ob in scene_objects if fnmatch.fnmatchcase(ob.name, pattern) and ob not in found]
+        if not hits and not any(fnmatch.fnmatchcase(ob.name, pattern) for ob in found):
+            names = ", ".join(ob.name for ob in scene_objects[:20]) or "none"
+            raise Usage(f"No object in the scene is named {pattern!r} (objects: {names})")
+        for ob in hits:
+            if ob.type not in verb.kinds:
+                raise Usage(f"{ob.name!r} is a {ob.type.lower()} object; {verb.name} takes "
+                            f"{'/'.join(sorted(verb.kinds)).lower()} objects")
+        found += hits
+    return found
+
+
+def _scene_settings(args):
+    scene = bpy.context.scene
+    if args.camera is not None:
+        cam = scene.objects.get(args.camera)
+        if cam is None or cam.type != "CAMERA":
+            raise Usage(f"No camera object named {args.camera!r} in the scene")
+        scene.camera = cam
+    if args.frame is not None:
+        scene.frame_set(args.frame)
+
+
+def _frames(text):
+    try:
+        a, _, b = text.partition("-")
+        first, last = int(a), int(b or a)
+    except ValueError:
+        raise Usage(f"--frames {text!r}: give A-B, whole numbers (or one frame)")
+    if last < first:
+        raise Usage(f"--frames {text!r}: the last frame comes before the first")
+    return range(first, last + 1)
+
+
+def _check_outputs(verb, args, per_object_count):
+    try:
+        files.check_output(args.out, verb.outputs or None)
+    except files.FileProblem as err:
+        raise Usage(str(err))
+    one_object_formats = {".glb"} if verb.name == "impostors" else set()
+    if (files.extension(args.out) in one_object_formats and "{object}" not in args.out
+            and per_object_count != 1):
+        raise Usage(f"{args.out}: a {files.extension(args.out)} holds one impostor; put {{object}} in the name to "
+                    "write one file per object")
+
+
+def _write(verb, pattern, groups, summary, frame=None):
+    """Write the results: ``groups`` is [(source name, objects)]; one file, or one per source with {object}."""
+    if "{object}" in pattern:
+        jobs = [(files.output_name(pattern, src, frame), objs) for src, objs in groups]
+    else:
+        jobs = [(files.output_name(pattern, None, frame), [ob for _, objs in groups for ob in objs])]
+    for path, objects in jobs:
+        if verb.name == "impostors" and files.extension(path) == ".glb":
+            files.select_only(objects)
+            written = files.write_with(path, lambda p: bpy.ops.tessera.impostor_export(filepath=p))
+        else:
+            written = files.write(path, objects)
+        summary.outputs += written
+        for w in written:
+            _say(f"wrote {w}")
+
+
+def run_object_verb(verb, args, summary):
+    props = settable(verb.operator, _NOT_OPTIONS | set(verb.fixed))
+    kwargs = dict(chosen(args, props), **verb.fixed)
+    files.read_inputs(args.inputs)
+    _scene_settings(args)
+    sources = targets(verb, args.objects)
+    _check_outputs(verb, args, len(sources))
+    groups = []
+    for i, ob in enumerate(sources):
+        _say(f"{verb.name} {i + 1}/{len(sources)}: {ob.name}")
+        files.select_only([ob])
+        made = _run_operator(verb, kwargs, ob.name, summary)
+        if made is not None:
+            groups.append((ob.name, made))
+    if summary.failures:
+        return EXIT_FAILED
+    _write(verb, args.out, groups, summary, args.frame)
+    return EXIT_OK
+
+
+def run_terrain(verb, args, summary):
+    props = settable(verb.operator, _NOT_OPTIONS)
+    kwargs = chosen(args, props)
+    blends = [p for p in args.inputs if files.extension(p) == ".blend"]
+    maps = [os.path.abspath(p) for p in args.inputs if files.extension(p) != ".blend"]
+    frames = _frames(args.frames) if args.frames else None
+    if frames is not None and len(frames) > 1 and not files.per_frame(args.out):
+        raise Usage(f"{args.out}: several frames need {{frame}} or #### in the output name")
+    _check_outputs(verb, args, 1)
+    if not maps:
+        raise Usage("Give a height map (PNG, TIFF/GeoTIFF, EXR, .r16/.r32/.raw)")
+    for m in maps:
+        if not os.path.isfile(m):
+            raise Usage(f"{m}: no such file")
+    if any(os.path.dirname(m) != os.path.dirname(maps[0]) for m in maps[1:]):
+        raise Usage("A terrain's tiles must lie in one folder")
+    try:
+        files.read_inputs(blends)
+    except files.FileProblem as err:
+        raise Usage(str(err))
+    _scene_settings(args)
+    kwargs.update(filepath=maps[0], tile_files=";".join(os.path.basename(m) for m in maps[1:]),
+                  source="FILE", camera_source="SCENE")
+    bake = {k: v for k, v in kwargs.items() if k == "block"}
+    scene, source = bpy.context.scene, os.path.basename(maps[0])
+    terrain = None
+    for frame in frames or [args.frame]:
+        if frame is not None:
+            scene.frame_set(frame)
+            _say(f"terrain: frame {frame}")
+        if terrain is None:
+            made = _run_operator(verb, kwargs, source, summary)
+            if made is None:
+                return EXIT_FAILED
+            terrain = made[0]
+        else:  # later frames: the same terrain (its analysis cached), meshed again for the camera
+            files.select_only([terrain])
+            if _run_operator(_TERRAIN_BAKE, bake, source, summary, edits=[terrain]) is None:
+                return EXIT_FAILED
+        summary.results[-1]["frame"] = frame
+        _write(verb, args.out, [(source, [terrain])], summary, frame)
+    return EXIT_OK
+
+
+def run(verb_name, argv):
+    """Run one verb with its arguments; returns the exit code."""
+    verb = VERBS[verb_name]
+    summary = Summary(verb.name)
+    t0 = time.perf_counter()
+    args = parser_for(verb).parse_args(argv)  # Usage on bad arguments; SystemExit(0) for --help
+    try:
+        code = (run_terrain if verb.name == "terrain" else run_object_verb)(verb, args, summary)
+    except files.FileProblem as err:
+        raise Usage(str(err))
+    finally:
+        summary.seconds = round(time.perf_counter() - t0, 3)
+        summary.ok = not summary.failures and bool(summary.outputs)
+        _summary_out(args, summary)
+    return code
+
+
+def _summary_out(args, summary):
+    if not args.json:
+        return
+    import json
+    from dataclasses import asdict
+
+    text = json.dumps(asdict(summary))
+    if args.json == "-":
+        print(text, flush=True)
+    else:
+        with open(args.json, "w", encoding="utf-8") as f:
+            f.write(text + "\n")

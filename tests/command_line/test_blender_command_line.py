@@ -1,0 +1,234 @@
+"""``blender -c tessera`` through the callback the add-on registers (tier: blender): help, exit codes, bad arguments,
+every output format read back by Blender's importers, failures that write nothing, ``--json``, and plans.
+
+These run in the test process on the file already open (no input files, which would replace it); the command lines
+with input files, separate processes and killed tasks are in `test_blender_command_line_processes.py`.
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+@pytest.fixture
+def cli(addon_module):
+    return addon_module("addon.command_line")
+
+
+@pytest.fixture
+def scene(clean_scene, bpy_module):
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_monkey_add(location=(0, 0, 0))
+    bpy.ops.mesh.primitive_cube_add(location=(3, 0, 0))
+    return bpy
+
+
+def test_the_add_on_registers_the_command(cli):
+    assert cli.COMMAND == "tessera" and len(cli._handles) == 1
+
+
+def test_help_lists_every_verb_and_every_setting_with_its_tooltip(cli, bpy_module, capsys):
+    assert cli.execute([]) == 2  # no verb: the usage, as a bad argument
+    assert cli.execute(["--help"]) == 0
+    out = capsys.readouterr().out
+    for verb in ("tessellate", "tubes", "loop", "surface", "impostors", "terrain", "join", "plan"):
+        assert f"  {verb}" in out
+    assert cli.execute(["tessellate", "--help"]) == 0
+    out = capsys.readouterr().out.replace("\n", " ")
+    rna = bpy_module.ops.tessera.tessellate.get_rna_type()
+    skipped = cli.verbs._NOT_OPTIONS | {"rna_type"}  # set by the command line itself, or needing a window
+    shown = [p for p in rna.properties if p.identifier not in skipped and not p.is_hidden]
+    assert len(shown) > 15
+    for p in shown:
+        assert "--" + p.identifier.replace("_", "-") in out, p.identifier
+    words = " ".join(out.split())
+    assert "Target edge length on screen (0.5 to 100000; default 10)" in words
+    for verb in ("tubes", "loop", "surface", "impostors", "terrain", "join", "plan"):
+        assert cli.execute([verb, "--help"]) == 0, verb
+    assert "--raw-width" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["unfold", "-o", "x.obj"], "no verb 'unfold'"),
+    (["tessellate", "--level"], "expected one argument"),
+    (["tessellate", "-o", "x.obj", "--level", "0"], "outside 1 to 64"),
+    (["loop", "-o", "x.obj", "--levels", "nan"], "'nan' is not an integer"),
+    (["tessellate", "-o", "x.obj", "--level", "nan"], "nan is outside 1 to 64"),
+    (["tessellate", "-o", "x.obj", "--edge-pixels", "nan"], "outside 0.5 to 100000"),
+    (["tessellate", "-o", "x.obj", "--method", "bezier"], "'bezier' is not one of pn, phong"),
+    (["tessellate", "-o", "x.obj", "--metrics", "projected,speed"], "'speed' is not one of"),
+    (["tessellate", "--level", "2"], "the following arguments are required: -o/--out"),
+    (["tessellate", "-o", "x.docx"], "cannot write .docx"),
+    (["tessellate", "-o", "x.obj", "--objects", "Teapot"], "No object in the scene is named 'Teapot'"),
+    (["tessellate", "-o", "x.obj", "--objects", "Cam*"], "'Camera' is a camera object; tessellate takes mesh"),
+    (["impostors", "-o", "x.glb"], "put {object} in the name"),
+    (["impostors", "-o", "x.obj"], "use one of .blend, .glb"),
+    (["terrain", "-o", "x.obj", "missing.png"], "missing.png: no such file"),
+    (["terrain", "-o", "x.obj", "a.png", "--frames", "3-1"], "the last frame comes before the first"),
+    (["terrain", "-o", "x.obj", "--block", "0,0,2"], "give 4 values"),
+    (["plan", "terrain", "a.png", "-o", "t.blend", "--blocks", "0x2"], "invalid blocks_arg value"),
+    (["tessellate", "-o", "x.obj", "--no-such-setting"], "unrecognized arguments: --no-such-setting"),
+])
+def test_bad_arguments_exit_2_with_what_is_wrong_and_change_nothing(cli, scene, tmp_path, capsys, argv, says):
+    bpy = scene
+    bpy.ops.object.camera_add()
+    objects = sorted(ob.name for ob in bpy.data.objects)
+    os.chdir(tmp_path)
+    assert cli.execute(argv) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert says in err
+    assert sorted(ob.name for ob in bpy.data.objects) == objects
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_run_writes_its_results_and_a_json_summary(cli, scene, tmp_path, capsys):
+    bpy = scene
+    summary = tmp_path / "summary.json"
+    code = cli.execute(["tessellate", "--objects", "Suz*", "--method", "phong", "--level", "3",
+                        "-o", str(tmp_path / "monkey.ply"), "--json", str(summary)])
+    assert code == 0
+    made = bpy.data.objects["Suzanne.tessellated"]
+    info = json.loads(summary.read_text())
+    assert info["ok"] and info["failures"] == [] and info["outputs"] == [str(tmp_path / "monkey.ply")]
+    assert len(made.data.polygons) > 968 * 9  # level 3 (fractional-even: more than 9 per triangle)
+    assert info["results"] == [{"source": "Suzanne", "objects": ["Suzanne.tessellated"],
+                                "faces": len(made.data.polygons),
+                                "vertices": len(made.data.vertices), "seconds": info["results"][0]["seconds"]}]
+    assert made.tessera.tessellate.method == "PHONG"  # the operator's own settings, stored as in the UI
+    # --json alone: the summary is the last line of the output
+    assert cli.execute(["loop", "--objects", "Cube", "--levels", "1", "-o", str(tmp_path / "cube.obj"),
+                        "--json"]) == 0
+    last = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert last["results"][0]["faces"] == 12 * 4
+    assert sorted(os.listdir(tmp_path)) == ["cube.mtl", "cube.obj", "monkey.ply", "summary.json"]
+
+
+FORMATS = (".blend", ".obj", ".ply", ".stl", ".glb", ".gltf", ".usdc", ".usda", ".abc", ".fbx")
+
+
+@pytest.mark.parametrize("ext", FORMATS)
+def test_every_output_format_is_written_whole_and_reads_back(cli, scene, tmp_path, ext):
+    bpy = scene
+    path = tmp_path / f"cube{ext}"
+    assert cli.execute(["loop", "--objects", "Cube", "--levels", "2", "-o", str(path)]) == 0
+    made = bpy.data.objects["Cube.loop"]
+    faces = len(made.data.polygons)
+    assert faces == 12 * 16
+    left = sorted(n for n in os.listdir(tmp_path) if n.startswith("."))
+    assert left == [] and path.stat().st_size > 0  # no partial file beside it
+    # read back through Blender: the same triangles
+    bpy.ops.wm.read_homefile(use_empty=True) if ext == ".blend" else None
+    if ext == ".blend":
+        with bpy.data.libraries.load(str(path)) as (src, dst):
+            dst.objects = ["Cube.loop"]
+        back = dst.objects
+    else:
+        files = cli.files
+        before = set(bpy.data.objects)
+        files.read_inputs_into_scene([str(path)])
+        back = [ob for ob in bpy.data.objects if ob not in before and ob.type == "MESH"]
+    assert len(back) == 1 and len(back[0].data.polygons) == faces
+
+
+def test_one_file_per_object_and_a_failure_writes_nothing(cli, scene, tmp_path, capsys):
+    bpy = scene
+    assert cli.execute(["tessellate", "--level", "2", "-o", str(tmp_path / "{object}.glb"), "--json"]) == 0
+    assert sorted(os.listdir(tmp_path)) == ["Cube.glb", "Suzanne.glb"]
+    capsys.readouterr()
+    empty = bpy.data.objects.new("Empty mesh", bpy.data.meshes.new("Empty mesh"))
+    bpy.context.scene.collection.objects.link(empty)
+    out = tmp_path / "again"
+    code = cli.execute(["tessellate", "--objects", "Suzanne,Empty*,Cube", "-o", str(out / "{object}.glb"),
+                        "--json"])
+    captured = capsys.readouterr()
+    assert code == 1
+    info = json.loads(captured.out.strip().splitlines()[-1])
+    assert not info["ok"] and [r["source"] for r in info["results"]] == ["Suzanne", "Cube"]  # the others still tried
+    assert info["failures"] == [{"source": "Empty mesh", "error": "Mesh 'Empty mesh' has no faces to work on"}]
+    assert "Empty mesh: FAILED: Mesh 'Empty mesh' has no faces to work on" in captured.err
+    assert not out.exists() and info["outputs"] == []
+
+
+def test_names_with_wildcards_and_commas_are_taken_literally(cli, scene, tmp_path):
+    bpy = scene
+    bpy.data.objects["Cube"].name = "Rock [a],b*"
+    verbs = cli.verbs
+    plan = cli.plan
+    import glob
+
+    pattern = glob.escape("Rock [a],b*").replace(",", "[,]")
+    assert verbs.split_patterns(f"Suz*,{pattern}") == ["Suz*", pattern]
+    found = verbs.targets(verbs.VERBS["tessellate"], pattern)
+    assert [ob.name for ob in found] == ["Rock [a],b*"]
+    assert plan is not None
+
+
+def test_a_plan_has_one_task_per_object_whose_arguments_mean_the_same(cli, scene, tmp_path, capsys):
+    bpy = scene
+    bpy.data.objects["Cube"].name = "Box, large"
+    assert cli.execute(["plan", "tessellate", "--method", "phong", "--metrics", "projected,silhouette",
+                        "--level-mode", "adaptive", "--edge-pixels", "6.25", "--no-use-object-settings",
+                        "-o", str(tmp_path / "out.glb")]) == 0
+    tasks = json.loads(capsys.readouterr().out)["tasks"]
+    assert [t["name"] for t in tasks] == ["tessellate Suzanne", "tessellate Box, large"]
+    assert tasks[1]["outputs"] == [str(tmp_path / "out_Box__large.glb")]
+    verbs = cli.verbs
+    verb = verbs.VERBS["tessellate"]
+    props = cli.settable(verb.operator, verbs._NOT_OPTIONS | set(verb.fixed))
+    for task in tasks:
+        assert task["command"][:3] == ["blender", "-c", "tessera"] and task["command"][3:] == task["argv"]
+        args = verbs.parser_for(verb).parse_args(task["argv"][1:])
+        assert [ob.name for ob in verbs.targets(verb, args.objects)] == [task["name"].split(" ", 1)[1]]
+        given = cli.options.chosen(args, props)
+        assert given == {"method": "PHONG", "metrics": {"PROJECTED", "SILHOUETTE"}, "level_mode": "ADAPTIVE",
+                         "edge_pixels": 6.25, "use_object_settings": False}
+
+
+def test_every_setting_survives_the_plans_round_trip(cli, bpy_module):
+    """Each setting, set away from its default, is written into a task's command line and parsed back equal."""
+    verbs, plan = cli.verbs, cli.plan
+    for verb in verbs.VERBS.values():
+        props = cli.settable(verb.operator, verbs._NOT_OPTIONS | set(verb.fixed))
+        parser = verbs.parser_for(verb)
+        args = parser.parse_args(["in.blend", "-o", "out.blend"])
+        for p in props:
+            if p.type == "BOOLEAN":
+                value = not p.default
+            elif p.type == "ENUM":
+                items = [i.identifier for i in p.enum_items]
+                value = set(items[:2]) if p.is_enum_flag else items[-1]
+            elif p.type == "STRING":
+                value = "a b;c"
+            elif getattr(p, "array_length", 0):
+                value = tuple(min(p.hard_max, p.hard_min + 1) for _ in range(p.array_length))
+            elif p.type == "FLOAT":
+                value = min(p.hard_max, max(p.hard_min, 0.1 + p.default * 1.5))
+            else:
+                value = min(p.hard_max, p.default + 1)
+            setattr(args, p.identifier, value)
+        argv = plan.task_argv(verb, args, props)
+        back = parser.parse_args(argv[1:])
+        for p in props:
+            assert getattr(back, p.identifier) == getattr(args, p.identifier), (verb.name, p.identifier)
+
+
+def test_stale_partial_files_of_dead_tasks_are_removed_and_live_ones_kept(cli, tmp_path):
+    files = cli.files
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    host = files._host()
+    stale = tmp_path / f".terrain.tessera-partial-{host}-{dead}.blend"
+    stale_dir = tmp_path / f".scene.tessera-partial-{host}-{dead}"
+    live = tmp_path / f".cube.tessera-partial-{host}-{os.getpid()}.obj"
+    other_host = tmp_path / f".rock.tessera-partial-elsewhere-{dead}.obj"
+    for p in (stale, live, other_host):
+        p.write_bytes(b"half")
+    stale_dir.mkdir()
+    (stale_dir / "scene.bin").write_bytes(b"half")
+    files.remove_stale_partials(str(tmp_path))
+    assert sorted(os.listdir(tmp_path)) == sorted([live.name, other_host.name])

@@ -1,0 +1,245 @@
+"""``blender -c tessera`` as separate processes, as a farm runs it (tier: blender): the built extension installed in a
+user folder of its own, ``blender`` on PATH (`blender_cli.py`, the ``bpy`` module standing in for the executable these
+machines do not have, with Blender's registry of add-on commands).
+
+- a terrain split by ``plan`` into 4 blocks (two frames of a camera path) and into 16 blocks, every task its own
+  process, joined: exactly the mesh one process makes (positions bit for bit, the same triangles);
+- impostors planned per object: the same atlases as one process baking both;
+- a task stopped (SIGTERM, as farm managers send) or killed (SIGKILL) leaves no output file, and the next task in that
+  folder removes what the killed one left.
+"""
+
+import json
+import os
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tessera.tools.geotiff_files import write_geotiff
+
+pytestmark = pytest.mark.blender
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def blender(built_zips, tmp_path_factory):
+    """``run(*args)``: ``blender ARGS`` in a process, with Tessera installed from the built zip: CompletedProcess."""
+    home = tmp_path_factory.mktemp("cli_home")
+    bin_dir = home / "bin"
+    bin_dir.mkdir()
+    shim = bin_dir / "blender"
+    shim.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{ROOT / "tests" / "blender_cli.py"}" "$@"\n')
+    shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
+    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+               BLENDER_USER_RESOURCES=str(home / "user"))
+    env.pop("PYTHONPATH", None)
+    linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
+
+    def run(*args, timeout=600):
+        return subprocess.run(["blender", *map(str, args)], env=env, capture_output=True, text=True, timeout=timeout,
+                              cwd=home)
+
+    def start(*args):
+        return subprocess.Popen(["blender", *map(str, args)], env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, cwd=home)
+
+    done = run("--command", "extension", "install-file", "-r", "user_default", "-e", linux)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    run.start = start
+    return run
+
+
+def _ok(proc):
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    return proc
+
+
+def _dem():
+    """A 193 x 257 int16 DEM with a lake of no-data, as a GeoTIFF in metres."""
+    y, x = np.mgrid[0:193, 0:257] / 64.0
+    top = 900 + 300 * np.sin(3 * x) * np.cos(2 * y) + 60 * np.sin(11 * x * y) + 25 * np.cos(23 * x)
+    top = np.round(top).astype(np.int16)
+    top[80:90, 100:118] = -32768
+    return top
+
+
+@pytest.fixture(scope="module")
+def shot(tmp_path_factory, bpy_module, addon):
+    """A folder with the DEM and a .blend whose camera flies over it (frames 1 and 2)."""
+    bpy = bpy_module
+    folder = tmp_path_factory.mktemp("terrain_job")
+    write_geotiff(str(folder / "dem.tif"), _dem(), spacing=(10.0, 10.0), nodata=-32768)
+    bpy.ops.wm.read_homefile(use_empty=True)
+    cam = bpy.data.objects.new("Drone", bpy.data.cameras.new("Drone"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.data.clip_end = 10000.0
+    cam.rotation_euler = (1.1, 0.0, -0.6)
+    cam.location = (-900.0, -1300.0, 1500.0)
+    cam.keyframe_insert("location", frame=1)
+    cam.location = (-300.0, -1100.0, 1300.0)
+    cam.keyframe_insert("location", frame=2)
+    bpy.context.scene.camera = cam
+    bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 960, 540
+    bpy.ops.wm.save_as_mainfile(filepath=str(folder / "shot.blend"), copy=True)
+    bpy.ops.wm.read_homefile(use_empty=True)
+    return folder
+
+
+def _mesh_of(bpy, path):
+    """(positions (n, 3) float32, triangles (m, 3)) of the one mesh object in the .blend ``path``."""
+    with bpy.data.libraries.load(str(path)) as (src, dst):
+        dst.objects = [n for n in src.objects]
+    meshes = [ob for ob in dst.objects if ob.type == "MESH"]
+    assert len(meshes) == 1, [ob.name for ob in dst.objects]
+    me = meshes[0].data
+    pos = np.empty(len(me.vertices) * 3, np.float32)
+    corners = np.empty(len(me.loops), np.int32)
+    if len(me.vertices):  # a block the camera does not see is an empty mesh, without a position attribute
+        me.attributes["position"].data.foreach_get("vector", pos)
+        me.attributes[".corner_vert"].data.foreach_get("value", corners)
+    for ob in dst.objects:
+        data = ob.data
+        bpy.data.objects.remove(ob)
+        if data is not None and data.users == 0:
+            getattr(bpy.data, "meshes" if isinstance(data, bpy.types.Mesh) else "cameras").remove(data)
+    return pos.reshape(-1, 3), corners.reshape(-1, 3)
+
+
+def _same_mesh(a, b):
+    """Meshes ``a`` and ``b`` (from `_mesh_of`) are the same: the same vertices bit for bit (no two alike) and the same
+    triangles (as triples of positions, orientation kept)."""
+    (pa, ta), (pb, tb) = a, b
+    assert len(pa) == len(pb) and len(ta) == len(tb)
+    assert np.array_equal(np.unique(pa, axis=0), np.unique(pb, axis=0)) and len(np.unique(pa, axis=0)) == len(pa)
+
+    def tris(p, t):
+        keys = [tuple(map(tuple, tri)) for tri in p[t]]  # each rotated to start at its smallest corner: winding kept
+        return {min(k[i:] + k[:i] for i in range(3)) for k in keys}
+
+    assert tris(pa, ta) == tris(pb, tb)
+
+
+def _run_plan(blender, plan):
+    """Run the plan's tasks as a farm would: the independent ones two at a time, each join after its blocks."""
+    tasks = plan["tasks"]
+    done = {}
+    with ThreadPoolExecutor(2) as pool:
+        while len(done) < len(tasks):
+            ready = [t for t in tasks if t["name"] not in done and all(a in done for a in t["after"])]
+            assert ready, "the plan's dependencies form a cycle"
+            for task, proc in zip(ready, pool.map(lambda t: blender("-c", "tessera", *t["argv"]), ready)):
+                _ok(proc)
+                done[task["name"]] = proc
+                for out in task["outputs"]:
+                    assert os.path.isfile(out), (task["name"], out)
+    return done
+
+
+@pytest.mark.parametrize("blocks, frames", [("2x2", "1-2"), ("4x4", "2-2")])
+def test_a_terrain_split_into_farm_tasks_joins_into_the_single_process_mesh(blender, shot, bpy_module, tmp_path,
+                                                                            blocks, frames):
+    bpy = bpy_module
+    args = [shot / "dem.tif", shot / "shot.blend", "--tile-size", "16", "--levels", "fractional", "--epsilon", "1.5",
+            "--frames", frames]
+    single = _ok(blender("-c", "tessera", "terrain", *args, "-o", tmp_path / "single" / "terrain_#.blend",
+                         "--json"))
+    summary = json.loads(single.stdout.strip().splitlines()[-1])
+    first, last = (int(f) for f in frames.split("-"))
+    assert summary["ok"] and [r["frame"] for r in summary["results"]] == list(range(first, last + 1))
+    proc = _ok(blender("-c", "tessera", "plan", "terrain", *args, "--blocks", blocks,
+                       "-o", tmp_path / "farm" / "terrain_#.blend"))
+    plan = json.loads(proc.stdout[proc.stdout.index("{"):])
+    cols, rows = (int(v) for v in blocks.split("x"))
+    n_frames = last - first + 1
+    assert len(plan["tasks"]) == n_frames * (cols * rows + 1)
+    assert all(t["command"][:3] == ["blender", "-c", "tessera"] for t in plan["tasks"])
+    _run_plan(blender, plan)
+    for frame in range(first, last + 1):
+        whole = _mesh_of(bpy, tmp_path / "single" / f"terrain_{frame}.blend")
+        joined = _mesh_of(bpy, tmp_path / "farm" / f"terrain_{frame}.blend")
+        assert len(whole[1]) > 2000
+        _same_mesh(whole, joined)
+        blocks_tris = sum(len(_mesh_of(bpy, p)[1]) for p in (tmp_path / "farm").glob(f"terrain_{frame}_b*-*.blend"))
+        assert blocks_tris == len(whole[1])  # every triangle made by exactly one block
+    assert not [n for n in os.listdir(tmp_path / "farm") if n.startswith(".")]
+
+
+def test_impostors_planned_per_object_bake_the_atlases_of_one_process(blender, bpy_module, tmp_path):
+    bpy = bpy_module
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.mesh.primitive_cube_add(location=(0, 0, 0))
+    bpy.ops.mesh.primitive_ico_sphere_add(location=(3, 0, 0), subdivisions=2)
+    bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "props.blend"), copy=True)
+    bpy.ops.wm.read_homefile(use_empty=True)
+    opts = ["--grid", "2", "--tile", "16", "--samples", "2"]
+    _ok(blender("-c", "tessera", "impostors", tmp_path / "props.blend", *opts, "-o", tmp_path / "one" / "{object}.blend"))
+    proc = _ok(blender("-c", "tessera", "plan", "impostors", tmp_path / "props.blend", *opts,
+                       "-o", tmp_path / "farm" / "{object}.blend"))
+    plan = json.loads(proc.stdout[proc.stdout.index("{"):])
+    assert sorted(t["name"] for t in plan["tasks"]) == ["impostors Cube", "impostors Icosphere"]
+    _run_plan(blender, plan)
+    for name in ("Cube", "Icosphere"):
+        images = []
+        for folder in ("one", "farm"):
+            with bpy.data.libraries.load(str(tmp_path / folder / f"{name}.blend")) as (src, dst):
+                dst.images = [n for n in src.images if n.startswith(f"{name} impostor")]
+            assert len(dst.images) == 3  # colour, normal, depth
+            images.append({im.name.rsplit(".", 1)[0] if im.name[-4:-3] == "." else im.name:
+                           np.array(im.pixels[:], np.float32) for im in dst.images})
+            for im in dst.images:
+                bpy.data.images.remove(im)
+        assert images[0].keys() == images[1].keys()
+        for key in images[0]:
+            assert np.array_equal(images[0][key], images[1][key]), key
+            assert images[0][key].max() > 0
+
+
+@pytest.fixture(scope="module")
+def heavy(tmp_path_factory, bpy_module, addon):
+    """A .blend with a dense mesh that takes Loop subdivision seconds."""
+    bpy = bpy_module
+    folder = tmp_path_factory.mktemp("heavy")
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=200, y_subdivisions=200)
+    bpy.ops.wm.save_as_mainfile(filepath=str(folder / "grid.blend"), copy=True)
+    bpy.ops.wm.read_homefile(use_empty=True)
+    return folder / "grid.blend"
+
+
+def test_a_stopped_task_leaves_no_file(blender, heavy, tmp_path):
+    out = tmp_path / "out"
+    proc = blender.start("-c", "tessera", "loop", heavy, "--levels", "3", "-o", out / "grid.ply")
+    for line in proc.stderr:  # the work has started
+        if line.startswith("tessera: loop 1/1"):
+            break
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 1, err[-2000:]
+    assert "stopped by signal" in err
+    assert not out.exists() or os.listdir(out) == []
+
+
+def test_a_killed_task_leaves_no_output_and_the_next_task_clears_its_partial_file(blender, heavy, tmp_path):
+    out = tmp_path / "out"
+    proc = blender.start("-c", "tessera", "tessellate", heavy, "--level", "6", "--spacing", "equal",
+                         "-o", out / "grid.obj")
+    partial = []
+    while proc.poll() is None and not partial:
+        partial = [n for n in (os.listdir(out) if out.exists() else []) if ".tessera-partial-" in n]
+        time.sleep(0.005)
+    proc.kill()
+    proc.communicate(timeout=60)
+    assert partial, "the task finished before its output was being written"
+    assert not (out / "grid.obj").exists()  # killed while writing: the file asked for is not there
+    assert sorted(os.listdir(out)) == partial  # only the hidden partial folder
+    _ok(blender("-c", "tessera", "loop", heavy, "--levels", "1", "-o", out / "other.ply"))
+    assert sorted(os.listdir(out)) == ["other.ply"]
