@@ -23,7 +23,8 @@ _handles = []
 _USAGE = f"""usage: blender -c {COMMAND} VERB [FILES] [OPTIONS] -o OUTPUT
 
 Verbs:
-""" + "".join(f"  {v.name:<11} {v.summary}\n" for v in verbs.VERBS.values()) + """  join        Join the meshes of several files into one object, welding vertices that coincide exactly
+""" + "".join(f"  {v.name:<11} {v.summary}\n" for v in verbs.VERBS.values()) + """\
+  join        Join the meshes of several files into one object, welding vertices that coincide exactly
   plan        Print a large job as independent tasks for a render farm (JSON): plan VERB ... [--blocks CxR]
 
 'blender -c tessera VERB --help' lists a verb's options. Exit codes: 0 done, 1 failed (nothing written),
@@ -64,9 +65,10 @@ def _join(argv):
 
 def _plan(argv):
     p = verbs._Parser(prog=f"blender -c {COMMAND} plan", allow_abbrev=False, add_help=False,
-                      description="Print the independent tasks of a job as JSON, each a command line for any machine: "
-                                  "one per object (per-object verbs) or one per block of --blocks CxR per frame "
-                                  "(terrain, with a join task per frame). Tessera runs none of them.")
+                      description="Print the independent tasks of a job as JSON (or write them to the file given "
+                                  "with --json FILE), each a command line for any machine: one per object "
+                                  "(per-object verbs) or one per block of --blocks CxR per frame (terrain, with a "
+                                  "join task per frame). Tessera runs none of them.")
     p.add_argument("verb", choices=sorted(verbs.VERBS))
     p.add_argument("--blocks", type=plan.blocks_arg, default=(2, 2), metavar="CxR",
                    help="terrain: split into C columns by R rows of tiles (default 2x2)")
@@ -87,7 +89,7 @@ def _plan(argv):
     else:
         files.read_inputs(args.inputs)
         tasks = plan.plan_objects(verb, args, props, verbs.targets(verb, args.objects))
-    plan.print_plan(verb, tasks)
+    plan.print_plan(verb, tasks, args.json)
     return verbs.EXIT_OK
 
 

@@ -56,7 +56,8 @@ def join(objects, name):
     point_names = set.intersection(*(set(a.point_attributes) for a, _, _ in parts))
     offsets = np.cumsum([0] + [len(w) for _, w, _ in parts])
     positions = np.concatenate([w for _, w, _ in parts])
-    triangles = np.concatenate([a.triangles.astype(np.int64) + o for (a, _, _), o in zip(parts, offsets)])
+    triangles = np.concatenate([a.triangles.astype(np.int64) + o
+                                for (a, _, _), o in zip(parts, offsets[:-1], strict=True)])
     welded, tris, keep, kept = weld_triangles(positions, triangles)
     out = MeshArrays(positions=welded, triangles=tris)
     for n in sorted(corner_names):

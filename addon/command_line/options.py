@@ -48,7 +48,8 @@ def _number(p):
         try:
             value = convert(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a{'n integer' if p.type == 'INT' else ' number'}")
+            kind = "an integer" if p.type == "INT" else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
         if not (p.hard_min <= value <= p.hard_max):  # NaN fails both
             raise argparse.ArgumentTypeError(f"{text} is outside {_range(p)}")
         return value
@@ -88,7 +89,8 @@ def _enum(p):
         chosen = [t.strip().upper() for t in text.split(",")] if p.is_enum_flag else [text.strip().upper()]
         for value in chosen:
             if value not in names:
-                raise argparse.ArgumentTypeError(f"{value.lower()!r} is not one of {', '.join(n.lower() for n in names)}")
+                allowed = ", ".join(n.lower() for n in names)
+                raise argparse.ArgumentTypeError(f"{value.lower()!r} is not one of {allowed}")
         return set(chosen) if p.is_enum_flag else chosen[0]
 
     return parse

@@ -111,6 +111,12 @@ def blocks_arg(text):
     return cols, rows
 
 
-def print_plan(verb, tasks):
-    print(json.dumps({"verb": verb.name, "tasks": tasks}, indent=1), flush=True)
+def print_plan(verb, tasks, to=None):
+    """Print the plan as JSON, or write it to the file ``to`` (Blender may print lines of its own)."""
+    text = json.dumps({"verb": verb.name, "tasks": tasks}, indent=1)
+    if to in (None, "-"):
+        print(text, flush=True)
+        return
+    with open(to, "w", encoding="utf-8") as f:
+        f.write(text + "\n")
 

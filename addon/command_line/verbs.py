@@ -143,7 +143,7 @@ def _run_operator(verb, kwargs, source, summary, edits=None):
         getattr(getattr(bpy.ops, module), name)(**kwargs)
     except RuntimeError as err:  # the operator's report: what to change
         if stopping:
-            raise Stopped(f"stopped by signal {min(stopping)}; nothing was written")
+            raise Stopped(f"stopped by signal {min(stopping)}; nothing was written") from err
         message = str(err).strip()
         message = message[len("Error: "):] if message.startswith("Error: ") else message
         summary.failures.append({"source": source, "error": message})
@@ -203,7 +203,7 @@ def _frames(text):
         a, _, b = text.partition("-")
         first, last = int(a), int(b or a)
     except ValueError:
-        raise Usage(f"--frames {text!r}: give A-B, whole numbers (or one frame)")
+        raise Usage(f"--frames {text!r}: give A-B, whole numbers (or one frame)") from None
     if last < first:
         raise Usage(f"--frames {text!r}: the last frame comes before the first")
     return range(first, last + 1)
@@ -213,7 +213,7 @@ def _check_outputs(verb, args, per_object_count):
     try:
         files.check_output(args.out, verb.outputs or None)
     except files.FileProblem as err:
-        raise Usage(str(err))
+        raise Usage(str(err)) from err
     one_object_formats = {".glb"} if verb.name == "impostors" else set()
     if (files.extension(args.out) in one_object_formats and "{object}" not in args.out
             and per_object_count != 1):
@@ -277,7 +277,7 @@ def run_terrain(verb, args, summary):
     try:
         files.read_inputs(blends)
     except files.FileProblem as err:
-        raise Usage(str(err))
+        raise Usage(str(err)) from err
     _scene_settings(args)
     kwargs.update(filepath=maps[0], tile_files=";".join(os.path.basename(m) for m in maps[1:]),
                   source="FILE", camera_source="SCENE")
@@ -311,7 +311,7 @@ def run(verb_name, argv):
     try:
         code = (run_terrain if verb.name == "terrain" else run_object_verb)(verb, args, summary)
     except files.FileProblem as err:
-        raise Usage(str(err))
+        raise Usage(str(err)) from err
     finally:
         summary.seconds = round(time.perf_counter() - t0, 3)
         summary.ok = not summary.failures and bool(summary.outputs)

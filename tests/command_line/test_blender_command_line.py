@@ -232,3 +232,40 @@ def test_stale_partial_files_of_dead_tasks_are_removed_and_live_ones_kept(cli, t
     (stale_dir / "scene.bin").write_bytes(b"half")
     files.remove_stale_partials(str(tmp_path))
     assert sorted(os.listdir(tmp_path)) == sorted([live.name, other_host.name])
+
+
+@pytest.mark.parametrize("verb, add, extra", [
+    ("tubes", "curve.primitive_bezier_circle_add", ["--radius", "0.05", "--caps", "round"]),
+    ("surface", "surface.primitive_nurbs_surface_sphere_add", ["--metrics", "tolerance", "--tolerance", "0.001"]),
+    ("loop", "mesh.primitive_ico_sphere_add", ["--levels", "2"]),
+    ("tessellate", "mesh.primitive_cylinder_add", ["--method", "pn", "--level", "4"]),
+])
+def test_each_verb_makes_its_geometry_from_blenders_own_primitives(cli, clean_scene, bpy_module, tmp_path, capsys,
+                                                                    verb, add, extra):
+    bpy = bpy_module
+    module, name = add.split(".")
+    getattr(getattr(bpy.ops, module), name)()
+    source = bpy.context.active_object.name
+    out = tmp_path / "out.glb"
+    assert cli.execute([verb, *extra, "-o", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    (result,) = info["results"]
+    assert result["source"] == source and result["faces"] > 100
+    made = bpy.data.objects[result["objects"][0]]
+    assert made.type == "MESH" and len(made.data.polygons) == result["faces"]
+    before = set(bpy.data.objects)
+    cli.files.read_inputs_into_scene([str(out)])
+    (back,) = [ob for ob in bpy.data.objects if ob not in before and ob.type == "MESH"]
+
+    def triangles(me):  # glTF holds triangles: quads come back as two
+        return sum(len(p.vertices) - 2 for p in me.polygons)
+
+    assert triangles(back.data) == triangles(made.data)
+
+
+def test_a_plan_goes_to_a_file_when_asked(cli, scene, tmp_path):
+    to = tmp_path / "plan.json"
+    assert cli.execute(["plan", "loop", "--levels", "1", "-o", str(tmp_path / "{object}.ply"), "--json", str(to)]) == 0
+    tasks = json.loads(to.read_text())["tasks"]
+    assert sorted(t["outputs"][0] for t in tasks) == [str(tmp_path / "Cube.ply"), str(tmp_path / "Suzanne.ply")]
+    assert all("--json" not in t["argv"] for t in tasks)

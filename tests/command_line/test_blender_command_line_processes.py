@@ -11,7 +11,6 @@ machines do not have, with Blender's registry of add-on commands).
 
 import json
 import os
-import shutil
 import signal
 import stat
 import subprocess
@@ -134,7 +133,7 @@ def _run_plan(blender, plan):
         while len(done) < len(tasks):
             ready = [t for t in tasks if t["name"] not in done and all(a in done for a in t["after"])]
             assert ready, "the plan's dependencies form a cycle"
-            for task, proc in zip(ready, pool.map(lambda t: blender("-c", "tessera", *t["argv"]), ready)):
+            for task, proc in zip(ready, pool.map(lambda t: blender("-c", "tessera", *t["argv"]), ready), strict=True):
                 _ok(proc)
                 done[task["name"]] = proc
                 for out in task["outputs"]:
@@ -180,7 +179,8 @@ def test_impostors_planned_per_object_bake_the_atlases_of_one_process(blender, b
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "props.blend"), copy=True)
     bpy.ops.wm.read_homefile(use_empty=True)
     opts = ["--grid", "2", "--tile", "16", "--samples", "2"]
-    _ok(blender("-c", "tessera", "impostors", tmp_path / "props.blend", *opts, "-o", tmp_path / "one" / "{object}.blend"))
+    _ok(blender("-c", "tessera", "impostors", tmp_path / "props.blend", *opts,
+                "-o", tmp_path / "one" / "{object}.blend"))
     proc = _ok(blender("-c", "tessera", "plan", "impostors", tmp_path / "props.blend", *opts,
                        "-o", tmp_path / "farm" / "{object}.blend"))
     plan = json.loads(proc.stdout[proc.stdout.index("{"):])
