@@ -13,6 +13,7 @@ folder of its own holding the built Linux zip (tier: blender).
 Then what the snippets say they make is there: the OBJ with the tessellated monkey, the tubes, the farm's frame.
 """
 
+import json
 import os
 import re
 import shutil
@@ -86,6 +87,10 @@ def test_every_readme_block_runs_as_printed(built_zips, tmp_path):
     # blender -b --python monkey_pn.py: Suzanne's 968 triangles at uniform level 4, 24 each
     faces = sum(1 for line in (home / "monkey_pn.obj").read_text().splitlines() if line.startswith("f "))
     assert faces == 968 * 24
+    # blender -c tessera: the monkey again, as glTF, and the summary line
+    assert (home / "monkey_smooth.glb").stat().st_size > 968 * 24 * 4 * 12
+    summaries = [json.loads(line) for out in printed for line in out.splitlines() if line.startswith('{"verb": ')]
+    assert summaries and summaries[0]["ok"] and summaries[0]["results"][0]["faces"] > 968 * 24 * 2  # finer again
     # the bpy module's script: round-capped tubes around the circle
     counts = [int(m.group(1)) for out in printed for m in re.finditer(r"^(\d+) faces$", out, re.MULTILINE)]
     assert counts and counts[-1] > 100
