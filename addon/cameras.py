@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..kernels.common.camera import Camera
+from ..kernels.common.camera import Camera, product
 from ..kernels.common.errors import InvalidInputError
 
 #: The camera choice of every view-dependent setting (adaptive levels, tube sides, the pixel clamp).
@@ -43,4 +43,4 @@ def camera_for(context, source, purpose="Adaptive levels"):
 def object_camera(camera, matrix_world):
     """``camera`` seen from an object's local space (for work done in object coordinates)."""
     m = np.array(matrix_world, np.float64)
-    return Camera(np.asarray(camera.view) @ m, camera.projection, camera.width, camera.height)
+    return Camera(product(camera.view, m), camera.projection, camera.width, camera.height)

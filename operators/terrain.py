@@ -5,7 +5,6 @@ import os
 import time
 
 import bpy
-import numpy as np
 
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import check_numbers, guarded
@@ -14,7 +13,7 @@ from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
 from ..kernels.common.budget import check_bytes
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
-from ..kernels.terrain.lod import box_distance, select
+from ..kernels.terrain.lod import box_distance, only_block, select
 from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
 
@@ -46,23 +45,13 @@ def _nothing_seen(hm, table, camera):
 WHOLE = (0, 0, 1, 1)
 
 
+
 def _block_property():
     return bpy.props.IntVectorProperty(
         name="Block", size=4, default=WHOLE, min=0, max=4096, options={"SKIP_SAVE"},
         description="Mesh one block of an even split of the terrain's tiles: column, row, columns, rows (0, 0, 2, 2 "
                     "is the lower-left quarter). Blocks of one split meet without cracks, so render-farm tasks can "
                     "each mesh one; 0, 0, 1, 1 meshes the whole terrain")
-
-
-def block_tiles(block, counts):
-    """Tile columns and rows of ``block`` (column, row, columns, rows) on a ``counts`` = (ntx, nty) grid: two
-    ``range``s. Raises `InvalidInputError` for a block outside its split."""
-    col, row, cols, rows = (int(v) for v in block)
-    if cols < 1 or rows < 1 or not (0 <= col < cols and 0 <= row < rows):
-        raise InvalidInputError(f"Block {col}, {row} of a {cols} x {rows} split does not exist: the column must be "
-                                "below the columns and the row below the rows, both at least 1")
-    ntx, nty = counts
-    return range(ntx * col // cols, ntx * (col + 1) // cols), range(nty * row // rows, nty * (row + 1) // rows)
 
 
 def _bake_into(context, ob, camera, report, tx, block=WHOLE):
@@ -81,10 +70,7 @@ def _bake_into(context, ob, camera, report, tx, block=WHOLE):
     t_select = time.perf_counter() - t0
     whole = tuple(block) == WHOLE
     if not whole:
-        xs, ys = block_tiles(block, table.counts)
-        inside = np.zeros_like(sel.culled)
-        inside[ys.start:ys.stop, xs.start:xs.stop] = True
-        sel.culled |= ~inside
+        sel = only_block(sel, block)
     n_tris = triangle_count(sel)
     if n_tris == 0 and whole:  # every tile culled: say which of the camera's settings keeps the terrain out
         raise EmptyResultError(_nothing_seen(hm, table, local_camera))

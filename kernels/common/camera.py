@@ -1,4 +1,9 @@
-"""Cameras as numpy arrays (row-major matrices, OpenGL clip-space conventions, eye looking down -z)."""
+"""Cameras as numpy arrays (row-major matrices, OpenGL clip-space conventions, eye looking down -z).
+
+`product` and `Camera.eye` use only elementwise +, -, × and / in a fixed order, never BLAS or LAPACK (whose rounding
+depends on the CPU and the library's build): a camera gives the same bits on every machine, so view-dependent levels
+computed by separate farm tasks on different machines agree (terrain blocks weld exactly).
+"""
 
 from dataclasses import dataclass
 
@@ -6,6 +11,24 @@ import numpy as np
 
 from .errors import InvalidInputError
 from .tolerances import NO_DIRECTION
+
+
+def product(a, b):
+    """``a @ b`` for (4, 4) matrices, each entry summed in the order k = 0, 1, 2, 3 with separate roundings (the same
+    bits on every machine): (4, 4) float64."""
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    return ((a[:, 0, None] * b[0] + a[:, 1, None] * b[1]) + a[:, 2, None] * b[2]) + a[:, 3, None] * b[3]
+
+
+def _affine_eye(view):
+    """Where an affine world -> eye matrix puts the eye: ``-A⁻¹ t`` by the adjugate (fixed order): (3,) float64."""
+    (a, b, c), (d, e, f), (g, h, i) = view[:3, :3]
+    t = view[:3, 3]
+    cof = np.array([[e * i - f * h, c * h - b * i, b * f - c * e],
+                    [f * g - d * i, a * i - c * g, c * d - a * f],
+                    [d * h - e * g, b * g - a * h, a * e - b * d]])
+    det = (a * cof[0, 0] + b * cof[1, 0]) + c * cof[2, 0]
+    return -(((cof[:, 0] * t[0] + cof[:, 1] * t[1]) + cof[:, 2] * t[2]) / det)
 
 
 def perspective(fovy, aspect, near, far):
@@ -70,8 +93,11 @@ class Camera:
 
     @property
     def eye(self):
-        """Camera position in world space: (3,) float64."""
-        return np.linalg.inv(np.asarray(self.view, np.float64))[:3, 3]
+        """Camera position in world space: (3,) float64 (the same bits on every machine for an affine view)."""
+        view = np.asarray(self.view, np.float64)
+        if np.array_equal(view[3], (0.0, 0.0, 0.0, 1.0)):
+            return _affine_eye(view)
+        return np.linalg.inv(view)[:3, 3]
 
     @property
     def backward(self):

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..common.camera import product
 from ..common.errors import InvalidInputError
 from ..common.partition import MAX_LEVEL, segment_counts
 from .analysis import tile_bounds
@@ -129,7 +130,7 @@ def auto_d_max(hm, camera, settings):
 
 
 def _clip_matrix(camera):
-    return np.asarray(camera.projection, np.float64) @ np.asarray(camera.view, np.float64)
+    return product(camera.projection, camera.view)  # no BLAS: the same bits on every machine
 
 
 def _project(camera, points):
@@ -301,6 +302,27 @@ def _neighbour(a, side, fill):
     else:
         out[:, :-1] = a[:, 1:]
     return out
+
+
+def block_tiles(block, counts):
+    """Tile columns and rows of ``block`` = (column, row, columns, rows), one block of an even split of a ``counts`` =
+    (ntx, nty) tile grid: two ``range``s (empty where the split has more blocks than tiles). Raises
+    `InvalidInputError` for a block outside its split."""
+    col, row, cols, rows = (int(v) for v in block)
+    if cols < 1 or rows < 1 or not (0 <= col < cols and 0 <= row < rows):
+        raise InvalidInputError(f"Block {col}, {row} of a {cols} x {rows} split does not exist: the column must be "
+                                "below the columns and the row below the rows, both at least 1")
+    ntx, nty = counts
+    return range(ntx * col // cols, ntx * (col + 1) // cols), range(nty * row // rows, nty * (row + 1) // rows)
+
+
+def only_block(selection, block):
+    """``selection`` with every tile outside ``block`` (see `block_tiles`) culled: a new `Selection`. The levels stay
+    those chosen for the whole terrain, so the blocks of a split, meshed apart, weld into the whole mesh."""
+    xs, ys = block_tiles(block, selection.culled.shape[::-1])
+    inside = np.zeros_like(selection.culled)
+    inside[ys.start:ys.stop, xs.start:xs.stop] = True
+    return replace(selection, culled=selection.culled | ~inside)
 
 
 def select(hm, table, camera, settings=TerrainLod()):

@@ -290,3 +290,42 @@ def test_a_mesh_never_outgrows_its_full_grid(size, tile, mode, levels):
     e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
     cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
     assert cross.min() > 0 and cross.sum() / 2 == pytest.approx((w - 1) * (h - 1))
+
+
+@pytest.mark.parametrize("split", [(2, 2), (3, 2), (4, 4), (9, 1)])
+def test_the_blocks_of_a_split_weld_into_the_whole_mesh(split, monkeypatch):
+    """Farm tasks mesh one block each (`only_block`): their meshes, welded where positions coincide bit for bit, are
+    the whole mesh; every triangle comes from exactly one block. The selection calls no LAPACK (CPU-dependent)."""
+    from tessera.kernels.common.weld import weld_triangles
+
+    hm = _terrain(size=193, seed=5)
+    table = ta.tile_table(hm, 16, backend="numpy")
+    rng = np.random.default_rng(sum(split))
+    monkeypatch.setattr(np.linalg, "inv", None)  # any use would raise: the levels must be the same on every machine
+    for levels in ("FRACTIONAL", "POW2"):
+        cam = _random_camera(rng, hm, far=50.0)
+        sel = tl.select(hm, table, cam, tl.TerrainLod(levels=levels))
+        whole = tm.bake(hm, table, sel)
+        assert len(whole.triangles) > 500
+        cols, rows = split
+        parts = [tm.bake(hm, table, tl.only_block(sel, (c, r, cols, rows))) for r in range(rows) for c in range(cols)]
+        assert sum(len(p.triangles) for p in parts) == len(whole.triangles)
+        offsets = np.cumsum([0] + [len(p.positions) for p in parts])
+        pos, tris, _, kept = weld_triangles(np.concatenate([p.positions for p in parts]),
+                                            np.concatenate([p.triangles + o for p, o in zip(parts, offsets[:-1],
+                                                                                            strict=True)]))
+        assert len(kept) == len(whole.triangles) and len(pos) == len(whole.positions)
+        assert np.array_equal(np.unique(pos, axis=0), np.unique(whole.positions, axis=0))
+
+        def triangles(p, t):
+            keys = [tuple(map(tuple, tri)) for tri in p[t]]
+            return {min(k[i:] + k[:i] for i in range(3)) for k in keys}
+
+        assert triangles(pos, tris) == triangles(whole.positions, whole.triangles)
+
+
+def test_a_block_outside_its_split_is_refused():
+    with pytest.raises(InvalidInputError, match="Block 2, 0 of a 2 x 2 split does not exist"):
+        tl.block_tiles((2, 0, 2, 2), (8, 8))
+    assert tl.block_tiles((1, 0, 3, 1), (8, 5)) == (range(2, 5), range(0, 5))
+    assert tl.block_tiles((0, 1, 1, 4), (8, 2)) == (range(0, 8), range(0, 1))
