@@ -85,6 +85,10 @@ def _plan(argv):
         frames = verbs._frames(args.frames) if args.frames else None
         if frames is not None and len(frames) > 1 and not files.per_frame(args.out):
             raise verbs.Usage(f"{args.out}: several frames need {{frame}} or #### in the output name")
+        if args.g == "LOG" or args.t_min_rule in ("LOG2", "PRINTED"):
+            print("tessera: warning: the Log roughness curve and the Log2/As Printed error rules use log2, whose last "
+                  "bit can differ between processors: on a farm of mixed machines, blocks may not weld exactly "
+                  "(keep --g sqrt --t-min-rule search)", file=sys.stderr, flush=True)
         tasks = plan.plan_terrain(verb, args, props, frames, mine.blocks)
     else:
         files.read_inputs(args.inputs)
