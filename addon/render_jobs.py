@@ -1,5 +1,6 @@
 """Background renders: the one mechanism every render Tessera runs in a worker process goes through (impostor atlases,
-nailboards, and any later one).
+nailboards, the lighting bake for Loop subdivision, and any later one). `start_worker` starts a worker script; the
+scripts share `worker_device.py` (the user's Cycles device on the worker's side).
 
 - **Folders**: each job works in a folder of its own, ``tessera-<kind>-*`` in the system's temporary directory, with
   the id of the process that made it (`job_folder`). The folder is removed as soon as the job's result is read, on
@@ -19,6 +20,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -27,7 +29,7 @@ import bpy
 from ..kernels.common.errors import TesseraError
 
 #: The kinds of job folders; only these are ever removed as stale.
-KINDS = ("impostor", "board")
+KINDS = ("impostor", "board", "bake")
 #: A folder of a process that is gone is stale after this many seconds; any folder of ours after `STALE_AGE_S`.
 ORPHAN_AGE_S = 60.0
 STALE_AGE_S = 24 * 3600.0
@@ -121,6 +123,33 @@ def remove_stale_folders(root=None, now=None):
     return removed
 
 
+def worker_command(script, job_file):
+    """The command line of worker ``script`` (a path) on ``job_file``: the blender binary where there is one, else this
+    Python with the bpy module."""
+    binary = getattr(bpy.app, "binary_path", "")
+    if binary and os.path.basename(binary).lower().startswith("blender") and os.path.isfile(binary):
+        return [binary, "--background", "--factory-startup", "--python", str(script), "--", str(job_file)]
+    return [sys.executable, str(script), "--", str(job_file)]
+
+
+def start_worker(script, job_file, log_path):
+    """Start worker ``script`` on ``job_file``, its output going to ``log_path`` (a file, not a pipe: a chatty
+    worker never stalls), below the viewport's priority ([Clua et al.]'s "low-priority thread": nice 10 on POSIX, below
+    normal on Windows). Returns the `subprocess.Popen`. The priority is lowered after the start rather than in the
+    child before it, so Python can spawn without copying this (large) process's page tables (no ``preexec_fn``)."""
+    kwargs = {}
+    if os.name == "nt":
+        kwargs["creationflags"] = subprocess.BELOW_NORMAL_PRIORITY_CLASS
+    with open(log_path, "wb") as log:
+        process = subprocess.Popen(worker_command(script, job_file), stdout=log, stderr=subprocess.STDOUT, **kwargs)
+    if hasattr(os, "setpriority"):
+        try:
+            os.setpriority(os.PRIO_PROCESS, process.pid, 10)
+        except OSError:  # it has finished already, or the system does not let us: it runs at normal priority
+            pass
+    return process
+
+
 def render_device(context=None):
     """The Cycles device the user chose, for a worker: ``{"type": "NONE" | "CUDA" | "OPTIX" | "HIP" | "METAL" |
     "ONEAPI", "devices": [ids of the devices in use], "gpu": whether the scene renders on the GPU}``. A worker given
@@ -162,12 +191,15 @@ class RenderJob:
     def running(self):
         return self.process.poll() is None
 
+    def tail(self):
+        """The end of the worker's log (what it said last): str."""
+        return self._log_bytes()[-600:].decode("utf-8", "replace")
+
     def check(self, what):
         """Raise `TesseraError` with the end of the worker's log when it failed (``what``: "Baking the impostor")."""
         code = self.process.poll()
         if code is not None and code != 0:
-            tail = self._log_bytes()[-600:].decode("utf-8", "replace")
-            raise TesseraError(f"{what} failed (exit {code}): {tail}")
+            raise TesseraError(f"{what} failed (exit {code}): {self.tail()}")
 
     def wait(self, report=None, what="Rendering", timeout=None):
         """Follow the job to its end where nothing polls it (background mode, the ``bpy`` module): ``report(line)``

@@ -8,12 +8,12 @@ import bpy
 import numpy as np
 
 from ..addon import bridge
-from ..addon.guarded import check_editable, guarded
+from ..addon.guarded import check_editable, check_numbers, guarded
 from ..addon.preferences import get_preferences
-from ..addon.render_jobs import render_device
-from ..addon.subdivision.bake import bake_colours
+from ..addon.subdivision.bake import read_bake, start_bake
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
+from ..kernels.common.errors import TesseraError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.normals import face_unit_normals
 from ..kernels.subdivision import hce
@@ -113,42 +113,105 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     def poll(cls, context):
         return mesh_poll(cls, context, "bake")
 
-    @guarded
-    def execute(self, context, tx):
+    def _start(self, context):
+        """Subdivide to Depth and start the worker: ``(BakeJob, what _store needs)``; refusals raise."""
         ob = context.active_object
+        check_numbers(self)
         check_editable(ob.data, "baked lighting stored on its mesh", "Make the object and its mesh local "
                                                                      "(Object › Relations › Make Local) first")
-        t0 = time.perf_counter()
+        budget = get_preferences(context).memory_budget_bytes
+        arrays, _ = bridge.read_mesh(ob.data)
+        marks = bridge.read_edge_marks(ob.data)
+        sub = loop_subdivide(arrays.positions, arrays.triangles, self.depth,
+                             creases=(marks.pairs, crease_to_sharpness(marks.crease)), budget_bytes=budget)
+        material = arrays.face_attributes.get("material_index")
+        material = np.zeros(len(arrays.triangles), np.int32) if material is None else material.reshape(-1)
+        bj = start_bake(context, ob, sub.positions, sub.triangles, material[sub.coarse_face()], self.samples,
+                        self.albedo, budget)
+        return bj, (ob.name, arrays, sub)
+
+    def invoke(self, context, event):
+        """In the UI: start the bake and follow it from a timer (the UI never waits; Esc cancels); elsewhere:
+        `execute`."""
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        self._job = None
+        result = self._begin(context)
+        if self._job is None:
+            return result
         wm = context.window_manager
-        wm.progress_begin(0, 100)
+        self._timer = wm.event_timer_add(0.25, window=context.window)
+        wm.modal_handler_add(self)
+        context.workspace.status_text_set("Baking lighting with Cycles — Esc to cancel")
+        return {"RUNNING_MODAL"}
+
+    @guarded
+    def _begin(self, context, tx):
+        self._t0 = time.perf_counter()
+        self._job, self._what = self._start(context)
+        return {"FINISHED"}
+
+    def _end(self, context):
+        context.window_manager.event_timer_remove(self._timer)
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._job.job.cancel()
+            self._end(context)
+            self.report({"WARNING"}, "Lighting bake cancelled: nothing was changed")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        if self._job.job.running():
+            device = self._job.job.device()
+            on = f" on {device}" if device else ""
+            context.workspace.status_text_set(f"Baking lighting with Cycles{on} — Esc to cancel")
+            return {"RUNNING_MODAL"}
+        self._end(context)
+        return self._finish(context)
+
+    @guarded
+    def _finish(self, context, tx):
+        device = self._job.job.device()
+        colours = read_bake(self._job)
+        return self._store(tx, colours, device, self._what, self._t0)
+
+    @guarded
+    def execute(self, context, tx):
+        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines."""
+        t0 = time.perf_counter()
+        bj, what = self._start(context)
         try:
-            arrays, _ = bridge.read_mesh(ob.data)
-            marks = bridge.read_edge_marks(ob.data)
-            sub = loop_subdivide(arrays.positions, arrays.triangles, self.depth,
-                                 creases=(marks.pairs, crease_to_sharpness(marks.crease)),
-                                 budget_bytes=get_preferences(context).memory_budget_bytes)
-            wm.progress_update(10)
-            material = arrays.face_attributes.get("material_index")
-            material = np.zeros(len(arrays.triangles), np.int32) if material is None else material.reshape(-1)
-            colours = bake_colours(context, ob, sub.positions, sub.triangles, material[sub.coarse_face()],
-                                   self.samples, self.albedo)
-            wm.progress_update(80)
-            n_f, leaves = len(arrays.triangles), 4**self.depth
-            normals = face_unit_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
-            trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), normals,
-                                       face_unit_normals(arrays.positions, arrays.triangles), m=self.normals,
-                                       tolerance=self.tolerance)
-            blob = hce.pack_container(trees, arrays.triangles, 4)
-        finally:
-            wm.progress_end()
+            bj.job.wait(None, "Baking lighting")
+        except BaseException:
+            bj.job.cancel()
+            raise
+        device = bj.job.device()
+        return self._store(tx, read_bake(bj), device, what, t0)
+
+    def _store(self, tx, colours, device, what, t0):
+        """Encode the baked colours as the HCE and store it on the mesh (undone if anything fails after)."""
+        name, arrays, sub = what
+        ob = bpy.data.objects.get(name)
+        if ob is None or len(ob.data.polygons) == 0:
+            raise TesseraError(f"{name!r} was deleted while its light was baked: nothing was changed")
+        current, _ = bridge.read_mesh(ob.data)
+        if not np.array_equal(current.triangles, arrays.triangles):
+            raise TesseraError(f"{name!r} was edited while its light was baked: nothing was changed; bake again")
+        n_f, leaves = len(arrays.triangles), 4**self.depth
+        normals = face_unit_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
+        trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), normals,
+                                   face_unit_normals(arrays.positions, arrays.triangles), m=self.normals,
+                                   tolerance=self.tolerance)
+        blob = hce.pack_container(trees, arrays.triangles, 4)
         old = ob.data.get(HCE_PROPERTY)
         ob.data[HCE_PROPERTY] = blob
         tx.on_rollback(lambda: ob.data.__setitem__(HCE_PROPERTY, old) if old is not None
                        else ob.data.pop(HCE_PROPERTY, None))
         nodes = sum(len(t.subdivided) for t in trees)
-        device = render_device(context)
-        on = f"GPU ({device['type']})" if device["gpu"] else "CPU"
-        self.report({"INFO"}, f"Baked lighting on the {on}: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
+        on = device or "the CPU"
+        self.report({"INFO"}, f"Baked lighting on {on}: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
                               f"{np.mean([len(t.normals) for t in trees]):.1f} extra normals each, "
                               f"{len(blob) / 1024:,.0f} KiB, {time.perf_counter() - t0:.1f} s")
         return {"FINISHED"}

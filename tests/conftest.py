@@ -45,7 +45,7 @@ def tier_unavailable(reason):
 
 
 #: Job folders of background renders (`addon.render_jobs`) that were there before the tests: any other is a leftover.
-_JOB_PREFIXES = ("tessera-impostor-", "tessera-board-")
+_JOB_PREFIXES = ("tessera-impostor-", "tessera-board-", "tessera-bake-")
 _JOB_FOLDERS_BEFORE = {n for n in os.listdir(tempfile.gettempdir()) if n.startswith(_JOB_PREFIXES)}
 
 

@@ -9,7 +9,6 @@ object is), so the main thread never reads a file either; `BoardJob.result()` ha
 import json
 import os
 import subprocess
-import sys
 from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +22,7 @@ from ...kernels.common.image_io import read_channels
 from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
+from .. import render_jobs
 from ..render_jobs import job_folder, remove_folder, render_device, stop_process, track
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
@@ -38,15 +38,6 @@ class BoardImages:
     displacement: np.ndarray
     normals: np.ndarray
     present: np.ndarray
-
-
-def worker_command(job_file):
-    """The worker's command line for a job file (`write_job`): the blender binary where there is one, else this
-    Python with the bpy module."""
-    binary = getattr(bpy.app, "binary_path", "")
-    if binary and os.path.basename(binary).lower().startswith("blender") and os.path.isfile(binary):
-        return [binary, "--background", "--factory-startup", "--python", str(SCRIPT), "--", str(job_file)]
-    return [sys.executable, str(SCRIPT), "--", str(job_file)]
 
 
 def write_job(ob, folder, resolution, samples, scale, clip, views, device=None):
@@ -82,21 +73,8 @@ def write_job(ob, folder, resolution, samples, scale, clip, views, device=None):
 
 
 def start_worker(job_file, log_path):
-    """Start the worker on a job file (`write_job`), its output going to ``log_path`` (a file, not a pipe: a chatty
-    worker never stalls), below the viewport's priority ([Clua et al.]'s "low-priority thread": nice 10 on POSIX, below
-    normal on Windows). Returns the `subprocess.Popen`. The priority is lowered after the start rather than in the
-    child before it, so Python can spawn without copying this (large) process's page tables (no ``preexec_fn``)."""
-    kwargs = {}
-    if os.name == "nt":
-        kwargs["creationflags"] = subprocess.BELOW_NORMAL_PRIORITY_CLASS
-    with open(log_path, "wb") as log:
-        process = subprocess.Popen(worker_command(job_file), stdout=log, stderr=subprocess.STDOUT, **kwargs)
-    if hasattr(os, "setpriority"):
-        try:
-            os.setpriority(os.PRIO_PROCESS, process.pid, 10)
-        except OSError:  # it has finished already, or the system does not let us: it runs at normal priority
-            pass
-    return process
+    """Start the board and atlas worker (`worker_script.py`) on a job file (`write_job`): `render_jobs.start_worker`."""
+    return render_jobs.start_worker(SCRIPT, job_file, log_path)
 
 
 class BoardJob:

@@ -16,29 +16,8 @@ import sys
 import bpy
 from mathutils import Matrix, Vector
 
-
-def use_device(scene, device):
-    """Render on the Cycles device the user chose (``device``: `addon.render_jobs.render_device`), else the CPU; says
-    which in a ``TESSERA_DEVICE`` line."""
-    scene.cycles.device = "CPU"
-    if device and device.get("gpu"):
-        try:
-            prefs = bpy.context.preferences.addons["cycles"].preferences
-            prefs.compute_device_type = device["type"]
-            (getattr(prefs, "refresh_devices", None) or prefs.get_devices)()
-            wanted = set(device.get("devices") or ())
-            used = []
-            for d in prefs.devices:
-                d.use = d.type != "CPU" and (not wanted or d.id in wanted)
-                if d.use:
-                    used.append(d.name)
-            if used:
-                scene.cycles.device = "GPU"
-                print(f"TESSERA_DEVICE GPU ({device['type']}): {', '.join(used)}", flush=True)
-                return
-        except (KeyError, TypeError, AttributeError, RuntimeError) as err:
-            print(f"Tessera: the GPU device could not be set up ({err}); rendering on the CPU", flush=True)
-    print("TESSERA_DEVICE CPU", flush=True)
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # addon/: the shared worker module
+from worker_device import use_device  # noqa: E402
 
 
 def setup(job):

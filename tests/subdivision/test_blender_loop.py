@@ -1,6 +1,8 @@
 """``tessera.loop_subdivide`` on Blender meshes (tier: blender): the kernel's result written as it is, creases
 from Blender's marks, UVs carried, open meshes, bad input refused with nothing changed."""
 
+import os
+
 import numpy as np
 import pytest
 from blender_helpers import select_only
@@ -179,3 +181,63 @@ def test_baked_lighting_is_saved_with_the_file(clean_scene, bpy_module, addon_mo
     select_only(bpy, ob)
     assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
     assert "BakedLight" in bpy.context.active_object.data.color_attributes
+
+
+def _state(bpy, ob):
+    """What the user's file holds: every block's name, and the source's render visibility and selection."""
+    names = {k: sorted(x.name for x in getattr(bpy.data, k)) for k in ("objects", "meshes", "materials", "images")}
+    return names, ob.hide_render, [o.name for o in bpy.context.selected_objects], bpy.context.active_object.name
+
+
+def test_the_lighting_bake_runs_in_a_worker_and_changes_nothing_of_the_users_until_it_is_read(
+        clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    bake = addon_module("addon.subdivision.bake")
+    jobs = addon_module("addon.render_jobs")
+    loop = addon_module("kernels.subdivision.loop")
+    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    sub = loop.loop_subdivide(arrays.positions, arrays.triangles, 1)
+    before = _state(bpy, ob)
+    bj = bake.start_bake(bpy.context, ob, sub.positions, sub.triangles, np.zeros(len(sub.triangles), np.int32), 2,
+                         True, 2**30)
+    assert _state(bpy, ob) == before  # the copy, its materials and image went to the job's file only
+    assert os.path.isdir(bj.job.folder) and bj.job.folder in jobs.open_folders()
+    lines = []
+    bj.job.wait(lines.append, "Baking lighting", timeout=300)
+    assert lines[-1] == "Tessera: Baking lighting 1/1" and bj.job.device() == "CPU"
+    colours = bake.read_bake(bj)
+    assert colours.shape == (len(sub.triangles), 4) and (colours[:, 3] == 1).all() and colours[:, :3].max() > 0.05
+    assert not os.path.exists(bj.job.folder) and not jobs.open_folders()
+    assert "tessera_hce" not in ob.data  # only the operator stores a bake
+
+
+def test_a_cancelled_lighting_bake_leaves_nothing(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    bake = addon_module("addon.subdivision.bake")
+    loop = addon_module("kernels.subdivision.loop")
+    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    sub = loop.loop_subdivide(arrays.positions, arrays.triangles, 2)
+    before = _state(bpy, ob)
+    bj = bake.start_bake(bpy.context, ob, sub.positions, sub.triangles, np.zeros(len(sub.triangles), np.int32), 4096,
+                         True, 2**30)
+    bj.job.cancel()
+    assert bj.job.process.poll() is not None and not os.path.exists(bj.job.folder)
+    assert not addon_module("addon.render_jobs").open_folders() and _state(bpy, ob) == before
+
+
+def test_a_lighting_bake_too_large_for_the_budget_is_refused_before_it_starts(clean_scene, bpy_module,
+                                                                              addon_module):
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    prefs = addon_module("addon.preferences").get_preferences()
+    kept = prefs.memory_budget_mb
+    prefs.memory_budget_mb = 1
+    try:
+        with pytest.raises(RuntimeError, match="Baking the light of 1,280 triangles") as err:
+            bpy.ops.tessera.bake_lighting_hce(depth=3)
+        assert "a lower Depth" in str(err.value)
+    finally:
+        prefs.memory_budget_mb = kept
+    assert not addon_module("addon.render_jobs").open_folders() and "tessera_hce" not in ob.data

@@ -1,0 +1,29 @@
+"""The worker side of background renders (`render_jobs`): imported by the worker scripts, which run in a Blender
+process of their own with this folder on ``sys.path`` (not as part of the add-on), so this module imports nothing of
+Tessera's."""
+
+import bpy
+
+
+def use_device(scene, device):
+    """Render on the Cycles device the user chose (``device``: `addon.render_jobs.render_device`), else the CPU; says
+    which in a ``TESSERA_DEVICE`` line."""
+    scene.cycles.device = "CPU"
+    if device and device.get("gpu"):
+        try:
+            prefs = bpy.context.preferences.addons["cycles"].preferences
+            prefs.compute_device_type = device["type"]
+            (getattr(prefs, "refresh_devices", None) or prefs.get_devices)()
+            wanted = set(device.get("devices") or ())
+            used = []
+            for d in prefs.devices:
+                d.use = d.type != "CPU" and (not wanted or d.id in wanted)
+                if d.use:
+                    used.append(d.name)
+            if used:
+                scene.cycles.device = "GPU"
+                print(f"TESSERA_DEVICE GPU ({device['type']}): {', '.join(used)}", flush=True)
+                return
+        except (KeyError, TypeError, AttributeError, RuntimeError) as err:
+            print(f"Tessera: the GPU device could not be set up ({err}); rendering on the CPU", flush=True)
+    print("TESSERA_DEVICE CPU", flush=True)
