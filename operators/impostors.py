@@ -4,7 +4,8 @@ rendered by Cycles in a worker process) on a card that faces the camera, for EEV
 
 In the UI the bake runs in the background (`addon.render_jobs`): the operator returns at once, a timer follows the
 worker, the status bar shows the views done, Esc stops it and leaves nothing. Scripts, ``blender -b`` and the redo
-panel run it to the end with progress lines; the redo panel renders again only when a setting that changes the
+panel run it to the end with progress lines. Once the views are in, they are read and dilated on a worker thread; the
+main thread only makes the images and the card; the redo panel renders again only when a setting that changes the
 render changed (Blend Views and Dilation reuse the last views)."""
 
 import hashlib
@@ -17,8 +18,16 @@ from ..addon.impostors.bake import atlas_images, check_atlas_size, dilated, make
 from ..addon.impostors.export import export_card, impostor_info
 from ..addon.preferences import get_preferences
 from ..addon.render_jobs import render_device
+from ..kernels.common import workers
 from ..kernels.common.errors import TesseraError
 from .selection import object_poll, select_only
+
+
+def _read_dilated(aj, dilation):
+    """(the atlas as rendered, the atlas dilated) of a finished job: on a worker thread (numpy and file reads only)."""
+    atlas = read_atlas(aj)
+    return atlas, dilated(atlas, dilation)
+
 
 #: The last atlas rendered (before dilation), by what its render depended on: the redo panel reuses it.
 _last = {"key": None, "atlas": None, "device": ""}
@@ -107,7 +116,7 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
     def _begin(self, context):
         """Start the job; None when it started, else the operator's result (the refusal is reported)."""
-        self._job = None
+        self._job, self._reading = None, None
         result = self._begin_guarded(context)
         return None if self._job is not None else result
 
@@ -136,18 +145,26 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
         if self._job.job.running():
             self._status(context)
             return {"RUNNING_MODAL"}
+        if self._reading is None:  # the views are in: read and dilate them on a worker thread, the UI keeps going
+            self._device = self._job.job.device()
+            dilation = self.dilation
+            self._reading = workers.submit(lambda: _read_dilated(self._job, dilation))
+            context.workspace.status_text_set("Baking impostor: reading the views — Esc to cancel")
+            return {"RUNNING_MODAL"}
+        if not self._reading.done():
+            return {"RUNNING_MODAL"}
         self._end(context)
         return self._finish(context)
 
     @guarded
     def _finish(self, context, tx):
-        atlas = read_atlas(self._job)
+        atlas, ready = self._reading.result()
         _last.update(key=self._key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas,
-                     device=self._job.job.device())
+                     device=self._device)
         ob = bpy.data.objects.get(self._name)
         if ob is None:
             raise TesseraError(f"{self._name!r} was deleted while its views were rendered: nothing was made")
-        return self._make(context, tx, atlas, _last["device"], ob)
+        return self._make(context, tx, atlas, _last["device"], ob, ready)
 
     @guarded
     def execute(self, context, tx):
@@ -168,9 +185,10 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
             _last.update(key=key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas, device=device)
         return self._make(context, tx, atlas, device, ob)
 
-    def _make(self, context, tx, atlas, device, ob):
-        """``ob``'s card and its images from a rendered atlas (dilated here: the kept atlas stays as rendered)."""
-        atlas = dilated(atlas, self.dilation)
+    def _make(self, context, tx, atlas, device, ob, ready=None):
+        """``ob``'s card and its images from a rendered atlas (dilated here unless ``ready`` is: the kept atlas stays
+        as rendered)."""
+        atlas = ready if ready is not None else dilated(atlas, self.dilation)
         name = f"{ob.name} impostor"
         images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}
         card = make_card(name, atlas, images, context.scene.camera, self.blend)

@@ -13,6 +13,7 @@ from ..addon.preferences import get_preferences
 from ..addon.subdivision.bake import read_bake, start_bake
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
+from ..kernels.common import workers
 from ..kernels.common.errors import TesseraError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.normals import face_unit_normals
@@ -88,6 +89,16 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
             bridge.write_edge_attribute(mesh, "crease_edge", result.edge_values(marks.pairs, remaining, 0.0))
 
 
+def _encode(colours, what, depth, normals, tolerance):
+    """The HCE of baked ``colours`` (N·4^depth, 4): ``(trees, packed bytes)``; numpy only (runs on a worker thread)."""
+    _, arrays, sub = what
+    n_f, leaves = len(arrays.triangles), 4**depth
+    sub_normals = face_unit_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
+    trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), sub_normals,
+                               face_unit_normals(arrays.positions, arrays.triangles), m=normals, tolerance=tolerance)
+    return trees, hce.pack_container(trees, arrays.triangles, 4)
+
+
 class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     """Bake the active mesh's light with Cycles and store it on the mesh, so Loop Subdivide shows it at any level"""
 
@@ -135,7 +146,7 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
         `execute`."""
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        self._job = None
+        self._job, self._encoding = None, None
         result = self._begin(context)
         if self._job is None:
             return result
@@ -168,14 +179,22 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
             on = f" on {device}" if device else ""
             context.workspace.status_text_set(f"Baking lighting with Cycles{on} — Esc to cancel")
             return {"RUNNING_MODAL"}
+        if self._encoding is None:  # rendered: read the colours and encode them on a worker thread
+            self._device = self._job.job.device()
+            job, what, settings = self._job, self._what, self._settings()
+            self._encoding = workers.submit(lambda: _encode(read_bake(job), what, *settings))
+            return {"RUNNING_MODAL"}
+        if not self._encoding.done():
+            return {"RUNNING_MODAL"}
         self._end(context)
         return self._finish(context)
 
+    def _settings(self):
+        return self.depth, self.normals, self.tolerance
+
     @guarded
     def _finish(self, context, tx):
-        device = self._job.job.device()
-        colours = read_bake(self._job)
-        return self._store(tx, colours, device, self._what, self._t0)
+        return self._store(tx, self._encoding.result(), self._device, self._what, self._t0)
 
     @guarded
     def execute(self, context, tx):
@@ -188,23 +207,19 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
             bj.job.cancel()
             raise
         device = bj.job.device()
-        return self._store(tx, read_bake(bj), device, what, t0)
+        return self._store(tx, _encode(read_bake(bj), what, *self._settings()), device, what, t0)
 
-    def _store(self, tx, colours, device, what, t0):
-        """Encode the baked colours as the HCE and store it on the mesh (undone if anything fails after)."""
-        name, arrays, sub = what
+    def _store(self, tx, encoded, device, what, t0):
+        """Store the encoded HCE on the mesh (undone if anything fails after)."""
+        name, arrays, _ = what
+        trees, blob = encoded
         ob = bpy.data.objects.get(name)
         if ob is None or len(ob.data.polygons) == 0:
             raise TesseraError(f"{name!r} was deleted while its light was baked: nothing was changed")
         current, _ = bridge.read_mesh(ob.data)
         if not np.array_equal(current.triangles, arrays.triangles):
             raise TesseraError(f"{name!r} was edited while its light was baked: nothing was changed; bake again")
-        n_f, leaves = len(arrays.triangles), 4**self.depth
-        normals = face_unit_normals(sub.positions, sub.triangles).reshape(n_f, leaves, 3)
-        trees = hce.encode_samples(colours.reshape(n_f, leaves, 4), normals,
-                                   face_unit_normals(arrays.positions, arrays.triangles), m=self.normals,
-                                   tolerance=self.tolerance)
-        blob = hce.pack_container(trees, arrays.triangles, 4)
+        n_f = len(arrays.triangles)
         old = ob.data.get(HCE_PROPERTY)
         ob.data[HCE_PROPERTY] = blob
         tx.on_rollback(lambda: ob.data.__setitem__(HCE_PROPERTY, old) if old is not None
