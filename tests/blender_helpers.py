@@ -1,6 +1,7 @@
 """Helpers shared by the blender-tier tests (importable as ``blender_helpers``, like ``mesh_checks``)."""
 
 import importlib
+import time
 
 import pytest
 from conftest import ADDON_MODULE
@@ -38,3 +39,46 @@ def stroke_elements(points, map_space=True):
     element = compat().stroke_element
     return [element(p[:3] if not map_space else (p[0], p[1], 0.0), p[2] if map_space else 1.0, first=i == 0)
             for i, p in enumerate(points)]
+
+
+class UiOperator:
+    """An operator as the UI runs it: its settings, its methods bound to it, its reports kept; ``drive`` calls its
+    ``modal`` with timer events (or Esc) as Blender's event loop does, without a window (none exists here)."""
+
+    def __init__(self, bpy, idname, **settings):
+        module, name = idname.split(".")
+        op = getattr(getattr(bpy.ops, module), name)
+        self.bl_rna = op.get_rna_type()
+        self.cls = getattr(bpy.types, op.idname())
+        for p in self.bl_rna.properties:
+            if p.identifier != "rna_type":
+                setattr(self, p.identifier, settings.get(p.identifier, getattr(p, "default", None)))
+        self.reports, self._timer = [], None
+        for klass in reversed(self.cls.__mro__):  # the operator's own methods (modal, _begin, _finish, ...), bound here
+            for attr, fn in vars(klass).items():
+                if callable(fn) and (attr == "modal" or (attr.startswith("_") and not attr.startswith("__"))):
+                    setattr(self, attr, fn.__get__(self))
+
+    def report(self, kind, text):
+        self.reports.append((set(kind), text))
+
+    def drive(self, context, escape_after=None, timeout=300):
+        class UI:  # the real context, with a window's status bar and timers that need no window
+            window_manager = type("WM", (), {"event_timer_remove": staticmethod(lambda t: None),
+                                             "progress_update": staticmethod(lambda v: None),
+                                             "progress_end": staticmethod(lambda: None)})()
+            workspace = type("WS", (), {"status_text_set": staticmethod(lambda t: None)})()
+
+            def __getattr__(self, name):
+                return getattr(context, name)
+
+        ui = UI()
+        start, ticks = time.monotonic(), 0
+        while time.monotonic() - start < timeout:
+            ticks += 1
+            kind = "ESC" if escape_after is not None and ticks > escape_after else "TIMER"
+            result = self.modal(ui, type("Event", (), {"type": kind})())
+            if result != {"RUNNING_MODAL"}:
+                return result
+            time.sleep(0.05)
+        raise AssertionError("the job did not end")

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from blender_helpers import UiOperator
 from test_blender_bake import baked_box
 
 pytestmark = pytest.mark.blender
@@ -210,3 +211,22 @@ def test_linked_data_is_refused_by_name(clean_scene, bpy_module, tmp_path):
             op(**kw)
     assert len(bpy.data.meshes) == n and rock.data.library is not None
     assert bpy.ops.tessera.loop_subdivide(levels=1, output="NEW_OBJECT") == {"FINISHED"}  # a local copy is fine
+
+
+def test_the_ui_path_of_the_impostor_bake_makes_the_card_of_the_script_path(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    box = _box(bpy)
+    op = UiOperator(bpy, "tessera.impostor_bake", grid=2, tile=16, samples=2, dilation=2)
+    op._begin(bpy.context)
+    assert op.drive(bpy.context) == {"FINISHED"}
+    card = bpy.context.active_object
+    assert card.name == "Cube impostor" and any("2x2 views of 16px" in text for _, text in op.reports)
+    ui_colour = np.array(bpy.data.images["Cube impostor colour"].pixels[:])
+    for image in [i for i in bpy.data.images if i.name.startswith("Cube impostor")]:
+        bpy.data.images.remove(image)
+    bpy.data.objects.remove(card)
+    box.select_set(True)
+    bpy.context.view_layer.objects.active = box
+    assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=2, dilation=2) == {"FINISHED"}  # the kept views
+    assert np.array_equal(np.array(bpy.data.images["Cube impostor colour"].pixels[:]), ui_colour)
+    assert not addon_module("addon.render_jobs").open_folders()

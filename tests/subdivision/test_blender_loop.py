@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 import pytest
-from blender_helpers import select_only
+from blender_helpers import UiOperator, select_only
 
 pytestmark = pytest.mark.blender
 
@@ -241,3 +241,26 @@ def test_a_lighting_bake_too_large_for_the_budget_is_refused_before_it_starts(cl
     finally:
         prefs.memory_budget_mb = kept
     assert not addon_module("addon.render_jobs").open_folders() and "tessera_hce" not in ob.data
+
+
+def test_the_ui_path_of_the_lighting_bake_stores_the_bake_or_cancels_cleanly(clean_scene, bpy_module, addon_module):
+    """The modal path (timer polls, colours read and encoded on a worker thread, then stored) gives the bake the
+    script path gives; Esc stops the worker and changes nothing."""
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=2) == {"FINISHED"}
+    want = bytes(ob.data["tessera_hce"])
+    del ob.data["tessera_hce"]
+    op = UiOperator(bpy, "tessera.bake_lighting_hce", depth=1, samples=2)
+    op._job, op._encoding = None, None
+    assert op._begin(bpy.context) == {"FINISHED"} and op._job is not None
+    assert op.drive(bpy.context) == {"FINISHED"}
+    assert bytes(ob.data["tessera_hce"]) == want  # the same Cycles bake, encoded on a thread
+    assert any("Baked lighting on CPU" in text for _, text in op.reports)
+    del ob.data["tessera_hce"]
+    op = UiOperator(bpy, "tessera.bake_lighting_hce", depth=2, samples=4096)
+    op._job, op._encoding = None, None
+    op._begin(bpy.context)
+    assert op.drive(bpy.context, escape_after=2) == {"CANCELLED"}
+    assert op._job.job.process.poll() is not None and not os.path.exists(op._job.job.folder)
+    assert "tessera_hce" not in ob.data and not addon_module("addon.render_jobs").open_folders()
