@@ -470,6 +470,14 @@ def read_image_pixels(image, channels=None):
     return pixels.reshape(h, w, c)
 
 
+def set_bytes_property(block, name, value):
+    """Store ``value`` (bytes; None: remove) as the custom property ``name`` of ``block``. The property is removed
+    first: Blender copies new bytes into an existing bytes property only up to their first zero byte."""
+    block.pop(name, None)
+    if value is not None:
+        block[name] = value
+
+
 def pack_float_image(image):
     """Pack a float image into the .blend as OpenEXR with its channels kept apart (alpha mode Channel Packed: no
     premultiplication on the way in or out), so its values come back bit for bit after save and reload, colours

@@ -16,6 +16,7 @@ scripts share `worker_device.py` (the user's Cycles device on the worker's side)
 """
 
 import atexit
+import hashlib
 import os
 import re
 import shutil
@@ -25,6 +26,7 @@ import tempfile
 import time
 
 import bpy
+import numpy as np
 
 from ..kernels.common.errors import TesseraError
 
@@ -162,6 +164,37 @@ def render_device(context=None):
     devices = [d.id for d in getattr(prefs, "devices", ()) if getattr(d, "use", False) and d.type != "CPU"] \
         if prefs is not None else []
     return {"type": kind or "NONE", "devices": devices, "gpu": bool(scene_gpu and kind not in ("", "NONE"))}
+
+
+def _mesh_digest(digest, ob, depsgraph=None):
+    """Add ``ob``'s vertex positions (evaluated with ``depsgraph``, else its own mesh) to ``digest``."""
+    source = ob.evaluated_get(depsgraph) if depsgraph is not None else ob
+    try:
+        mesh = source.to_mesh() if depsgraph is not None else ob.data
+        pos = np.empty(len(mesh.vertices) * 3, np.float32)
+        mesh.vertices.foreach_get("co", pos)
+        digest.update(pos.tobytes())
+    finally:
+        if depsgraph is not None:
+            source.to_mesh_clear()
+
+
+def render_key(context, ob, surroundings=False):
+    """What a render of ``ob`` depends on, to tell whether a redo must render again: its evaluated geometry,
+    transform and materials, the lights that render (and, with ``surroundings``, every other object that renders: its
+    transform and mesh, for a bake of the light bounced off them), the world and the user's render device. A tuple."""
+    digest = hashlib.sha256()
+    _mesh_digest(digest, ob, context.evaluated_depsgraph_get())
+    digest.update(np.array(ob.matrix_world, np.float64).tobytes())
+    for o in context.view_layer.objects:
+        if o is ob or o.hide_render or not (o.type == "LIGHT" or surroundings):
+            continue
+        digest.update(o.name.encode() + np.array(o.matrix_world, np.float64).tobytes())
+        if surroundings and o.type == "MESH":
+            _mesh_digest(digest, o)
+    names = [m.name for m in getattr(ob.data, "materials", ()) if m is not None]
+    world = context.scene.world.name if context.scene.world else ""
+    return ob.session_uid, digest.hexdigest(), tuple(names), world, str(render_device(context))
 
 
 class RenderJob:

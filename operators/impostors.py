@@ -8,16 +8,13 @@ panel run it to the end with progress lines. Once the views are in, they are rea
 main thread only makes the images and the card; the redo panel renders again only when a setting that changes the
 render changed (Blend Views and Dilation reuse the last views)."""
 
-import hashlib
-
 import bpy
-import numpy as np
 
 from ..addon.guarded import check_numbers, guarded
 from ..addon.impostors.bake import atlas_images, check_atlas_size, dilated, make_card, read_atlas, start_atlas
 from ..addon.impostors.export import export_card, impostor_info
 from ..addon.preferences import get_preferences
-from ..addon.render_jobs import render_device
+from ..addon.render_jobs import render_device, render_key
 from ..kernels.common import workers
 from ..kernels.common.errors import TesseraError
 from .selection import object_poll, select_only
@@ -36,25 +33,8 @@ _KEEP_BYTES = 256 * 2**20
 
 
 def _render_key(context, ob, op):
-    """What a bake's views depend on: the object (its evaluated geometry, transform, materials), the lights and world
-    of the scene, and the settings that change the render."""
-    digest = hashlib.sha256()
-    evaluated = ob.evaluated_get(context.evaluated_depsgraph_get())
-    try:
-        mesh = evaluated.to_mesh()
-        pos = np.empty(len(mesh.vertices) * 3, np.float32)
-        mesh.vertices.foreach_get("co", pos)
-        digest.update(pos.tobytes())
-    finally:
-        evaluated.to_mesh_clear()
-    digest.update(np.array(ob.matrix_world, np.float64).tobytes())
-    for o in context.view_layer.objects:
-        if o.type == "LIGHT" and not o.hide_render:
-            digest.update(o.name.encode() + np.array(o.matrix_world, np.float64).tobytes())
-    names = [m.name for m in getattr(ob.data, "materials", ()) if m is not None]
-    world = context.scene.world.name if context.scene.world else ""
-    return (ob.session_uid, digest.hexdigest(), tuple(names), world, op.grid, op.tile, op.samples, op.hemi,
-            str(render_device(context)))
+    """What a bake's views depend on (`render_jobs.render_key`) and the settings that change the render."""
+    return render_key(context, ob), op.grid, op.tile, op.samples, op.hemi
 
 
 class TESSERA_OT_impostor_bake(bpy.types.Operator):

@@ -10,6 +10,7 @@ import numpy as np
 from ..addon import bridge
 from ..addon.guarded import check_editable, check_numbers, guarded
 from ..addon.preferences import get_preferences
+from ..addon.render_jobs import render_key
 from ..addon.subdivision.bake import read_bake, start_bake
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
@@ -89,6 +90,24 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
             bridge.write_edge_attribute(mesh, "crease_edge", result.edge_values(marks.pairs, remaining, 0.0))
 
 
+#: The last lighting bake's colours, by what its render depended on: the redo panel re-encodes them.
+_last = {"key": None, "colours": None, "device": "", "what": None}
+#: Bakes at most this large are kept for the redo panel.
+_KEEP_BYTES = 256 * 2**20
+
+
+def _bake_key(context, ob, op):
+    """What a lighting bake's render depends on (the object, everything around it that renders, the world, the device:
+    `render_jobs.render_key`) and the settings that change the render."""
+    return render_key(context, ob, surroundings=True), op.depth, op.samples, op.albedo
+
+
+def _keep(key, colours, device, what):
+    small = colours.nbytes <= _KEEP_BYTES
+    _last.update(key=key if small else None, colours=colours if small else None, device=device,
+                 what=what if small else None)
+
+
 def _encode(colours, what, depth, normals, tolerance):
     """The HCE of baked ``colours`` (N·4^depth, 4): ``(trees, packed bytes)``; numpy only (runs on a worker thread)."""
     _, arrays, sub = what
@@ -124,12 +143,15 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     def poll(cls, context):
         return mesh_poll(cls, context, "bake")
 
+    def _check(self, context):
+        check_numbers(self)
+        check_editable(context.active_object.data, "baked lighting stored on its mesh",
+                       "Make the object and its mesh local (Object › Relations › Make Local) first")
+
     def _start(self, context):
         """Subdivide to Depth and start the worker: ``(BakeJob, what _store needs)``; refusals raise."""
         ob = context.active_object
-        check_numbers(self)
-        check_editable(ob.data, "baked lighting stored on its mesh", "Make the object and its mesh local "
-                                                                     "(Object › Relations › Make Local) first")
+        self._check(context)
         budget = get_preferences(context).memory_budget_bytes
         arrays, _ = bridge.read_mesh(ob.data)
         marks = bridge.read_edge_marks(ob.data)
@@ -159,6 +181,7 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     @guarded
     def _begin(self, context, tx):
         self._t0 = time.perf_counter()
+        self._key = _bake_key(context, context.active_object, self)
         self._job, self._what = self._start(context)
         return {"FINISHED"}
 
@@ -182,7 +205,12 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
         if self._encoding is None:  # rendered: read the colours and encode them on a worker thread
             self._device = self._job.job.device()
             job, what, settings = self._job, self._what, self._settings()
-            self._encoding = workers.submit(lambda: _encode(read_bake(job), what, *settings))
+
+            def read_and_encode():
+                colours = read_bake(job)
+                return colours, _encode(colours, what, *settings)
+
+            self._encoding = workers.submit(read_and_encode)
             return {"RUNNING_MODAL"}
         if not self._encoding.done():
             return {"RUNNING_MODAL"}
@@ -194,20 +222,30 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
 
     @guarded
     def _finish(self, context, tx):
-        return self._store(tx, self._encoding.result(), self._device, self._what, self._t0)
+        colours, encoded = self._encoding.result()
+        _keep(self._key, colours, self._device, self._what)
+        return self._store(tx, encoded, self._device, self._what, self._t0)
 
     @guarded
     def execute(self, context, tx):
-        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines."""
+        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines. The last bake's colours are
+        reused when nothing the render depends on changed (the redo panel's Normals and Colour Tolerance)."""
         t0 = time.perf_counter()
-        bj, what = self._start(context)
-        try:
-            bj.job.wait(None, "Baking lighting")
-        except BaseException:
-            bj.job.cancel()
-            raise
-        device = bj.job.device()
-        return self._store(tx, _encode(read_bake(bj), what, *self._settings()), device, what, t0)
+        key = _bake_key(context, context.active_object, self)
+        if _last["key"] == key:
+            self._check(context)
+            colours, device, what = _last["colours"], _last["device"], _last["what"]
+        else:
+            bj, what = self._start(context)
+            try:
+                bj.job.wait(None, "Baking lighting")
+            except BaseException:
+                bj.job.cancel()
+                raise
+            device = bj.job.device()
+            colours = read_bake(bj)
+            _keep(key, colours, device, what)
+        return self._store(tx, _encode(colours, what, *self._settings()), device, what, t0)
 
     def _store(self, tx, encoded, device, what, t0):
         """Store the encoded HCE on the mesh (undone if anything fails after)."""
@@ -221,9 +259,9 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
             raise TesseraError(f"{name!r} was edited while its light was baked: nothing was changed; bake again")
         n_f = len(arrays.triangles)
         old = ob.data.get(HCE_PROPERTY)
-        ob.data[HCE_PROPERTY] = blob
-        tx.on_rollback(lambda: ob.data.__setitem__(HCE_PROPERTY, old) if old is not None
-                       else ob.data.pop(HCE_PROPERTY, None))
+        old = bytes(old) if isinstance(old, bytes | bytearray) else old
+        bridge.set_bytes_property(ob.data, HCE_PROPERTY, blob)
+        tx.on_rollback(lambda: bridge.set_bytes_property(ob.data, HCE_PROPERTY, old))
         nodes = sum(len(t.subdivided) for t in trees)
         on = device or "the CPU"
         self.report({"INFO"}, f"Baked lighting on {on}: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "

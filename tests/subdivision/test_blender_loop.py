@@ -264,3 +264,33 @@ def test_the_ui_path_of_the_lighting_bake_stores_the_bake_or_cancels_cleanly(cle
     assert op.drive(bpy.context, escape_after=2) == {"CANCELLED"}
     assert op._job.job.process.poll() is not None and not os.path.exists(op._job.job.folder)
     assert "tessera_hce" not in ob.data and not addon_module("addon.render_jobs").open_folders()
+
+
+def test_the_redo_panel_bakes_again_only_when_the_render_changes(clean_scene, bpy_module, addon_module, monkeypatch):
+    """Normals and Colour Tolerance re-encode the last bake's colours; a moved object nearby (its bounced light) or
+    more samples render again."""
+    bpy = bpy_module
+    jobs = addon_module("addon.render_jobs")
+    started = []
+    real = jobs.start_worker
+    monkeypatch.setattr(jobs, "start_worker", lambda *a: started.append(1) or real(*a))
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    for normals in (2, 0, 3):
+        assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=2, normals=normals) == {"FINISHED"}
+    assert len(started) == 1
+    reused = bytes(ob.data["tessera_hce"])
+    bpy.data.objects["Plane"].location.x += 0.8  # the red wall the light bounces off moved closer
+    select_only(bpy, ob)
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=2, normals=3) == {"FINISHED"}
+    assert len(started) == 2 and bytes(ob.data["tessera_hce"]) != reused
+    bpy.data.objects["Plane"].location.x -= 0.8
+    select_only(bpy, ob)
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=2, normals=3) == {"FINISHED"}
+    assert len(started) == 3 and bytes(ob.data["tessera_hce"]) == reused  # rendered again: the same bytes
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=3, normals=3) == {"FINISHED"}
+    assert len(started) == 4
+    # every bake stored whole (Blender cut a bytes property replaced in place at its first zero byte)
+    hce = addon_module("kernels.subdivision.hce")
+    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    assert len(ob.data["tessera_hce"]) > 1000
+    assert len(hce.unpack_container(ob.data["tessera_hce"], arrays.triangles).node_start) == len(arrays.triangles) + 1
