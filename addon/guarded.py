@@ -134,6 +134,16 @@ def out_of_memory_message(err):
     return None
 
 
+def _failed(op, tx, err):
+    """Roll ``tx`` back and report ``err`` on operator ``op`` (see the module): ``{'CANCELLED'}``."""
+    if not isinstance(err, TesseraError):
+        traceback.print_exc()
+    tx.rollback()
+    op.report({"ERROR"}, str(err) if isinstance(err, TesseraError) else out_of_memory_message(err) or
+              failure_message(err))
+    return {"CANCELLED"}
+
+
 def guarded(execute):
     """Decorate ``execute(self, context, tx)`` into Blender's ``execute(self, context)`` (see the module)."""
 
@@ -143,17 +153,24 @@ def guarded(execute):
         try:
             check_numbers(self)
             result = execute(self, context, tx)
-        except TesseraError as err:
-            tx.rollback()
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
         except Exception as err:  # noqa: BLE001 - the guard: no traceback may escape to the user
-            traceback.print_exc()
-            tx.rollback()
-            self.report({"ERROR"}, out_of_memory_message(err) or failure_message(err))
-            return {"CANCELLED"}
+            return _failed(self, tx, err)
         if "CANCELLED" in result:
             tx.rollback()
         return result
 
     return wrapper
+
+
+def guarded_step(op, tx, steps):
+    """One step of work spread over several calls (a modal operator's timer ticks, each short): ``next(steps)`` with
+    the new blocks tracked by ``tx``, a `Transaction` kept across the steps. Returns None while steps remain, the
+    result when ``steps`` (a generator returning the operator's result) ends, or ``{'CANCELLED'}`` on failure (rolled
+    back and reported as the guard does)."""
+    try:
+        next(steps)
+    except StopIteration as done:
+        return done.value
+    except Exception as err:  # noqa: BLE001 - the guard
+        return _failed(op, tx, err)
+    return None

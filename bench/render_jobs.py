@@ -5,8 +5,9 @@ baseline: the render's whole time, what a bake froze Blender for before they bec
 The session is what the operators' timers do, in one run: every job is started, then polled every 20 ms as the
 timers poll them (progress, device, whether done); once a worker is done its files are read on a worker thread (a
 board's images; the impostor's views, read and dilated; the lighting's colours, read and encoded), and the main thread
-only makes what Blender must make itself (the impostor's three packed images and its card; the lighting's stored
-bytes). Every main-thread step is timed; rows give the longest. The impostor is the bake's default, 8 x 8 views of
+only makes what Blender must make itself, a piece per timer tick (the impostor's three packed images, then its card;
+the lighting's stored bytes). A card copies the material of an earlier card of its kind (`step` rows: the first card
+builds it). Every main-thread step is timed; rows give the longest. The impostor is the bake's default, 8 x 8 views of
 128 px. The scene holds a
 Suzanne at subdivision level 3 (63k triangles), a floor, two lights; ``heavy_scene`` adds a 1M-triangle mesh, which
 the lighting bake writes with the scene (it needs every object for the bounced light) while the impostor and board
@@ -17,6 +18,7 @@ Run: .venv/bin/python bench/render_jobs.py
 import importlib
 import json
 import time
+from functools import partial
 
 import numpy as np
 from _setup import enable_extension
@@ -43,7 +45,7 @@ def _timed(steps, job, fn):
     t = time.perf_counter()
     result = fn()
     steps.setdefault(job, []).append(time.perf_counter() - t)
-    return result
+    return result if job != "copy" else steps[job][-1]
 
 
 def session(bpy, mod, heavy):
@@ -75,12 +77,16 @@ def session(bpy, mod, heavy):
                                                         atlas.job.running())[-1])
             if not running and "impostor" not in reading:
                 reading["impostor"] = workers.submit(impostor_op._read_dilated, atlas, 4)
-            elif not running and reading["impostor"].done():
-                def make():
-                    _, ready = reading["impostor"].result()
-                    images = bake.atlas_images("Suzanne impostor", ready)
-                    return bake.make_card("Suzanne impostor", ready, images, None)
-                _timed(steps, "impostor", make)
+            elif not running and reading["impostor"].done():  # one image per tick, then the card
+                _, ready = reading["impostor"].result()
+                images = {}
+                for key, pixels in bake.atlas_pixels(ready).items():
+                    images[key] = _timed(steps, "impostor", partial(bake.packed_float_image, f"S {key}", pixels))
+                    time.sleep(0.02)
+                _timed(steps, "impostor", partial(bake.make_card, "Suzanne impostor", ready, images, None))
+                card_ms = steps["impostor"][-1] * 1e3
+                # a second card of the kind: its material is copied, not built
+                copy_ms = _timed({}, "copy", partial(bake.make_card, "Suzanne impostor 2", ready, images, None))
                 pending.discard("impostor")
                 ended["impostor"] = time.perf_counter() - started
         for k, job in enumerate(boards):
@@ -100,6 +106,10 @@ def session(bpy, mod, heavy):
                 _timed(steps, "lighting", lambda: reading["lighting"].result())
                 pending.discard("lighting")
                 ended["lighting"] = time.perf_counter() - started
+    print(json.dumps({"case": "heavy_scene" if heavy else "session", "step": "the impostor's card",
+                      "first_card_ms (material built)": round(card_ms, 1),
+                      "later_card_ms (material copied)": round(copy_ms * 1e3, 1),
+                      "ratio": round(card_ms / (copy_ms * 1e3), 1)}), flush=True)
     for job, times in steps.items():
         longest = max(times)
         print(json.dumps({"case": "heavy_scene" if heavy else "session", "job": job,

@@ -10,8 +10,16 @@ render changed (Blend Views and Dilation reuse the last views)."""
 
 import bpy
 
-from ..addon.guarded import check_numbers, guarded
-from ..addon.impostors.bake import atlas_images, check_atlas_size, dilated, make_card, read_atlas, start_atlas
+from ..addon.guarded import Transaction, check_numbers, guarded, guarded_step
+from ..addon.impostors.bake import (
+    atlas_pixels,
+    check_atlas_size,
+    dilated,
+    make_card,
+    packed_float_image,
+    read_atlas,
+    start_atlas,
+)
 from ..addon.impostors.export import export_card, impostor_info
 from ..addon.preferences import get_preferences
 from ..addon.render_jobs import render_device, render_key
@@ -96,7 +104,7 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
     def _begin(self, context):
         """Start the job; None when it started, else the operator's result (the refusal is reported)."""
-        self._job, self._reading = None, None
+        self._job, self._reading, self._making = None, None, None
         result = self._begin_guarded(context)
         return None if self._job is not None else result
 
@@ -117,6 +125,8 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
     def modal(self, context, event):
         if event.type == "ESC":
             self._job.job.cancel()
+            if self._making is not None:
+                self._tx.rollback()  # the images made so far
             self._end(context)
             self.report({"WARNING"}, "Impostor bake cancelled: nothing was made")
             return {"CANCELLED"}
@@ -133,18 +143,23 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
             return {"RUNNING_MODAL"}
         if not self._reading.done():
             return {"RUNNING_MODAL"}
+        if self._making is None:  # then the images and the card, one per tick
+            self._tx = Transaction()
+            self._making = self._finish_steps(context)
+        result = guarded_step(self, self._tx, self._making)
+        if result is None:
+            return {"RUNNING_MODAL"}
         self._end(context)
-        return self._finish(context)
+        return result
 
-    @guarded
-    def _finish(self, context, tx):
+    def _finish_steps(self, context):
         atlas, ready = self._reading.result()
         _last.update(key=self._key if atlas.colour.nbytes * 3 <= _KEEP_BYTES else None, atlas=atlas,
                      device=self._device)
         ob = bpy.data.objects.get(self._name)
         if ob is None:
             raise TesseraError(f"{self._name!r} was deleted while its views were rendered: nothing was made")
-        return self._make(context, tx, atlas, _last["device"], ob, ready)
+        return (yield from self._make_steps(context, self._tx, atlas, _last["device"], ob, ready))
 
     @guarded
     def execute(self, context, tx):
@@ -168,9 +183,22 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
     def _make(self, context, tx, atlas, device, ob, ready=None):
         """``ob``'s card and its images from a rendered atlas (dilated here unless ``ready`` is: the kept atlas stays
         as rendered)."""
+        steps = self._make_steps(context, tx, atlas, device, ob, ready)
+        while True:
+            try:
+                next(steps)
+            except StopIteration as done:
+                return done.value
+
+    def _make_steps(self, context, tx, atlas, device, ob, ready=None):
+        """`_make` one step at a time (a generator: each image, the card), so that a timer tick never holds the UI
+        long; returns the operator's result."""
         atlas = ready if ready is not None else dilated(atlas, self.dilation)
         name = f"{ob.name} impostor"
-        images = {k: tx.track(v) for k, v in atlas_images(name, atlas).items()}
+        images = {}
+        for key, pixels in atlas_pixels(atlas).items():
+            images[key] = tx.track(packed_float_image(f"{name} {key}", pixels))
+            yield
         card = make_card(name, atlas, images, context.scene.camera, self.blend)
         tx.track(card.data)
         tx.track(card.data.materials[0])

@@ -230,3 +230,38 @@ def test_the_ui_path_of_the_impostor_bake_makes_the_card_of_the_script_path(clea
     assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=2, dilation=2) == {"FINISHED"}  # the kept views
     assert np.array_equal(np.array(bpy.data.images["Cube impostor colour"].pixels[:]), ui_colour)
     assert not addon_module("addon.render_jobs").open_folders()
+
+
+def _graph(mat):
+    nodes = sorted((n.bl_idname, n.label, getattr(n, "operation", ""), getattr(n, "interpolation", ""))
+                   for n in mat.node_tree.nodes)
+    links = sorted((lk.from_node.bl_idname, lk.from_socket.identifier, lk.to_node.bl_idname, lk.to_socket.identifier)
+                   for lk in mat.node_tree.links)
+    values = sorted((n.bl_idname, s.identifier, round(float(s.default_value), 6)) for n in mat.node_tree.nodes
+                    for s in n.inputs if not s.is_linked and s.type == "VALUE")
+    return nodes, links, values
+
+
+def test_a_later_card_copies_the_material_of_its_kind_with_its_own_atlas(clean_scene, bpy_module, addon_module):
+    """Building a card's ~120 nodes takes tens of ms; a card of the same kind copies a local one instead: the same
+    graph, its own images."""
+    bpy = bpy_module
+    bake = addon_module("addon.impostors.bake")
+    cards = []
+    for k, blend in enumerate((True, True, False)):
+        bpy.ops.mesh.primitive_cube_add(location=(3 * k, 0, 0))
+        assert bpy.ops.tessera.impostor_bake(grid=2, tile=8, samples=1, blend=blend) == {"FINISHED"}
+        cards.append(bpy.context.active_object)
+    first, second, unblended = (c.active_material for c in cards)
+    assert first[bake.MATERIAL_KIND] == second[bake.MATERIAL_KIND] != unblended[bake.MATERIAL_KIND]
+    assert _graph(first) == _graph(second) and _graph(first) != _graph(unblended)
+    for card, mat in zip(cards, (first, second, unblended), strict=True):
+        name = card.name
+        used = {n.image.name for n in mat.node_tree.nodes if n.type == "TEX_IMAGE"}
+        assert used == {f"{name} colour", f"{name} normal", f"{name} depth"}, used
+    # the material built fresh (no card of its kind in the file) is the one copied
+    copied = [n for n in _graph(second)[0] if "for export" not in n[1]]
+    for card in cards:
+        bpy.data.materials.remove(card.active_material)
+    fresh = bake.card_material("fresh", bpy.data.images[f"{cards[1].name} colour"], 2, False, True)
+    assert _graph(fresh)[0] == copied
