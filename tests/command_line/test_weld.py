@@ -46,3 +46,18 @@ def test_a_triangle_collapsed_by_welding_is_dropped():
     p = np.array([[0, 0, 0], [1, 0, 0], [0, 0, 0], [0, 1, 0]], np.float32)
     welded, tris, keep, kept = weld_triangles(p, np.array([[0, 1, 2], [0, 1, 3]]))
     assert kept.tolist() == [1] and tris.tolist() == [[0, 1, 2]] and len(welded) == 3
+
+
+def test_the_farm_digest_tool_prints_the_same_digest_twice():
+    """`tools/terrain_digest.py`, what a farm admin runs on each machine: digests of levels and meshes, stable."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    tool = Path(__file__).resolve().parents[2] / "tools" / "terrain_digest.py"
+    runs = [subprocess.run([sys.executable, str(tool), "--cameras", "3"], capture_output=True, text=True, timeout=300)
+            for _ in range(2)]
+    assert all(r.returncode == 0 for r in runs), runs[0].stderr[-2000:]
+    a, b = (json.loads(r.stdout.strip().splitlines()[-1]) for r in runs)
+    assert len(a["levels"]) == len(a["meshes"]) == 16 and (a["levels"], a["meshes"]) == (b["levels"], b["meshes"])
