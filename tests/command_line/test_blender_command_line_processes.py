@@ -55,6 +55,16 @@ def blender(built_zips, tmp_path_factory):
     return run
 
 
+def _blend(path, body):
+    """Write the .blend ``path`` made by the Python lines ``body`` (``bpy`` imported, an empty scene) in a process
+    of its own: the test process's file is never replaced."""
+    code = (f"import bpy\nbpy.ops.wm.read_homefile(use_empty=True)\n{body}\n"
+            f"bpy.ops.wm.save_as_mainfile(filepath={str(path)!r})\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return path
+
+
 def _ok(proc):
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return proc
@@ -70,24 +80,21 @@ def _dem():
 
 
 @pytest.fixture(scope="module")
-def shot(tmp_path_factory, bpy_module, addon):
+def shot(tmp_path_factory):
     """A folder with the DEM and a .blend whose camera flies over it (frames 1 and 2)."""
-    bpy = bpy_module
     folder = tmp_path_factory.mktemp("terrain_job")
     write_geotiff(str(folder / "dem.tif"), _dem(), spacing=(10.0, 10.0), nodata=-32768)
-    bpy.ops.wm.read_homefile(use_empty=True)
-    cam = bpy.data.objects.new("Drone", bpy.data.cameras.new("Drone"))
-    bpy.context.scene.collection.objects.link(cam)
-    cam.data.clip_end = 10000.0
-    cam.rotation_euler = (1.1, 0.0, -0.6)
-    cam.location = (-900.0, -1300.0, 1500.0)
-    cam.keyframe_insert("location", frame=1)
-    cam.location = (-300.0, -1100.0, 1300.0)
-    cam.keyframe_insert("location", frame=2)
-    bpy.context.scene.camera = cam
-    bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 960, 540
-    bpy.ops.wm.save_as_mainfile(filepath=str(folder / "shot.blend"), copy=True)
-    bpy.ops.wm.read_homefile(use_empty=True)
+    _blend(folder / "shot.blend", """
+cam = bpy.data.objects.new("Drone", bpy.data.cameras.new("Drone"))
+bpy.context.scene.collection.objects.link(cam)
+cam.data.clip_end = 10000.0
+cam.rotation_euler = (1.1, 0.0, -0.6)
+cam.location = (-900.0, -1300.0, 1500.0)
+cam.keyframe_insert("location", frame=1)
+cam.location = (-300.0, -1100.0, 1300.0)
+cam.keyframe_insert("location", frame=2)
+bpy.context.scene.camera = cam
+bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 960, 540""")
     return folder
 
 
@@ -172,12 +179,10 @@ def test_a_terrain_split_into_farm_tasks_joins_into_the_single_process_mesh(blen
 
 def test_impostors_planned_per_object_bake_the_atlases_of_one_process(blender, bpy_module, tmp_path):
     bpy = bpy_module
-    bpy.ops.wm.read_homefile(use_empty=True)
-    bpy.ops.mesh.primitive_cube_add(location=(0, 0, 0))
-    bpy.ops.mesh.primitive_ico_sphere_add(location=(3, 0, 0), subdivisions=2)
-    bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "props.blend"), copy=True)
-    bpy.ops.wm.read_homefile(use_empty=True)
+    _blend(tmp_path / "props.blend", """
+bpy.ops.mesh.primitive_cube_add(location=(0, 0, 0))
+bpy.ops.mesh.primitive_ico_sphere_add(location=(3, 0, 0), subdivisions=2)
+bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))""")
     opts = ["--grid", "2", "--tile", "16", "--samples", "2"]
     _ok(blender("-c", "tessera", "impostors", tmp_path / "props.blend", *opts,
                 "-o", tmp_path / "one" / "{object}.blend"))
@@ -203,15 +208,10 @@ def test_impostors_planned_per_object_bake_the_atlases_of_one_process(blender, b
 
 
 @pytest.fixture(scope="module")
-def heavy(tmp_path_factory, bpy_module, addon):
+def heavy(tmp_path_factory):
     """A .blend with a dense mesh that takes Loop subdivision seconds."""
-    bpy = bpy_module
-    folder = tmp_path_factory.mktemp("heavy")
-    bpy.ops.wm.read_homefile(use_empty=True)
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=200, y_subdivisions=200)
-    bpy.ops.wm.save_as_mainfile(filepath=str(folder / "grid.blend"), copy=True)
-    bpy.ops.wm.read_homefile(use_empty=True)
-    return folder / "grid.blend"
+    return _blend(tmp_path_factory.mktemp("heavy") / "grid.blend",
+                  "bpy.ops.mesh.primitive_grid_add(x_subdivisions=200, y_subdivisions=200)")
 
 
 def test_a_stopped_task_leaves_no_file(blender, heavy, tmp_path):

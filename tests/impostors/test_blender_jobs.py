@@ -255,10 +255,13 @@ def test_a_later_card_copies_the_material_of_its_kind_with_its_own_atlas(clean_s
     first, second, unblended = (c.active_material for c in cards)
     assert first[bake.MATERIAL_KIND] == second[bake.MATERIAL_KIND] != unblended[bake.MATERIAL_KIND]
     assert _graph(first) == _graph(second) and _graph(first) != _graph(unblended)
+    seen = set()
     for card, mat in zip(cards, (first, second, unblended), strict=True):
-        name = card.name
-        used = {n.image.name for n in mat.node_tree.nodes if n.type == "TEX_IMAGE"}
-        assert used == {f"{name} colour", f"{name} normal", f"{name} depth"}, used
+        used = {n.image.name.rsplit(".", 1)[0] if n.image.name[-4:-3] == "." else n.image.name: n.image
+                for n in mat.node_tree.nodes if n.type == "TEX_IMAGE"}
+        assert sorted(used) == sorted(f"{card.name} {k}" for k in ("colour", "normal", "depth")), used
+        assert not seen & set(used.values())  # its own images, none of another card's
+        seen |= set(used.values())
     # the material built fresh (no card of its kind in the file) is the one copied
     copied = [n for n in _graph(second)[0] if "for export" not in n[1]]
     for card in cards:
