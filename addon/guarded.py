@@ -162,6 +162,15 @@ def guarded(execute):
     return wrapper
 
 
+def run_to_end(steps):
+    """Run a generator of steps (see `guarded_step`) at once: its return value."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as done:
+            return done.value
+
+
 def guarded_step(op, tx, steps):
     """One step of work spread over several calls (a modal operator's timer ticks, each short): ``next(steps)`` with
     the new blocks tracked by ``tx``, a `Transaction` kept across the steps. Returns None while steps remain, the

@@ -202,6 +202,7 @@ class RenderJob:
 
     def __init__(self, process, folder, total, log):
         self.process, self.folder, self.total, self.log = process, folder, int(total), log
+        self._read, self._partial, self._done, self._device = 0, b"", 0, ""
         _open_jobs[folder] = self
 
     def _log_bytes(self):
@@ -211,15 +212,35 @@ class RenderJob:
         except OSError:
             return b""
 
+    def _scan(self):
+        """Read what the worker wrote since the last call (whole lines) for its progress and device lines: a poll
+        costs what is new, not the whole log."""
+        try:
+            with open(self.log, "rb") as f:
+                f.seek(self._read)
+                new = f.read()
+        except OSError:
+            return
+        self._read += len(new)
+        text = self._partial + new
+        cut = text.rfind(b"\n") + 1
+        lines, self._partial = text[:cut], text[cut:]
+        done = _PROGRESS.findall(lines)
+        if done:
+            self._done = int(done[-1][0])
+        found = _DEVICE.search(lines)
+        if found and not self._device:
+            self._device = found.group(1).decode("utf-8", "replace").strip()
+
     def progress(self):
         """Steps done so far (from the worker's log; never blocks): int."""
-        done = _PROGRESS.findall(self._log_bytes())
-        return int(done[-1][0]) if done else 0
+        self._scan()
+        return self._done
 
     def device(self):
         """What the worker said it renders on, or "" before it says."""
-        found = _DEVICE.search(self._log_bytes())
-        return found.group(1).decode("utf-8", "replace").strip() if found else ""
+        self._scan()
+        return self._device
 
     def running(self):
         return self.process.poll() is None

@@ -15,8 +15,8 @@ from ..addon.impostors.bake import (
     atlas_pixels,
     check_atlas_size,
     dilated,
-    make_card,
-    packed_float_image,
+    make_card_steps,
+    packed_float_image_steps,
     read_atlas,
     start_atlas,
 )
@@ -191,15 +191,15 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
                 return done.value
 
     def _make_steps(self, context, tx, atlas, device, ob, ready=None):
-        """`_make` one step at a time (a generator: each image, the card), so that a timer tick never holds the UI
-        long; returns the operator's result."""
+        """`_make` one step at a time (a generator: each image, the parts of the card's material, the card), so that a
+        timer tick never holds the UI long; returns the operator's result."""
         atlas = ready if ready is not None else dilated(atlas, self.dilation)
         name = f"{ob.name} impostor"
         images = {}
         for key, pixels in atlas_pixels(atlas).items():
-            images[key] = tx.track(packed_float_image(f"{name} {key}", pixels))
+            images[key] = tx.track((yield from packed_float_image_steps(f"{name} {key}", pixels)))
             yield
-        card = make_card(name, atlas, images, context.scene.camera, self.blend)
+        card = yield from make_card_steps(name, atlas, images, context.scene.camera, self.blend)
         tx.track(card.data)
         tx.track(card.data.materials[0])
         tx.track(card)

@@ -18,6 +18,7 @@ from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.dilation import dilate_views
 from ...kernels.impostors.octahedral import view_directions
 from .. import bridge
+from ..guarded import run_to_end
 from ..node_groups import Graph
 from ..render_jobs import RenderJob, job_folder, remove_folder
 from .export import PROPERTY
@@ -147,12 +148,22 @@ def bake_atlas(ob, grid=8, tile=128, samples=16, hemi=False, timeout=None, dilat
 def packed_float_image(name, pixels):
     """A float image of ``pixels`` (H, W, C <= 4; the channels padded to RGBA), packed into the .blend
     (`bridge.pack_float_image`: bit for bit after save and reload)."""
+    return run_to_end(packed_float_image_steps(name, pixels))
+
+
+def packed_float_image_steps(name, pixels):
+    """`packed_float_image` as steps (a generator returning the image): the pixels, then the packing."""
     h, w, c = pixels.shape
     rgba = np.ones((h, w, 4), np.float32)
     rgba[..., :c] = pixels
     image = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
-    bridge.write_image_pixels(image, rgba)
-    bridge.pack_float_image(image)
+    try:
+        bridge.write_image_pixels(image, rgba)
+        yield
+        bridge.pack_float_image(image)
+    except BaseException:
+        bpy.data.images.remove(image)
+        raise
     return image
 
 
@@ -192,6 +203,12 @@ def card_material(name, colour_image, grid, hemi, blend=True):
     alpha; a direction at a view's own centre shows that view alone), so the card changes smoothly as it turns; off:
     the nearest view is shown (it switches at cell borders). A local card material of the same kind in the file is
     copied rather than built again."""
+    return run_to_end(card_material_steps(name, colour_image, grid, hemi, blend))
+
+
+def card_material_steps(name, colour_image, grid, hemi, blend=True):
+    """`card_material` as steps (a generator returning the material; it yields between parts of the build, each a
+    few tens of nodes, so a timer tick never holds the UI long)."""
     key = _material_key(grid, hemi, blend)
     like = next((m for m in bpy.data.materials if m.get(MATERIAL_KIND) == key and m.library is None
                  and m.node_tree is not None), None)
@@ -202,7 +219,7 @@ def card_material(name, colour_image, grid, hemi, blend=True):
             if node.type == "TEX_IMAGE" and node.label == _VIEW_LABEL:
                 node.image = colour_image
         return mat
-    mat = _build_card_material(name, colour_image, grid, hemi, blend)
+    mat = yield from _build_card_material(name, colour_image, grid, hemi, blend)
     mat[MATERIAL_KIND] = key
     return mat
 
@@ -214,8 +231,17 @@ def _build_card_material(name, colour_image, grid, hemi, blend):
     tree = mat.node_tree
     tree.nodes.clear()
     g = Graph(tree)
-    incoming = g.node("ShaderNodeNewGeometry").outputs["Incoming"]
-    u, v = octahedral_uv(g, incoming, hemi)
+    try:
+        incoming = g.node("ShaderNodeNewGeometry").outputs["Incoming"]
+        u, v = octahedral_uv(g, incoming, hemi)
+        yield
+        return (yield from _card_views(mat, g, u, v, colour_image, grid, blend))
+    except BaseException:
+        bpy.data.materials.remove(mat)  # nothing half-built is left
+        raise
+
+
+def _card_views(mat, g, u, v, colour_image, grid, blend):
     n = float(grid)
     card = g.split(g.node("ShaderNodeTexCoord").outputs["UV"])
 
@@ -245,12 +271,13 @@ def _build_card_material(name, colour_image, grid, hemi, blend):
                 term = g.vec("SCALE", tex.outputs["Color"], wa)
                 premultiplied = term if premultiplied is None else g.vec("ADD", premultiplied, term)
                 alpha = wa if alpha is None else g.math("ADD", alpha, wa)
+                yield
         colour = g.vec("SCALE", premultiplied, g.math("DIVIDE", 1.0, g.math("MAXIMUM", alpha, ALPHA_FLOOR)))
     emit = g.node("ShaderNodeEmission", [("Color", colour), ("Strength", 1.0)])
     clear = g.node("ShaderNodeBsdfTransparent")
     mix = g.node("ShaderNodeMixShader", [(0, alpha), (1, clear.outputs[0]), (2, emit.outputs[0])])
     out = g.node("ShaderNodeOutputMaterial")
-    tree.links.new(mix.outputs[0], out.inputs["Surface"])
+    g.tree.links.new(mix.outputs[0], out.inputs["Surface"])
     if hasattr(mat, "blend_method"):  # EEVEE (4.2 Legacy): let the alpha through
         try:
             mat.blend_method = "HASHED"
@@ -262,12 +289,17 @@ def _build_card_material(name, colour_image, grid, hemi, blend):
 def make_card(name, atlas, images, scene_camera, blend=True):
     """A square card as big as the bounding sphere at its centre, facing ``scene_camera`` (Track To) when there is
     one, with the atlas material (``blend``: see `card_material`): a new object (not linked)."""
+    return run_to_end(make_card_steps(name, atlas, images, scene_camera, blend))
+
+
+def make_card_steps(name, atlas, images, scene_camera, blend=True):
+    """`make_card` as steps (a generator returning the card; see `card_material_steps`)."""
+    mat = yield from card_material_steps(name, images["colour"], atlas.grid, atlas.hemi, blend)
     half = atlas.size / 2
     me = bpy.data.meshes.new(name)
     me.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
     uv = me.uv_layers.new(name="UVMap")
     uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32))
-    mat = card_material(name, images["colour"], atlas.grid, atlas.hemi, blend)
     for k, key in enumerate(("normal", "depth")):  # kept by the material (saved with it) for the exporters
         label = f"{key.title()} atlas (for export)"
         node = mat.node_tree.nodes.get(label) or mat.node_tree.nodes.new("ShaderNodeTexImage")
