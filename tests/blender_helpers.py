@@ -82,3 +82,20 @@ class UiOperator:
                 return result
             time.sleep(0.05)
         raise AssertionError("the job did not end")
+
+
+def blender_on_path(folder):
+    """A ``blender`` command in ``folder``/bin that runs `blender_cli.py` (the ``bpy`` module standing in for the
+    Blender executable these machines do not have): the environment with it first on PATH (a copy of os.environ)."""
+    import os
+    import stat
+    import sys
+    from pathlib import Path
+
+    bin_dir = Path(folder) / "bin"
+    bin_dir.mkdir(exist_ok=True)
+    shim = bin_dir / "blender"
+    cli = Path(__file__).resolve().parent / "blender_cli.py"
+    shim.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{cli}" "$@"\n')
+    shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
+    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")

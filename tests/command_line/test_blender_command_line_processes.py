@@ -12,7 +12,6 @@ machines do not have, with Blender's registry of add-on commands).
 import json
 import os
 import signal
-import stat
 import subprocess
 import sys
 import time
@@ -21,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from blender_helpers import blender_on_path
 from tessera.tools.geotiff_files import write_geotiff
 
 pytestmark = pytest.mark.blender
@@ -31,13 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def blender(built_zips, tmp_path_factory):
     """``run(*args)``: ``blender ARGS`` in a process, with Tessera installed from the built zip: CompletedProcess."""
     home = tmp_path_factory.mktemp("cli_home")
-    bin_dir = home / "bin"
-    bin_dir.mkdir()
-    shim = bin_dir / "blender"
-    shim.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{ROOT / "tests" / "blender_cli.py"}" "$@"\n')
-    shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
-    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
-               BLENDER_USER_RESOURCES=str(home / "user"))
+    env = dict(blender_on_path(home), BLENDER_USER_RESOURCES=str(home / "user"))
     env.pop("PYTHONPATH", None)
     linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
 

@@ -14,15 +14,14 @@ Then what the snippets say they make is there: the OBJ with the tessellated monk
 """
 
 import json
-import os
 import re
 import shutil
-import stat
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from blender_helpers import blender_on_path
 
 pytestmark = pytest.mark.blender
 
@@ -56,13 +55,7 @@ def test_every_readme_block_runs_as_printed(built_zips, tmp_path):
     home = tmp_path / "home"
     home.mkdir()
     shutil.copy2(linux, home / linux.name)
-    bin_dir = tmp_path / "bin"
-    bin_dir.mkdir()
-    shim = bin_dir / "blender"
-    shim.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{ROOT / "tests" / "blender_cli.py"}" "$@"\n')
-    shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
-    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
-               BLENDER_USER_RESOURCES=str(tmp_path / "user"))
+    env = dict(blender_on_path(tmp_path), BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     farm_env = dict(env, BLENDER_USER_RESOURCES=str(tmp_path / "farm_user"))
     printed = []
     for language, code in blocks:

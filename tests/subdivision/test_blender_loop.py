@@ -189,18 +189,23 @@ def _state(bpy, ob):
     return names, ob.hide_render, [o.name for o in bpy.context.selected_objects], bpy.context.active_object.name
 
 
+def _start_lit_bake(bpy, addon_module, depth, samples):
+    """The lit scene's sphere subdivided to ``depth`` and its light bake started: (object, subdivision, the file's
+    state before the start, the `BakeJob`)."""
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
+    sub = addon_module("kernels.subdivision.loop").loop_subdivide(arrays.positions, arrays.triangles, depth)
+    before = _state(bpy, ob)
+    bj = addon_module("addon.subdivision.bake").start_bake(
+        bpy.context, ob, sub.positions, sub.triangles, np.zeros(len(sub.triangles), np.int32), samples, True, 2**30)
+    return ob, sub, before, bj
+
+
 def test_the_lighting_bake_runs_in_a_worker_and_changes_nothing_of_the_users_until_it_is_read(
         clean_scene, bpy_module, addon_module):
     bpy = bpy_module
-    ob = lit_scene(bpy, addon_module("addon.compat"))
-    bake = addon_module("addon.subdivision.bake")
-    jobs = addon_module("addon.render_jobs")
-    loop = addon_module("kernels.subdivision.loop")
-    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
-    sub = loop.loop_subdivide(arrays.positions, arrays.triangles, 1)
-    before = _state(bpy, ob)
-    bj = bake.start_bake(bpy.context, ob, sub.positions, sub.triangles, np.zeros(len(sub.triangles), np.int32), 2,
-                         True, 2**30)
+    ob, sub, before, bj = _start_lit_bake(bpy, addon_module, depth=1, samples=2)
+    bake, jobs = addon_module("addon.subdivision.bake"), addon_module("addon.render_jobs")
     assert _state(bpy, ob) == before  # the copy, its materials and image went to the job's file only
     assert os.path.isdir(bj.job.folder) and bj.job.folder in jobs.open_folders()
     lines = []
@@ -214,14 +219,7 @@ def test_the_lighting_bake_runs_in_a_worker_and_changes_nothing_of_the_users_unt
 
 def test_a_cancelled_lighting_bake_leaves_nothing(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
-    ob = lit_scene(bpy, addon_module("addon.compat"))
-    bake = addon_module("addon.subdivision.bake")
-    loop = addon_module("kernels.subdivision.loop")
-    arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
-    sub = loop.loop_subdivide(arrays.positions, arrays.triangles, 2)
-    before = _state(bpy, ob)
-    bj = bake.start_bake(bpy.context, ob, sub.positions, sub.triangles, np.zeros(len(sub.triangles), np.int32), 4096,
-                         True, 2**30)
+    ob, _, before, bj = _start_lit_bake(bpy, addon_module, depth=2, samples=4096)
     bj.job.cancel()
     assert bj.job.process.poll() is not None and not os.path.exists(bj.job.folder)
     assert not addon_module("addon.render_jobs").open_folders() and _state(bpy, ob) == before
