@@ -120,4 +120,12 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    code = main(sys.argv[1:])
+    if sys.argv[1:2] in (["--command"], ["-c"]):
+        # Blender ends a command with its own exit (the command's code, no Python teardown). The bpy module of 4.2,
+        # torn down by Python, crashes after a glTF export (its file-browser panels are freed after Python: a
+        # segfault in bpy_class_free, exit 139), which Blender itself does not do: end as Blender does.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(int(code or 0))
+    sys.exit(code)
