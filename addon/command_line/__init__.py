@@ -15,7 +15,6 @@ import bpy
 
 from ...kernels.common.errors import TesseraError
 from . import files, join, plan, verbs
-from .options import settable
 
 COMMAND = "tessera"
 _handles = []
@@ -79,12 +78,10 @@ def _plan(argv):
     verb = verbs.VERBS[mine.verb]
     parser = verbs.parser_for(verb)
     args = parser.parse_args(rest)
-    props = settable(verb.operator, verbs._NOT_OPTIONS | set(verb.fixed))
+    props = verbs.operator_settings(verb)
     verbs._check_outputs(verb, args, 1)
     if verb.name == "terrain":
-        frames = verbs._frames(args.frames) if args.frames else None
-        if frames is not None and len(frames) > 1 and not files.per_frame(args.out):
-            raise verbs.Usage(f"{args.out}: several frames need {{frame}} or #### in the output name")
+        frames = verbs.terrain_frames(args)
         if args.g == "LOG" or args.t_min_rule in ("LOG2", "PRINTED"):
             print("tessera: warning: the Log roughness curve and the Log2/As Printed error rules use log2, whose last "
                   "bit can differ between processors: on a farm of mixed machines, blocks may not weld exactly "

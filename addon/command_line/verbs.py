@@ -12,11 +12,12 @@ reported), then nothing is written and the exit code is 1.
 
 import argparse
 import fnmatch
+import json
 import os
 import re
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import bpy
 
@@ -85,6 +86,19 @@ def _say(line):
     print(f"tessera: {line}", file=sys.stderr, flush=True)
 
 
+def operator_settings(verb):
+    """The settings of ``verb``'s operator a command line may set (`options.settable`)."""
+    return settable(verb.operator, _NOT_OPTIONS | set(verb.fixed))
+
+
+def terrain_frames(args):
+    """The frames of ``--frames`` (None when not given); several need a per-frame output name."""
+    frames = _frames(args.frames) if args.frames else None
+    if frames is not None and len(frames) > 1 and not files.per_frame(args.out):
+        raise Usage(f"{args.out}: several frames need {{frame}} or #### in the output name")
+    return frames
+
+
 def parser_for(verb):
     """The argparse parser of ``verb`` (a `Verb`), with its operator's settings as options."""
     p = _Parser(prog=f"blender -c tessera {verb.name}", description=verb.summary + ".", allow_abbrev=False)
@@ -109,7 +123,7 @@ def parser_for(verb):
     p.add_argument("--frame", type=int, metavar="N", help="the scene frame (for an animated camera)")
     p.add_argument("--json", nargs="?", const="-", metavar="FILE",
                    help="print a JSON summary as the last line of the output (or write it to FILE)")
-    add_options(p, settable(verb.operator, _NOT_OPTIONS | set(verb.fixed)))
+    add_options(p, operator_settings(verb))
     return p
 
 
@@ -239,8 +253,7 @@ def _write(verb, pattern, groups, summary, frame=None):
 
 
 def run_object_verb(verb, args, summary):
-    props = settable(verb.operator, _NOT_OPTIONS | set(verb.fixed))
-    kwargs = dict(chosen(args, props), **verb.fixed)
+    kwargs = dict(chosen(args, operator_settings(verb)), **verb.fixed)
     files.read_inputs(args.inputs)
     _scene_settings(args)
     sources = targets(verb, args.objects)
@@ -259,13 +272,10 @@ def run_object_verb(verb, args, summary):
 
 
 def run_terrain(verb, args, summary):
-    props = settable(verb.operator, _NOT_OPTIONS)
-    kwargs = chosen(args, props)
+    kwargs = chosen(args, operator_settings(verb))
     blends = [p for p in args.inputs if files.extension(p) == ".blend"]
     maps = [os.path.abspath(p) for p in args.inputs if files.extension(p) != ".blend"]
-    frames = _frames(args.frames) if args.frames else None
-    if frames is not None and len(frames) > 1 and not files.per_frame(args.out):
-        raise Usage(f"{args.out}: several frames need {{frame}} or #### in the output name")
+    frames = terrain_frames(args)
     _check_outputs(verb, args, 1)
     if not maps:
         raise Usage("Give a height map (PNG, TIFF/GeoTIFF, EXR, .r16/.r32/.raw)")
@@ -322,9 +332,6 @@ def run(verb_name, argv):
 def _summary_out(args, summary):
     if not args.json:
         return
-    import json
-    from dataclasses import asdict
-
     text = json.dumps(asdict(summary))
     if args.json == "-":
         print(text, flush=True)

@@ -319,10 +319,3 @@ def make_card_steps(name, atlas, images, scene_camera, blend=True):
 def atlas_pixels(atlas):
     """The pixels of the card's three images: {"colour", "normal" (0..1), "depth"} -> (H, W, C) float32."""
     return {"colour": atlas.colour, "normal": atlas.normal * 0.5 + 0.5, "depth": atlas.depth[..., None]}
-
-
-def atlas_images(name, atlas):
-    """The card's images (`packed_float_image`), named "<name> colour" and so on."""
-    return {key: packed_float_image(f"{name} {key}", pixels) for key, pixels in atlas_pixels(atlas).items()}
-
-

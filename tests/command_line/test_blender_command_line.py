@@ -197,7 +197,7 @@ def test_a_plan_has_one_task_per_object_whose_arguments_mean_the_same(cli, scene
     assert tasks[1]["outputs"] == [str(tmp_path / "out_Box__large.glb")]
     verbs = cli.verbs
     verb = verbs.VERBS["tessellate"]
-    props = cli.settable(verb.operator, verbs._NOT_OPTIONS | set(verb.fixed))
+    props = verbs.operator_settings(verb)
     for task in tasks:
         assert task["command"][:3] == ["blender", "-c", "tessera"] and task["command"][3:] == task["argv"]
         args = verbs.parser_for(verb).parse_args(task["argv"][1:])
@@ -211,7 +211,7 @@ def test_every_setting_survives_the_plans_round_trip(cli, bpy_module):
     """Each setting, set away from its default, is written into a task's command line and parsed back equal."""
     verbs, plan = cli.verbs, cli.plan
     for verb in verbs.VERBS.values():
-        props = cli.settable(verb.operator, verbs._NOT_OPTIONS | set(verb.fixed))
+        props = verbs.operator_settings(verb)
         parser = verbs.parser_for(verb)
         args = parser.parse_args(["in.blend", "-o", "out.blend"])
         for p in props:
