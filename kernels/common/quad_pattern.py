@@ -43,9 +43,7 @@ def pattern(c0, c1, c2, c3, n, m=None):
         return np.array(_zip([0] + side[0] + [1], [3] + side[2] + [2]), np.int32)
     if n == 1 and c0 == c2 == 1:
         return np.array(_zip([1] + side[1] + [2], [0] + side[3] + [3]), np.int32)
-    rows = [[0] + side[0] + [1], [1] + side[1] + [2], [2] + side[2][::-1] + [3], [3] + side[3][::-1] + [0]]
-    grid = starts[4] + np.arange((m - 1) * (n - 1)).reshape(m - 1, n - 1)  # grid[j - 1, i - 1]
-    ring = [list(grid[0, :]), list(grid[:, -1]), list(grid[-1, ::-1]), list(grid[::-1, 0])]
+    rows, ring, grid = strips(c0, c1, c2, c3, n, m)  # grid[j - 1, i - 1]
     tris = [t for s in range(4) for t in _zip(rows[s], ring[s])]
     if m > 2 and n > 2:
         a, b = grid[:-1, :-1].ravel(), grid[:-1, 1:].ravel()
@@ -68,3 +66,37 @@ def pattern_codes(c0, c1, c2, c3, n, m=None):
     if n > 1 and m > 1:
         rows += [(5, i, j) for j in range(1, m) for i in range(1, n)]
     return np.array(rows, np.float32)
+
+
+def strips(c0, c1, c2, c3, n, m=None):
+    """The four strips of a tile class whose inner counts are both above 1 (`pattern`'s general case): (rows,
+    rings, grid). For each side BOTTOM, RIGHT, TOP, LEFT, the local vertex indices of its points (corners included)
+    and of the grid's outer ring beside it, both counter-clockwise around the tile (+x, +y, -x, -y); grid: the inner
+    grid's local indices (m - 1, n - 1). `pattern` zips each pair by index; a caller that knows the points'
+    parameters may zip them by parameter instead (`zip_by_params`)."""
+    m = n if m is None else m
+    counts = (c0, c1, c2, c3)
+    starts = np.cumsum((4,) + tuple(c - 1 for c in counts))
+    side = [list(range(starts[s], starts[s] + counts[s] - 1)) for s in range(4)]
+    rows = [[0] + side[0] + [1], [1] + side[1] + [2], [2] + side[2][::-1] + [3], [3] + side[3][::-1] + [0]]
+    grid = starts[4] + np.arange((m - 1) * (n - 1)).reshape(m - 1, n - 1)
+    ring = [list(grid[0, :]), list(grid[:, -1]), list(grid[-1, ::-1]), list(grid[::-1, 0])]
+    return rows, ring, grid
+
+
+def zip_by_params(outer, inner, t_outer, t_inner):
+    """`_zip`'s strip between two rows for many tiles at once, the rows merged by their points' parameters (each
+    segment taken in the order of its midpoint's parameter, the outer row's first on a tie) rather than by index.
+    outer (p + 1,) and inner (q + 1,) local indices; t_outer (T, p + 1) and t_inner (T, q + 1) increasing
+    parameters along the rows. Returns (T, p + q, 3) local indices, counter-clockwise as `_zip`'s."""
+    outer, inner = np.asarray(outer), np.asarray(inner)
+    mo = 0.5 * (t_outer[:, :-1] + t_outer[:, 1:])
+    mi = 0.5 * (t_inner[:, :-1] + t_inner[:, 1:])
+    j_of_i = (mi[:, None, :] < mo[:, :, None]).sum(axis=2)  # inner steps taken before outer step i
+    i_of_j = (mo[:, None, :] <= mi[:, :, None]).sum(axis=2)  # outer steps taken before inner step j
+    by_outer = np.stack([np.broadcast_to(outer[:-1], j_of_i.shape), np.broadcast_to(outer[1:], j_of_i.shape),
+                         inner[j_of_i]], axis=-1)
+    by_inner = np.stack([outer[i_of_j], np.broadcast_to(inner[1:], i_of_j.shape),
+                         np.broadcast_to(inner[:-1], i_of_j.shape)], axis=-1)
+    return np.concatenate([by_outer, by_inner], axis=1)
+

@@ -12,6 +12,8 @@ from math import comb
 
 import numpy as np
 
+from . import step_spacing
+
 #: Step counts from a tolerance aim this far under it, so a deviation between the measured points stays under.
 TOLERANCE_AIM = 0.8
 
@@ -51,7 +53,7 @@ def curve_points(h, t):
     b = bernstein(t, h.shape[1] - 1)
     if b.ndim == 2:
         b = np.broadcast_to(b, (len(h),) + b.shape)
-    return np.einsum("enk,ekc->enc", b, h)
+    return np.matmul(b, h)
 
 
 def steps_for(deviation, steps, tolerance, most):
@@ -61,18 +63,24 @@ def steps_for(deviation, steps, tolerance, most):
     return np.clip(np.ceil(want), 1, most).astype(np.int64)
 
 
-def chord_deviation(control, steps):
-    """The largest distance between each rational curve and its chords at ``steps`` equal steps of its parameter,
-    measured at each chord's quarter points: control (S, k, 4) homogeneous, steps (S,) -> (S,) float64."""
+def chord_deviation(control, steps, spacing=None):
+    """The largest distance between each rational curve and its chords at ``steps`` steps of its parameter,
+    measured at each chord's quarter points: control (S, k, 4) homogeneous, steps (S,) -> (S,) float64. The steps
+    are equal, or spaced by each curve's table spacing (S, M + 1) (`kernels.common.step_spacing`)."""
     h = np.asarray(control, np.float64)[..., :4]
     lv = np.broadcast_to(np.asarray(steps, np.int64), (len(h),))
     out = np.zeros(len(h))
     frac = np.array([0.25, 0.5, 0.75])
     for n in np.unique(lv):
         es = np.flatnonzero(lv == n)
-        t = np.arange(n + 1) / n
+        if spacing is None:
+            t = np.arange(n + 1) / n
+            at = (t[:-1, None] + frac[None] / n).ravel()
+        else:
+            t = step_spacing.params(spacing[es], int(n))
+            at = (t[:, :-1, None] + frac[None, None] * np.diff(t, axis=1)[..., None]).reshape(len(es), -1)
         ends = cartesian(curve_points(h[es], t))
-        mid = cartesian(curve_points(h[es], (t[:-1, None] + frac[None] / n).ravel())).reshape(len(es), n, 3, 3)
+        mid = cartesian(curve_points(h[es], at)).reshape(len(es), n, 3, 3)
         chord = ends[:, :-1, None] + frac[None, None, :, None] * (ends[:, 1:, None] - ends[:, :-1, None])
         out[es] = np.linalg.norm(mid - chord, axis=-1).reshape(len(es), -1).max(axis=1)
     return out
@@ -92,3 +100,11 @@ def tolerance_steps(control, tolerance, most, rounds=8):
             return steps, dev
         steps = np.where(over, np.minimum(most, np.maximum(steps + 1, steps_for(dev, steps, tol, most))), steps)
     return steps, chord_deviation(h, steps)
+
+
+def curve_spacing(control):
+    """Spacing tables (S, SAMPLES + 1) (`kernels.common.step_spacing`) of rational curves with homogeneous control
+    points (S, k, 4): their steps where they bend."""
+    t = np.linspace(0.0, 1.0, 2 * step_spacing.SAMPLES + 1)
+    return step_spacing.cumulative(step_spacing.bend_density(cartesian(curve_points(control, t))))
+

@@ -34,7 +34,7 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
   tolerance.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -42,12 +42,15 @@ import numpy as np
 from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
-from ..common.quad_pattern import pattern, pattern_codes
+from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
+from ..common import step_spacing
 from ..common.rational_bezier import (
     bernstein,
     bernstein_derivative,
+    TOLERANCE_AIM,
     cartesian,
     chord_deviation,
+    curve_spacing,
     steps_for,
 )
 from . import patch_split
@@ -61,6 +64,9 @@ TOLERANCE_ROUNDS = 16
 #: triangle is largest).
 _B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
                [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+#: `fitted_inner` aims this far under the tolerance: the grids are measured again at the levels it gives, at the
+#: same points, so only the model's error needs room.
+FIT_AIM = 0.95
 #: With the tolerance, how many times patches still over it at Max Level are split and the whole made again.
 SPLIT_ROUNDS = 3
 #: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
@@ -113,6 +119,106 @@ class PatchEdges:
     reversed: np.ndarray
     collapsed: np.ndarray = None
     point: np.ndarray = None
+
+
+@dataclass
+class Spacing:
+    """Where the steps fall, for the tolerance (`kernels.common.step_spacing`): edge (E, M + 1) each shared side's
+    table in its canonical direction (from the side's own control points, so every patch on it agrees); inner
+    (P, 2, M + 1) each patch's tables along u and along v (the density the largest over 9 iso-lines)."""
+
+    edge: np.ndarray
+    inner: np.ndarray
+
+    def side_params(self, level):
+        """Each edge's parameters at its level (E,) in its canonical direction: (E, max level + 1) float64, padded
+        with 1 past each edge's end."""
+        level = np.asarray(level, np.int64)
+        out = np.ones((len(level), int(level.max()) + 1))
+        for n in np.unique(level):
+            es = np.flatnonzero(level == n)
+            out[es, :n + 1] = step_spacing.params(self.edge[es], int(n))
+        return out
+
+    def of(self, ps):
+        """The spacing of patches ps (p,) alone (their inner tables; the edges' all)."""
+        return Spacing(self.edge, self.inner[ps])
+
+    def inner_params(self, ps, axis, n):
+        """Parameters (p, n + 1) of n steps along axis (0: u, 1: v) of patches ps (p,)."""
+        return step_spacing.params(self.inner[ps, axis], int(n))
+
+
+def patch_spacing(h, edges, lines=9):
+    """`Spacing` of nets h (P, k, k, 4) and their `PatchEdges`. A direction's density is the largest of its
+    ``lines`` iso-lines' (`kernels.common.step_spacing.bend_density`), boundaries included. Patches that share a
+    side share their steps along it: the directions linked through shared sides (`direction_chains`) take the
+    largest density of the chain, each read in its own direction, and each side its chain's, so a side's points
+    are where the inner grids beside it put theirs."""
+    k, m = h.shape[1], step_spacing.SAMPLES
+    t = np.linspace(0.0, 1.0, 2 * m + 1)
+    across = np.linspace(0.0, 1.0, lines)
+    grid_u = cartesian(tensor_grid(bernstein(t, k - 1), bernstein(across, k - 1), h))  # (P, lines, 2M+1, 3)
+    grid_v = cartesian(tensor_grid(bernstein(across, k - 1), bernstein(t, k - 1), h))  # (P, 2M+1, lines, 3)
+    rho_u = step_spacing.bend_density(grid_u.reshape(-1, len(t), 3)).reshape(len(h), lines, m).max(axis=1)
+    rho_v = step_spacing.bend_density(grid_v.transpose(0, 2, 1, 3).reshape(-1, len(t), 3))
+    rho = np.stack([rho_u, rho_v.reshape(len(h), lines, m).max(axis=1)], axis=1)  # (P, 2, M)
+    chain, flip, edge_chain, edge_flip, two_way = direction_chains(edges, len(h))
+    chain_rho = np.zeros((len(two_way), m))
+    np.maximum.at(chain_rho, chain.ravel(), np.where(flip[..., None], rho[..., ::-1], rho).reshape(-1, m))
+    chain_rho[two_way] = np.maximum(chain_rho[two_way], chain_rho[two_way, ::-1])
+    inner = chain_rho[chain]
+    inner = np.where(flip[..., None], inner[..., ::-1], inner)
+    edge = chain_rho[edge_chain]
+    edge = np.where(edge_flip[:, None], edge[:, ::-1], edge)
+    return Spacing(step_spacing.cumulative(edge),
+                   step_spacing.cumulative(inner.reshape(-1, m)).reshape(len(h), 2, m + 1))
+
+
+def direction_chains(edges, count):
+    """The patches' directions linked through their shared sides (a BOTTOM or TOP side runs along u, a RIGHT or
+    LEFT one along v; a pole links nothing), by union-find with orientation. Returns chain (P, 2) int64 of each
+    patch's u and v, flip (P, 2) bool (runs against its chain), edge_chain (E,) and edge_flip (E,) of each shared
+    side in its canonical direction, two_way (C,) bool: a chain met in both orientations (a twisted loop), whose
+    steps must then read the same both ways."""
+    n_e = len(edges.control)
+    parent = list(range(2 * count + n_e))
+    parity = [False] * len(parent)
+    twisted = set()
+
+    def find(a):
+        path = []
+        while parent[a] != a:
+            path.append(a)
+            a = parent[a]
+        flip = False
+        for b in reversed(path):  # compress, keeping each node's orientation to the root
+            flip ^= parity[b]
+            parent[b], parity[b] = a, flip
+        return a
+
+    for p in range(count):
+        for side in range(4):
+            e = int(edges.edge[p, side])
+            if edges.collapsed[e]:
+                continue
+            a, b = 2 * p + side % 2, 2 * count + e
+            ra, rb = find(a), find(b)
+            want = parity[a] ^ parity[b] ^ bool(edges.reversed[p, side])
+            if ra == rb:
+                if want:
+                    twisted.add(ra)
+            else:
+                parent[rb], parity[rb] = ra, want
+                if rb in twisted:
+                    twisted.add(ra)
+    roots = [find(a) for a in range(len(parent))]
+    _, label = np.unique(roots, return_inverse=True)
+    flips = np.array(parity)
+    two_way = np.zeros(int(label.max()) + 1, bool)
+    two_way[label[[find(r) for r in twisted]]] = True
+    return (label[:2 * count].reshape(count, 2), flips[:2 * count].reshape(count, 2), label[2 * count:],
+            flips[2 * count:], two_way)
 
 
 @dataclass
@@ -180,7 +286,7 @@ def evaluate(control, u, v):
     h = homogeneous_nets(control)
     k = h.shape[1]
     w = (bernstein(u, k - 1)[..., :, None] * bernstein(v, k - 1)[..., None, :]).reshape(np.shape(u) + (k * k,))
-    p = np.einsum("pnk,pkc->pnc", w, h.reshape(len(h), k * k, 4))
+    p = np.matmul(w, h.reshape(len(h), k * k, 4))  # batched matrix products: far faster than einsum here
     return p[..., :3] / p[..., 3:]
 
 
@@ -192,9 +298,11 @@ def _point_and_normal(h, u, v):
     def at(h, u, v):
         bu, bv = bernstein(u, d), bernstein(v, d)
         du, dv = bernstein_derivative(u, d), bernstein_derivative(v, d)
-        s = np.einsum("ni,nj,nijc->nc", bu, bv, h)
-        su = np.einsum("ni,nj,nijc->nc", du, bv, h)
-        sv = np.einsum("ni,nj,nijc->nc", bu, dv, h)
+        with_bv = np.matmul(h.transpose(0, 1, 3, 2), bv[:, None, :, None])[..., 0]  # (n, k_u, c): Σ_j bv_j h_ij
+        with_dv = np.matmul(h.transpose(0, 1, 3, 2), dv[:, None, :, None])[..., 0]
+        s = np.matmul(bu[:, None], with_bv)[:, 0]
+        su = np.matmul(du[:, None], with_bv)[:, 0]
+        sv = np.matmul(bu[:, None], with_dv)[:, 0]
         w = s[:, 3:]
         p = s[:, :3] / w
         n = np.cross(su[:, :3] - p * su[:, 3:], sv[:, :3] - p * sv[:, 3:])
@@ -299,22 +407,26 @@ def _polygon_length(points):
 
 
 
-def _direction_deviation(h, steps=16, lines=9):
-    """How far each patch's iso-lines stray from their chords at ``steps`` equal steps
-    (`kernels.common.rational_bezier.chord_deviation`): along u (``lines`` lines of constant v) and along v:
-    (P, 2) float64."""
+def _direction_deviation(h, steps=16, lines=9, spacing=None):
+    """How far each patch's iso-lines stray from their chords at ``steps`` steps
+    (`kernels.common.rational_bezier.chord_deviation`; equal, or by the patches' `Spacing`): along u (``lines``
+    lines of constant v) and along v: (P, 2) float64."""
     k = h.shape[1]
     b = bernstein(np.linspace(0.0, 1.0, lines), k - 1)  # (lines, k)
     along_u = np.einsum("aj,pijc->paic", b, h)  # the iso-lines' control points (P, lines, k, 4)
     along_v = np.einsum("ai,pijc->pajc", b, h)
-    return np.stack([chord_deviation(c.reshape(-1, k, 4), steps).reshape(len(h), lines).max(axis=1)
-                     for c in (along_u, along_v)], axis=1)
+    out = []
+    for axis, c in enumerate((along_u, along_v)):
+        table = None if spacing is None else np.repeat(spacing.inner[:, axis], lines, axis=0)
+        out.append(chord_deviation(c.reshape(-1, k, 4), steps, table).reshape(len(h), lines).max(axis=1))
+    return np.stack(out, axis=1)
 
 
-def patch_levels(control, edges, lod, camera=None):
+def patch_levels(control, edges, lod, camera=None, spacing=None):
     """Levels: (edge levels (E,) int64, inner levels (P, 2) int64: steps along u and along v) in [1, max_level].
     Curvature, distance and edge length give the same inner level both ways; the tolerance gives each direction
-    its own. camera: a `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
+    its own, for steps spaced by ``spacing`` (a `Spacing`; None: equal steps). camera: a
+    `kernels.common.camera.Camera` in the patches' space, for DISTANCE and EDGE_LENGTH."""
     h = check_patches(control)
     c = cartesian(h)
     k = h.shape[1]
@@ -362,11 +474,12 @@ def patch_levels(control, edges, lod, camera=None):
         edge_level = np.maximum(edge_level, dist(d_edge))
         inner = np.maximum(inner, dist(d_in))
     if "TOLERANCE" in lod.metrics:
-        edge_level = np.maximum(edge_level, steps_for(chord_deviation(edges.control, np.full(len(ec), 16)), 16,
-                                                       lod.tolerance, lod.max_level))
+        side_dev = chord_deviation(edges.control, np.full(len(ec), 16), None if spacing is None else spacing.edge)
+        edge_level = np.maximum(edge_level, steps_for(side_dev, 16, lod.tolerance, lod.max_level))
     inner = np.stack([inner, inner], 1)
     if "TOLERANCE" in lod.metrics:  # each direction half the tolerance: a cell's diagonal strays about their sum
-        inner = np.maximum(inner, steps_for(_direction_deviation(h), 16, 0.5 * lod.tolerance, lod.max_level))
+        inner = np.maximum(inner, steps_for(_direction_deviation(h, spacing=spacing), 16, 0.5 * lod.tolerance,
+                                            lod.max_level))
     return np.minimum(edge_level, lod.max_level), np.minimum(inner, lod.max_level)
 
 
@@ -377,16 +490,73 @@ def triangle_deviation(control, mesh, which=None):
     the triangles to measure (all by default); the result is theirs."""
     h = check_patches(control)
     which = np.arange(len(mesh.triangles)) if which is None else np.asarray(which, np.int64)
-    p = mesh.positions.astype(np.float64)[mesh.triangles[which]]  # (T, 3, 3)
-    uv = mesh.corner_uv[which].astype(np.float64)
-    patch = mesh.triangle_patch[which]
-    on_mesh = np.einsum("sc,tcd->tsd", _B, p)
-    at = np.einsum("sc,tcd->tsd", _B, uv)
-    out = np.empty(len(p))
-    for chunk in np.array_split(np.arange(len(p)), max(1, len(p) // 65536)):
+    return _deviation(h, mesh.positions.astype(np.float64)[mesh.triangles[which]],
+                      mesh.corner_uv[which].astype(np.float64), mesh.triangle_patch[which])
+
+
+def _deviation(h, corners, uv, patch):
+    """`triangle_deviation` of triangles given by their corners' positions (T, 3, 3), (u, v) (T, 3, 2) and
+    patch (T,): (T,) float64."""
+    on_mesh = np.matmul(_B, corners)
+    at = np.matmul(_B, uv)
+    out = np.empty(len(corners))
+    for chunk in np.array_split(np.arange(len(corners)), max(1, len(corners) // 65536)):
         s = evaluate(h[patch[chunk]], at[chunk, :, 0], at[chunk, :, 1])
         out[chunk] = np.linalg.norm(on_mesh[chunk] - s, axis=-1).max(axis=1)
     return out
+
+
+def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which):
+    """The triangles of patches ``which`` (p,) that reach a side of their patch, as `tessellate_patches` makes
+    them (a triangle flattened at a pole dropped, its fan's corner (u, v) at the pole moved as there), without
+    making the mesh: (corners (R, 3, 3) positions, (u, v) (R, 3, 2), both rounded to float32 as the mesh stores
+    them, patch (R,) int64)."""
+    h = check_patches(control)
+    el = np.asarray(edge_levels, np.int64)
+    side_counts = el[edges.edge]
+    n_in = _pattern_counts(inner_pairs(inner_levels, len(h)), side_counts)
+    side_t = None if spacing is None else spacing.side_params(el)
+    keys = np.concatenate([side_counts, n_in], axis=1)[which]
+    classes, inverse = np.unique(keys, axis=0, return_inverse=True)
+    uvs, patches = [], []
+    for cls, key in enumerate(classes):
+        ps = np.asarray(which)[inverse.ravel() == cls]
+        key_t = tuple(int(x) for x in key)
+        tmpl = pattern(*key_t)
+        border = pattern_codes(*key_t)[:, 0] < 5
+        on_rim = border[tmpl].any(axis=1)  # the same triangles, however the strips are zipped
+        if spacing is None:
+            local = np.broadcast_to(_pattern_uv(key_t), (len(ps),) + _pattern_uv(key_t).shape)
+            own = np.broadcast_to(tmpl[on_rim], (len(ps),) + tmpl[on_rim].shape)
+        else:
+            nu, nv = key_t[4], key_t[5]
+            cells = (nu - 1) * (nv - 1) if nu > 1 and nv > 1 else 0
+            jj, ii = np.divmod(np.arange(cells), max(nu - 1, 1))
+            t_u, t_v = spacing.inner_params(ps, 0, nu), spacing.inner_params(ps, 1, nv)
+            inner = np.stack([t_u[:, ii + 1], t_v[:, jj + 1]], axis=-1)
+            local = _spaced_pattern_uv(ps, key, edges, side_t, inner)
+            own = _spaced_template(key, local)[:, on_rim]
+        uvs.append(np.take_along_axis(local, own.reshape(len(ps), -1)[..., None], axis=1).reshape(-1, 3, 2))
+        patches.append(np.repeat(ps, own.shape[1]))
+    if not uvs:
+        return np.zeros((0, 3, 3)), np.zeros((0, 3, 2)), np.zeros(0, np.int64)
+    uv, patch = np.concatenate(uvs), np.concatenate(patches)
+    collapsed = edges.collapsed[edges.edge[patch]]  # (R, 4) BOTTOM, RIGHT, TOP, LEFT
+    u, v = uv[..., 0], uv[..., 1]
+    on = np.stack([(v == 0) & collapsed[:, :1], (u == 1) & collapsed[:, 1:2], (v == 1) & collapsed[:, 2:3],
+                   (u == 0) & collapsed[:, 3:]], axis=-1)  # (R, 3 corners, 4 sides)
+    corners = evaluate(h[patch], uv[..., 0], uv[..., 1])
+    at_pole = on.any(axis=2)
+    if at_pole.any():  # the one point of the pole, as the mesh has it; two corners there: flattened, dropped
+        side = on.argmax(axis=2)
+        corners[at_pole] = edges.point[edges.edge[np.broadcast_to(patch[:, None], side.shape), side][at_pole]]
+        same = [at_pole[:, a] & at_pole[:, b] & (corners[:, a] == corners[:, b]).all(axis=1)
+                for a, b in ((0, 1), (1, 2), (0, 2))]
+        keep = ~(same[0] | same[1] | same[2])
+        corners, uv, patch = corners[keep], uv[keep], patch[keep]
+        uv = _pole_corners(uv, edges.collapsed[edges.edge[patch]])
+    as_stored = np.float32
+    return corners.astype(as_stored).astype(np.float64), uv.astype(as_stored).astype(np.float64), patch
 
 
 def inner_pairs(inner_levels, count):
@@ -398,12 +568,13 @@ def inner_pairs(inner_levels, count):
     return np.maximum(n, 1)
 
 
-def grid_deviation(control, inner_levels):
+def grid_deviation(control, inner_levels, spacing=None, points=_B):
     """The largest distance between the surface and the triangles of each patch's inner grid (the cells between
-    its inner points (i / n, j / m), each cut along its (i, j)-(i+1, j+1) diagonal as the pattern cuts it), measured
-    at `_B` in every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels).
-    Returns (P, 3) float64: the largest distance anywhere, at the cells' sides along u, and along v (0 for a patch
-    with fewer than 2 cells a way)."""
+    its inner points (i / n, j / m), or where ``spacing`` (a `Spacing`) puts them, each cut along its
+    (i, j)-(i+1, j+1) diagonal as the pattern cuts it), measured at `_B` (or the barycentric ``points`` given) in
+    every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels). Returns (P, 3)
+    float64: the largest distance anywhere, at the cells' sides along u, and along v (0 for a patch with fewer than
+    2 cells a way)."""
     h = check_patches(control)
     n_in = inner_pairs(inner_levels, len(h))
     d = h.shape[1] - 1
@@ -418,26 +589,99 @@ def grid_deviation(control, inner_levels):
         # the cells' corners (the inner grid) and each sample point of every cell, by offsets a in each
         # direction: the v basis contracted once per distinct a along v, then the u basis per sample
         cu, cv = np.arange(1, nu - 1), np.arange(1, nv - 1)
-        corners = cartesian(tensor_grid(bernstein(np.arange(1, nu) / nu, d), bernstein(np.arange(1, nv) / nv, d),
-                                        h[ps]))  # (p, nv - 1, nu - 1, 3)
+        if spacing is None:
+            tu, tv = (np.arange(nu + 1) / nu)[None], (np.arange(nv + 1) / nv)[None]
+
+            def at(t, c, a, n):
+                return (c + a) / n
+        else:
+            tu, tv = spacing.inner_params(ps, 0, nu), spacing.inner_params(ps, 1, nv)
+
+            def at(t, c, a, n):
+                return t[:, c] + a * (t[:, c + 1] - t[:, c])
+        g = _grid_at(h[ps], tu[:, 1:-1], tv[:, 1:-1])
+        corners = g[:, :3] / g[:, 3:]  # (p, 3, nv - 1, nu - 1)
+        # every sample's offsets in its cell are sixths: the bases at each, computed together
+        sixths = np.arange(7) / 6
+        b_u = bernstein(np.stack([at(tu, cu, a, nu) for a in sixths]), d)  # (7, [p,] U, k)
+        b_v = bernstein(np.stack([at(tv, cv, a, nv) for a in sixths]), d)
         along_v = {}
         for offs in tri_offsets:
-            corner = [corners[:, int(dv):int(dv) + nv - 2, int(du):int(du) + nu - 2] for du, dv in offs]
-            for bary in _B:
-                lin = sum(w * c for w, c in zip(bary, corner, strict=True))
+            c0, c1, c2 = (corners[:, :, int(dv):int(dv) + nv - 2, int(du):int(du) + nu - 2] for du, dv in offs)
+            c1, c2 = c1 - c0, c2 - c0
+            for bary in points:
+                iu, iv = (round(float(x) * 6) for x in bary @ offs)
+                if iv not in along_v:
+                    along_v[iv] = _contract_v_basis(h[ps], b_v[iv])
+                on = _contract_u_basis(along_v[iv], b_u[iu])  # (p, 4, V, U) homogeneous
+                gap = on[:, :3] / on[:, 3:] - c0
+                gap -= bary[1] * c1
+                gap -= bary[2] * c2
+                gap *= gap
+                dev = np.sqrt((gap[:, 0] + gap[:, 1] + gap[:, 2]).reshape(len(ps), -1).max(axis=1))
                 a = bary @ offs
-                key = round(float(a[1]) * 6)
-                if key not in along_v:
-                    along_v[key] = np.tensordot(h[ps], bernstein((cv + a[1]) / nv, d), axes=([2], [1]))
-                on = np.tensordot(along_v[key], bernstein((cu + a[0]) / nu, d), axes=([1], [1]))  # (p, c, V, U)
-                on = cartesian(on.transpose(0, 2, 3, 1))
-                dev = np.linalg.norm(on - lin, axis=-1).reshape(len(ps), -1).max(axis=1)
                 out[ps, 0] = np.maximum(out[ps, 0], dev)
                 if a[1] in (0.0, 1.0):  # on a side of the cell along u
                     out[ps, 1] = np.maximum(out[ps, 1], dev)
                 elif a[0] in (0.0, 1.0):  # along v
                     out[ps, 2] = np.maximum(out[ps, 2], dev)
     return out
+
+
+def _contract_v(h, tv):
+    """Nets h (p, k, k, c) contracted with the v basis at tv (V,) shared, or (p, V) per net: (p, c, k, V), each
+    coordinate a plane (what numpy's element-wise steps run fastest on)."""
+    return _contract_v_basis(h, bernstein(tv, h.shape[1] - 1))
+
+
+def _contract_u(along_v, tu):
+    """`_contract_v`'s (p, c, k, V) contracted with the u basis at tu (U,) shared, or (p, U) per net: points
+    (p, c, V, U), each coordinate a plane."""
+    return _contract_u_basis(along_v, bernstein(tu, along_v.shape[2] - 1))
+
+
+def _contract_v_basis(h, b):
+    """`_contract_v` with given basis values b (V, k) shared or (p, V, k) per net (a derivative's too)."""
+    bt = np.swapaxes(b, -1, -2)  # (k, V) or (p, k, V)
+    return np.matmul(h.transpose(0, 3, 1, 2), bt if bt.ndim == 2 else bt[:, None])
+
+
+def _contract_u_basis(along_v, b):
+    """`_contract_u` with given basis values b (U, k) shared or (p, U, k) per net."""
+    bt = np.swapaxes(b, -1, -2)
+    return np.matmul(np.swapaxes(along_v, -1, -2), bt if bt.ndim == 2 else bt[:, None])
+
+
+def _grid_at(h, tu, tv):
+    """Homogeneous points (p, c, V, U) (coordinate planes) of nets h (p, k, k, c) at tu (1 or p, U) along u and
+    tv (1 or p, V)."""
+    return _contract_u(_contract_v(h, tv[0] if len(tv) == 1 else tv), tu[0] if len(tu) == 1 else tu)
+
+
+def fitted_inner(grid_dev, inner_levels, tolerance, most):
+    """Inner steps (P, 2) int64 in [1, most] from the inner grids' deviations measured at inner_levels (P, 2)
+    (`grid_deviation`: anywhere, at the cells' sides along u, along v). Each patch's grid is modelled as straying
+    A / n² + B / m² + C / nm at n steps along u and m along v (A and B from the cells' sides, C what their diagonals
+    add); the fewest cells n m within the aimed tolerance take n / m = √(A / B), n m = (2√(AB) + C) / T. A patch whose
+    grid was not measured (fewer than 3 steps a way) keeps its levels."""
+    g = np.asarray(grid_dev, np.float64)
+    n = np.asarray(inner_levels, np.float64)
+    aim = FIT_AIM * tolerance
+    a, b = g[:, 1] * n[:, 0] ** 2, g[:, 2] * n[:, 1] ** 2
+    c = np.maximum(g[:, 0] - g[:, 1] - g[:, 2], 0.0) * n[:, 0] * n[:, 1]
+    small = 1e-3 * (a + b + c)
+    a, b = np.maximum(a, small), np.maximum(b, small)
+    measured = (n >= 3).all(axis=1) & (a + b + c > 0)
+    ratio = np.sqrt(np.divide(a, b, out=np.ones_like(a), where=b > 0))
+    m = np.sqrt(np.divide(a / ratio ** 2 + b + c / ratio, aim))
+    u = np.clip(np.ceil(ratio * m), 1, most)
+    # with u fixed (at Max Level, or rounded up): the fewest steps along v, B x² + (C / u) x + A / u² - T <= 0 in
+    # x = 1 / v
+    lin, rest = c / u, a / u ** 2 - aim
+    x = np.divide(-lin + np.sqrt(np.maximum(lin ** 2 - 4 * b * rest, 0.0)), 2 * b, out=np.zeros_like(b), where=b > 0)
+    v = np.where((rest < 0) & (x > 0), np.ceil(np.divide(1.0, x, out=np.full_like(x, most), where=x > 0)), most)
+    fit = np.stack([u, np.clip(v, 1, most)], axis=1).astype(np.int64)
+    return np.where(measured[:, None], fit, np.asarray(inner_levels, np.int64))
 
 
 def _sides_keep_up(edge_levels, inner, edges):
@@ -489,69 +733,115 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
 def _tessellate_once(h, lod, camera, budget_bytes):
     """`tessellate` without splitting: a `Tessellation` of these patches (parent and box left to the caller)."""
     edges = patch_edges(h)
-    el, inner = patch_levels(h, edges, lod, camera)
-    if "TOLERANCE" in lod.metrics:  # a side as fine as the patches beside it: no stretched triangles along it
+    spacing = patch_spacing(h, edges) if "TOLERANCE" in lod.metrics else None
+    el, inner = patch_levels(h, edges, lod, camera, spacing)
+    if "TOLERANCE" in lod.metrics:
+        # the inner grids fitted to their measured deviation, before any mesh is made; then a side as fine as the
+        # patches beside it: no stretched triangles along it
+        others = tuple(m for m in lod.metrics if m != "TOLERANCE")
+        floor = patch_levels(h, edges, replace(lod, metrics=others), camera)[1] if others else 1
+        first = grid_deviation(h, inner, spacing, points=_B[:4])  # a model needs only the sides' and centroids'
+        inner = np.maximum(floor, fitted_inner(first, inner, lod.tolerance, lod.max_level))
         el = _sides_keep_up(el, inner, edges)
     lower = "a lower Max Level or a larger Tolerance" if "TOLERANCE" in lod.metrics else "a lower Max Level"
+    if "TOLERANCE" in lod.metrics:
+        el, inner, dev = _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower)
     check_budget(estimate(el, inner), budget_bytes, lower)
-    mesh = tessellate_patches(h, el, inner, edges)
+    mesh = tessellate_patches(h, el, inner, edges, spacing)
     if "TOLERANCE" not in lod.metrics:
         return Tessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
+    return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > lod.tolerance))
+
+
+def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower):
+    """Levels raised until every triangle is within the tolerance, measured before any mesh is made: the inner
+    grids by tensor products (`grid_deviation`), the triangles along the patches' sides one by one
+    (`rim_triangles`), each side's chords; each round measures again only the patches and sides whose levels
+    changed. Returns (edge levels (E,), inner levels (P, 2), deviation (P,) measured at them)."""
     tol, top = lod.tolerance, lod.max_level
-    for _round in range(TOLERANCE_ROUNDS):
-        side_dev = chord_deviation(edges.control, el)
-        # the inner grids by tensor products; the triangles that reach a side of their patch one by one
-        grid_dev = grid_deviation(h, inner)
-        cuv = mesh.corner_uv
-        rim = np.flatnonzero(((cuv == 0) | (cuv == 1)).any(axis=(1, 2)))
-        rim_dev = triangle_deviation(h, mesh, rim)
+    grid_dev = np.zeros((len(h), 3))
+    side_dev = np.zeros(len(el))
+    rim = [np.zeros((0, 3, 2)), np.zeros(0, np.int64), np.zeros(0)]  # (u, v), patch, deviation
+
+    def measure(el, inner, changed, changed_sides):
+        """Measure again what changed; the deviation of each patch (P,)."""
+        ps = np.flatnonzero(changed)
+        if len(ps):
+            grid_dev[ps] = grid_deviation(h[ps], inner[ps], None if spacing is None else spacing.of(ps))
+            corners, uv, patch = rim_triangles(h, el, inner, edges, spacing, ps)
+            keep = ~changed[rim[1]]
+            rim[:] = (np.concatenate([rim[0][keep], uv]), np.concatenate([rim[1][keep], patch]),
+                      np.concatenate([rim[2][keep], _deviation(h, corners, uv, patch)]))
+        es = np.flatnonzero(changed_sides)
+        side_dev[es] = chord_deviation(edges.control[es], el[es], None if spacing is None else spacing.edge[es])
         dev = grid_dev[:, 0].copy()
-        np.maximum.at(dev, mesh.triangle_patch[rim], rim_dev)
+        np.maximum.at(dev, rim[1], rim[2])
+        return dev
+
+    changed, changed_sides = np.ones(len(h), bool), np.ones(len(el), bool)
+    for _round in range(TOLERANCE_ROUNDS):
+        check_budget(estimate(el, inner), budget_bytes, lower)
+        dev = measure(el, inner, changed, changed_sides)
+        rim_uv, rim_patch, rim_dev = rim
         # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
-        # inside has along it raises that side (its long edge lies along it); any other raises the patch's steps
-        over = rim[rim_dev > tol]
-        uv, tp, td = mesh.corner_uv[over], mesh.triangle_patch[over], rim_dev[rim_dev > tol]
+        # inside has along it raises that side (its long edge lies along it)
+        over = rim_dev > tol
+        uv, tp, td = rim_uv[over], rim_patch[over], rim_dev[over]
         on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
                             (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
         side_need = side_dev.copy()
         side_need[edges.collapsed] = 0.0  # a pole has no length to split
-        coarse_side = np.zeros(len(over), bool)
+        # a triangle over the tolerance along a side with more segments than the inside has along it (a finer
+        # patch beside it): the inside takes the side's count that way, so the strip between them is regular
+        coarse_side, fine_side = np.zeros(len(tp), bool), np.zeros(len(tp), bool)
+        new_inner = inner.copy()
         for side in range(4):
             e = edges.edge[tp, side]
-            use = on_side[:, side] & (el[e] < inner[tp, side % 2]) & ~edges.collapsed[e]
+            along = inner[tp, side % 2]
+            use = on_side[:, side] & (el[e] < along) & ~edges.collapsed[e]
             np.maximum.at(side_need, e[use], td[use])
+            finer = on_side[:, side] & (el[e] > along) & ~edges.collapsed[e] & ~use
+            np.maximum.at(new_inner[:, side % 2], tp[finer], el[e[finer]])
             coarse_side |= use
+            fine_side |= finer
         new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, top)), el)
-        # a grid over the tolerance: each direction by its own cells' sides (half the tolerance each), at least
-        # one step more; a triangle along a side: both directions
+        # a grid over the tolerance: refitted (`fitted_inner`), at least one step more; any other triangle along
+        # a side: both directions
         rim_need = np.zeros(len(h))
-        np.maximum.at(rim_need, tp[~coarse_side], td[~coarse_side])
-        new_inner = inner.copy()
+        other = ~coarse_side & ~fine_side
+        np.maximum.at(rim_need, tp[other], td[other])
         grid_over = grid_dev[:, 0] > tol
-        for axis in (0, 1):
-            want = steps_for(np.maximum(grid_dev[:, 1 + axis], 0.25 * grid_dev[:, 0]), inner[:, axis], 0.5 * tol,
-                             top)
-            new_inner[:, axis] = np.where(grid_over, np.maximum(inner[:, axis], want), new_inner[:, axis])
+        refit = np.maximum(new_inner, fitted_inner(grid_dev, inner, tol, top))
+        new_inner[grid_over] = refit[grid_over]
         stuck = grid_over & (new_inner == inner).all(axis=1)
         new_inner[stuck] += 1
-        rim_over = rim_need > tol
-        new_inner[rim_over] = np.maximum(new_inner[rim_over], np.maximum(
-            inner[rim_over] + 1, steps_for(rim_need[rim_over, None], inner[rim_over], tol, top)))
+        # a triangle along a side over it: the grid's model scaled up to what was measured there, refitted (the
+        # directions keep the grid's best ratio), at least one step more the way that strays most
+        rim_over = np.flatnonzero(rim_need > tol)
+        if len(rim_over):
+            scaled = grid_dev[rim_over] * (rim_need[rim_over] / np.maximum(grid_dev[rim_over, 0], 1e-300))[:, None]
+            unmeasured = grid_dev[rim_over, 0] <= 0
+            scaled[unmeasured] = rim_need[rim_over][unmeasured, None] * [1.0, 0.5, 0.5]
+            want = np.maximum(new_inner[rim_over], fitted_inner(scaled, inner[rim_over], tol, top))
+            same = (want <= inner[rim_over]).all(axis=1)
+            axis = (scaled[:, 2] > scaled[:, 1]).astype(np.int64)
+            want[same, axis[same]] = inner[rim_over][same, axis[same]] + 1
+            new_inner[rim_over] = want
         new_inner = np.minimum(new_inner, top)
         new_el = np.minimum(_sides_keep_up(new_el, new_inner, edges), top)
-        if np.array_equal(new_el, el) and np.array_equal(new_inner, inner):
-            break
+        changed_sides = new_el != el
+        changed = (new_inner != inner).any(axis=1) | changed_sides[edges.edge].any(axis=1)
+        if not changed.any():
+            return el, inner, dev
         el, inner = new_el, new_inner
-        check_budget(estimate(el, inner), budget_bytes, lower)
-        mesh = tessellate_patches(h, el, inner, edges)
-    else:
-        dev = grid_deviation(h, inner)[:, 0]
-        np.maximum.at(dev, mesh.triangle_patch, triangle_deviation(h, mesh))
-    return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > tol))
+    check_budget(estimate(el, inner), budget_bytes, lower)
+    return el, inner, measure(el, inner, changed, changed_sides)
 
 
-def tessellate_patches(control, edge_levels, inner_levels, edges=None):
-    """The welded triangle mesh of the patches at these levels: a `PatchMesh`."""
+def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=None):
+    """The welded triangle mesh of the patches at these levels: a `PatchMesh`; equal steps, or steps where
+    ``spacing`` (a `Spacing`) puts them (then each strip between a side and the inner grid is zipped by the points'
+    parameters)."""
     h = check_patches(control)
     edges = edges if edges is not None and edges.collapsed is not None else patch_edges(h)
     k = h.shape[1]
@@ -571,9 +861,10 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     e_first = np.concatenate([[0], np.cumsum(counts)])[:-1]
     e_of = np.repeat(np.arange(len(el)), counts)
     kk = np.arange(len(e_of)) - e_first[e_of] + 1
-    t = kk / el[e_of]
+    side_t = None if spacing is None else spacing.side_params(el)  # (E, max level + 1)
+    t = kk / el[e_of] if spacing is None else side_t[e_of, kk]
     b = bernstein(t, deg)
-    edge_pts = cartesian(np.einsum("nk,nkc->nc", b, edges.control[e_of]))
+    edge_pts = cartesian(np.matmul(b[:, None], edges.control[e_of])[:, 0])
     edge_pts[edges.collapsed[e_of]] = edges.point[e_of[edges.collapsed[e_of]]]  # exactly the one point
     # each edge's (patch, uv) for the vertex record: the first patch side that uses it
     sides = np.arange(n_p * 4)
@@ -584,13 +875,8 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     tl = np.where(fr[e_of], 1.0 - t, t)
     side_uv = np.stack([np.select([fs[e_of] == 1, fs[e_of] == 3], [1.0, 0.0], tl),
                         np.select([fs[e_of] == 0, fs[e_of] == 2], [0.0, 1.0], tl)], 1)
-    n_in = inner_pairs(inner_levels, n_p)  # (P, 2): steps along u and along v
     side_counts = el[edges.edge]  # (P, 4)
-    one = side_counts == 1
-    # as terrain tiles: one step along u is a strip between the left and right sides when the bottom and top are
-    # one segment each (and along v likewise); else at least 2
-    n_in = np.stack([np.where((n_in[:, 0] == 1) & ~(one[:, 0] & one[:, 2]), 2, n_in[:, 0]),
-                     np.where((n_in[:, 1] == 1) & ~(one[:, 1] & one[:, 3]), 2, n_in[:, 1])], 1)
+    n_in = _pattern_counts(inner_pairs(inner_levels, n_p), side_counts)  # (P, 2): steps along u and along v
     mu, mv = n_in[:, 0] - 1, n_in[:, 1] - 1
     count = mu * mv
     in_first = np.concatenate([[0], np.cumsum(count)])[:-1]
@@ -603,19 +889,31 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
         ps = np.flatnonzero((pair_of.ravel() == q) & (count > 0))
         if len(ps) == 0:
             continue
-        t_u, t_v = np.arange(1, nu) / nu, np.arange(1, nv) / nv
-        b_u, b_v = bernstein(t_u, deg), bernstein(t_v, deg)
-        d_u, d_v = bernstein_derivative(t_u, deg), bernstein_derivative(t_v, deg)
-        grid = tensor_grid(b_u, b_v, h[ps]).reshape(len(ps), -1, 4)
-        g_u = tensor_grid(d_u, b_v, h[ps]).reshape(len(ps), -1, 4)
-        g_v = tensor_grid(b_u, d_v, h[ps]).reshape(len(ps), -1, 4)
+        if spacing is None:
+            t_u, t_v = np.arange(1, nu) / nu, np.arange(1, nv) / nv
+            b_u, b_v = bernstein(t_u, deg), bernstein(t_v, deg)
+            d_u, d_v = bernstein_derivative(t_u, deg), bernstein_derivative(t_v, deg)
+            grid = tensor_grid(b_u, b_v, h[ps]).reshape(len(ps), -1, 4)
+            g_u = tensor_grid(d_u, b_v, h[ps]).reshape(len(ps), -1, 4)
+            g_v = tensor_grid(b_u, d_v, h[ps]).reshape(len(ps), -1, 4)
+            t_u, t_v = t_u[None], t_v[None]
+        else:
+            t_u, t_v = spacing.inner_params(ps, 0, nu)[:, 1:-1], spacing.inner_params(ps, 1, nv)[:, 1:-1]
+            along_v, along_dv = _contract_v(h[ps], t_v), _contract_v_basis(h[ps], bernstein_derivative(t_v, deg))
+
+            def points(planes):
+                return planes.transpose(0, 2, 3, 1).reshape(len(ps), -1, 4)
+
+            grid = points(_contract_u(along_v, t_u))
+            g_u = points(_contract_u_basis(along_v, bernstein_derivative(t_u, deg)))
+            g_v = points(_contract_u(along_dv, t_u))
         rows = in_first[ps][:, None] + np.arange((nu - 1) * (nv - 1))[None]
         pts = cartesian(grid)
         inner_pts[rows] = pts
         w = grid[..., 3:]
         inner_nrm[rows] = np.cross(g_u[..., :3] - pts * g_u[..., 3:], g_v[..., :3] - pts * g_v[..., 3:]) / (w * w)
         jj, ii = np.divmod(np.arange((nu - 1) * (nv - 1)), nu - 1)
-        inner_uv[rows] = np.stack([t_u[ii], t_v[jj]], 1)[None]
+        inner_uv[rows] = np.stack(np.broadcast_arrays(t_u[:, ii], t_v[:, jj]), -1)
 
     n_c = 4 * n_p
     base_e, base_i = n_c, n_c + len(edge_pts)
@@ -637,10 +935,16 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
         cells = (int(key[4]) - 1) * (int(key[5]) - 1) if key[4] > 1 and key[5] > 1 else 0
         cols.append(base_i + in_first[ps][:, None] + np.arange(cells)[None])
         lmap = np.concatenate(cols, 1)
-        tris.append(lmap[:, tmpl].reshape(-1, 3))
         tri_patch.append(np.repeat(ps, len(tmpl)))
-        local_uv = _pattern_uv(tuple(int(x) for x in key))
-        tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
+        if spacing is None:
+            tris.append(lmap[:, tmpl].reshape(-1, 3))
+            local_uv = _pattern_uv(tuple(int(x) for x in key))
+            tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
+        else:
+            local_uv = _spaced_pattern_uv(ps, key, edges, side_t, inner_uv[cols[-1] - base_i])
+            own = _spaced_template(key, local_uv).reshape(len(ps), -1)  # (p, 3T)
+            tris.append(np.take_along_axis(lmap, own, axis=1).reshape(-1, 3))
+            tri_uv.append(np.take_along_axis(local_uv, own[..., None], axis=1).reshape(-1, 3, 2))
     tris, tri_patch, tri_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(tri_uv)
     # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
     # of corners and side points (inner points are never merged)
@@ -650,8 +954,10 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     tris = remap[tris]
     keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
     tris, tri_patch, tri_uv = tris[keep], tri_patch[keep], tri_uv[keep]
-    if edges.collapsed.any():
-        tri_uv = _pole_corners(tri_uv, edges.collapsed[edges.edge[tri_patch]])
+    if edges.collapsed.any():  # only the triangles with a corner on a pole move
+        near = np.flatnonzero(edges.collapsed[edges.edge].any(axis=1)[tri_patch]
+                              & (((tri_uv == 0) | (tri_uv == 1)).any(axis=(1, 2))))
+        tri_uv[near] = _pole_corners(tri_uv[near], edges.collapsed[edges.edge[tri_patch[near]]])
     used = np.zeros(len(positions), bool)
     used[tris.ravel()] = True
     new_id = np.cumsum(used) - 1
@@ -663,15 +969,61 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None):
     if len(weak):
         inner_nrm[weak] = _point_and_normal(h[p_of[weak]], inner_uv[weak, 0], inner_uv[weak, 1])[1]
         length[weak] = 1.0
+    summed = np.zeros_like(normals)  # inner points are never merged: only the shared ones are summed
+    np.add.at(summed, remap[:shared], normals)
+    length_s = np.linalg.norm(summed, axis=1, keepdims=True)
+    normals = np.where(length_s > 0, summed / np.where(length_s > 0, length_s, 1.0), normals)
     normals = np.concatenate([normals, inner_nrm / np.where(length > 0, length, 1.0)[:, None]])
-    summed = np.zeros_like(normals)
-    np.add.at(summed, remap, normals)
-    length = np.linalg.norm(summed, axis=1, keepdims=True)
-    normals = np.where(length > 0, summed / np.where(length > 0, length, 1.0), normals)
     # Blender's orientation: the pattern's counter-clockwise (u, v) triangles reversed, the normals along dS/dv x dS/du
     return PatchMesh(positions[used].astype(np.float32), new_id[tris[:, ::-1]].astype(np.int32),
                      uv[used].astype(np.float32), patch[used], tri_patch, tri_uv[:, ::-1].astype(np.float32),
                      -normals[used].astype(np.float32))
+
+
+def _spaced_template(key, local_uv):
+    """Each patch's triangles (p, T, 3) in local indices for the pattern of class key whose points lie at
+    local_uv (p, L, 2) (spaced steps): the inner cells as `pattern` makes them, each strip zipped by the points'
+    parameters (`kernels.common.quad_pattern.zip_by_params`), so a side finer than the grid beside it meets it
+    without skew."""
+    key_t = tuple(int(x) for x in key)
+    tmpl = pattern(*key_t)
+    if key_t[4] < 2 or key_t[5] < 2:  # a strip tile: no ring to meet
+        return np.broadcast_to(tmpl, (len(local_uv),) + tmpl.shape)
+    rows, ring, _ = strips(*key_t)
+    parts, n_strip = [], 0
+    for side in range(4):
+        t_row, t_ring = local_uv[:, rows[side], side % 2], local_uv[:, ring[side], side % 2]
+        if side >= 2:  # TOP and LEFT run against u and v
+            t_row, t_ring = 1.0 - t_row, 1.0 - t_ring
+        parts.append(zip_by_params(rows[side], ring[side], t_row, t_ring))
+        n_strip += len(rows[side]) + len(ring[side]) - 2
+    parts.append(np.broadcast_to(tmpl[n_strip:], (len(local_uv),) + tmpl[n_strip:].shape))
+    return np.concatenate(parts, axis=1)
+
+
+def _pattern_counts(n_in, side_counts):
+    """The inner steps (P, 2) the pattern is made with: as terrain tiles, one step along u is a strip between the
+    left and right sides when the bottom and top are one segment each (and along v likewise); else at least 2."""
+    one = side_counts == 1
+    return np.stack([np.where((n_in[:, 0] == 1) & ~(one[:, 0] & one[:, 2]), 2, n_in[:, 0]),
+                     np.where((n_in[:, 1] == 1) & ~(one[:, 1] & one[:, 3]), 2, n_in[:, 1])], 1)
+
+
+def _spaced_pattern_uv(ps, key, edges, side_t, inner):
+    """(u, v) (p, L, 2) of each local vertex of the pattern of class key for patches ps (p,) whose steps are
+    spaced: corners, each side's points at its edge's parameters (side_t (E, ·), canonical direction) read in the
+    patch's direction, and the inner points' (u, v) inner (p, (n - 1)(m - 1), 2)."""
+    parts = [np.broadcast_to(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64), (len(ps), 4, 2))]
+    for side in range(4):
+        c = int(key[side])
+        e, r = edges.edge[ps, side], edges.reversed[ps, side]
+        q = np.arange(1, c)[None]
+        t = side_t[e[:, None], np.where(r[:, None], c - q, q)]
+        t = np.where(r[:, None], 1.0 - t, t)
+        fixed = np.full_like(t, 1.0 if side in (1, 2) else 0.0)
+        parts.append(np.stack([t, fixed] if side in (0, 2) else [fixed, t], axis=-1))
+    parts.append(inner)
+    return np.concatenate(parts, axis=1)
 
 
 def _pole_corners(tri_uv, collapsed):
