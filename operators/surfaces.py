@@ -317,8 +317,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
             patch_set = nurbs.patches_of([s for _, s in surfaces], [k for k, _ in surfaces])
             result = bp.tessellate(patch_set.patches, lod, cam, budget)
             mesh = result.mesh
-            corner_uv = patch_set.uv(result.parent[mesh.triangle_patch][:, None], result.patch_uv())
-            corner_uv = corner_uv.astype(np.float32)
+            corner_uv = result.patch_uv(patch_set.box)  # each spline's own (u, v)
             arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles, point_normals=mesh.normals,
                                 corner_attributes={"UVMap": corner_uv}, attribute_types={"UVMap": "FLOAT2"})
             words.append(f"{len(patch_set.patches):,} patches in {len(result.parent):,} parts, sides "

@@ -256,10 +256,19 @@ class Tessellation:
     parent: np.ndarray = None
     box: np.ndarray = None
 
-    def patch_uv(self):
-        """Each triangle's corners' (u, v) in its patch (not its part): (T, 3, 2) float64."""
-        b = self.box[self.mesh.triangle_patch][:, None]
-        return b[..., 0] + self.mesh.corner_uv.astype(np.float64) * (b[..., 1] - b[..., 0])
+    def patch_uv(self, outer=None):
+        """Each triangle's corners' (u, v) in its patch (not its part): (T, 3, 2) float64. outer (P, 2, 2): each
+        patch's ((u0, u1), (v0, v1)) in something larger (its spline: `kernels.common.nurbs.PatchSet.box`): the
+        corners' (u, v) there instead, (T, 3, 2) float32, each part's two boxes composed first."""
+        lo, size = self.box[:, :, 0], self.box[:, :, 1] - self.box[:, :, 0]
+        if outer is None:
+            b = self.box[self.mesh.triangle_patch][:, None]
+            return b[..., 0] + self.mesh.corner_uv.astype(np.float64) * (b[..., 1] - b[..., 0])
+        o = np.asarray(outer, np.float64)[self.parent]
+        o_lo, o_size = o[:, :, 0], o[:, :, 1] - o[:, :, 0]
+        lo, size = o_lo + lo * o_size, size * o_size  # (P', 2): one affine map a part
+        tp = self.mesh.triangle_patch
+        return lo[tp].astype(np.float32)[:, None] + self.mesh.corner_uv * size[tp].astype(np.float32)[:, None]
 
 
 
@@ -535,7 +544,7 @@ def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which):
             t_u, t_v = spacing.inner_params(ps, 0, nu), spacing.inner_params(ps, 1, nv)
             inner = np.stack([t_u[:, ii + 1], t_v[:, jj + 1]], axis=-1)
             local = _spaced_pattern_uv(ps, key, edges, side_t, inner)
-            own = _spaced_template(key, local)[:, on_rim]
+            own = _spaced_template(key, local)[0]  # the strips: the triangles along the sides
         uvs.append(np.take_along_axis(local, own.reshape(len(ps), -1)[..., None], axis=1).reshape(-1, 3, 2))
         patches.append(np.repeat(ps, own.shape[1]))
     if not uvs:
@@ -942,9 +951,13 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
             tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
         else:
             local_uv = _spaced_pattern_uv(ps, key, edges, side_t, inner_uv[cols[-1] - base_i])
-            own = _spaced_template(key, local_uv).reshape(len(ps), -1)  # (p, 3T)
-            tris.append(np.take_along_axis(lmap, own, axis=1).reshape(-1, 3))
-            tri_uv.append(np.take_along_axis(local_uv, own[..., None], axis=1).reshape(-1, 3, 2))
+            strip, cells = _spaced_template(key, local_uv)
+            own = strip.reshape(len(ps), -1)  # (p, 3S)
+            tris.append(np.concatenate([np.take_along_axis(lmap, own, axis=1).reshape(len(ps), -1, 3),
+                                        lmap[:, cells]], axis=1).reshape(-1, 3))
+            tri_uv.append(np.concatenate([
+                np.take_along_axis(local_uv, own[..., None], axis=1).reshape(len(ps), -1, 3, 2),
+                local_uv[:, cells]], axis=1).reshape(-1, 3, 2))
     tris, tri_patch, tri_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(tri_uv)
     # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
     # of corners and side points (inner points are never merged)
@@ -981,14 +994,15 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
 
 
 def _spaced_template(key, local_uv):
-    """Each patch's triangles (p, T, 3) in local indices for the pattern of class key whose points lie at
-    local_uv (p, L, 2) (spaced steps): the inner cells as `pattern` makes them, each strip zipped by the points'
-    parameters (`kernels.common.quad_pattern.zip_by_params`), so a side finer than the grid beside it meets it
-    without skew."""
+    """The triangles of the pattern of class key, for patches whose points lie at local_uv (p, L, 2) (spaced
+    steps), in local indices: (strips (p, S, 3), each patch's own: each strip zipped by the points' parameters
+    (`kernels.common.quad_pattern.zip_by_params`), so a side finer than the grid beside it meets it without skew;
+    cells (C, 3), the inner grid's as `pattern` makes them, the same for all). A strip tile (an inner count of 1)
+    is all strip."""
     key_t = tuple(int(x) for x in key)
     tmpl = pattern(*key_t)
     if key_t[4] < 2 or key_t[5] < 2:  # a strip tile: no ring to meet
-        return np.broadcast_to(tmpl, (len(local_uv),) + tmpl.shape)
+        return np.broadcast_to(tmpl, (len(local_uv),) + tmpl.shape), tmpl[:0]
     rows, ring, _ = strips(*key_t)
     parts, n_strip = [], 0
     for side in range(4):
@@ -997,8 +1011,7 @@ def _spaced_template(key, local_uv):
             t_row, t_ring = 1.0 - t_row, 1.0 - t_ring
         parts.append(zip_by_params(rows[side], ring[side], t_row, t_ring))
         n_strip += len(rows[side]) + len(ring[side]) - 2
-    parts.append(np.broadcast_to(tmpl[n_strip:], (len(local_uv),) + tmpl[n_strip:].shape))
-    return np.concatenate(parts, axis=1)
+    return np.concatenate(parts, axis=1), tmpl[n_strip:]
 
 
 def _pattern_counts(n_in, side_counts):
