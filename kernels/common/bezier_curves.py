@@ -20,6 +20,7 @@ import numpy as np
 
 from . import nurbs
 from . import rational_bezier as rb
+from . import step_spacing
 from .errors import InvalidInputError
 from .level_metrics import curvature_level, curve_kappa
 
@@ -214,8 +215,9 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
 def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, what="NURBS spline"):
     """Sample one NURBS spline (points (n, 3), weights (n,), a `kernels.common.nurbs.Direction`, radius and tilt
     (n,)) by ``settings`` (`CurveSampling`), through its exact rational Bézier pieces. CURVATURE: eq. 4.5 on each
-    piece's control polygon (a straight piece of order 2: one step); TOLERANCE and SCREEN: steps measured to meet the
-    tolerance (up to Max Segments; the deviation left is in the result). what: how a refusal names the spline.
+    piece's control polygon (a straight piece of order 2: one step); TOLERANCE and SCREEN: steps spaced where each
+    piece bends, their count measured to meet the tolerance (up to Max Segments; the deviation left is in the
+    result). what: how a refusal names the spline.
     Returns the `AdaptiveSpline` of each copy."""
     pts = np.c_[np.asarray(co, np.float64).reshape(-1, 3), np.asarray(weight, np.float64).reshape(-1)]
     pieces, _ = nurbs.curve_pieces(pts, direction, np.c_[radius, tilt], what=what)
@@ -228,9 +230,14 @@ def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, w
         else:
             counts = np.ceil(curvature_level(curve_kappa(control), n_control=direction.order, gain=GAIN,
                                              t_max=settings.max_segments)).astype(np.int64)
-    else:
-        counts, deviation = rb.tolerance_steps(geo, _world_tolerance(control, settings, camera), settings.max_segments)
-    segment, t = steps(counts, direction.cyclic)
+        segment, t = steps(counts, direction.cyclic)
+    else:  # steps where each piece bends (`kernels.common.step_spacing`)
+        spacing = rb.curve_spacing(geo)
+        counts, deviation = rb.tolerance_steps(geo, _world_tolerance(control, settings, camera), settings.max_segments,
+                                               spacing=spacing)
+        segment, t = steps(counts, direction.cyclic)
+        k = np.rint(t * counts[segment]).astype(np.int64)  # each point's step in its piece
+        t = step_spacing.padded_params(spacing, counts)[segment, k]
     h = np.einsum("nk,nkc->nc", rb.bernstein(t, direction.order - 1), pieces[segment])
     h[t == 0] = pieces[segment[t == 0], 0]  # piece ends exactly (shared by the pieces that meet there)
     if not direction.cyclic:

@@ -86,20 +86,21 @@ def chord_deviation(control, steps, spacing=None):
     return out
 
 
-def tolerance_steps(control, tolerance, most, rounds=8):
+def tolerance_steps(control, tolerance, most, rounds=8, spacing=None):
     """Steps per curve so its chords stay within ``tolerance`` (a number or (S,)): estimated at 16 steps, then
-    checked and raised. control (S, k, 4) homogeneous. Returns (steps (S,) int64 in [1, most], deviation (S,) at
-    those steps)."""
+    checked and raised. control (S, k, 4) homogeneous; spacing (S, M + 1): the steps where each curve bends
+    (`curve_spacing`), or None for equal steps. Returns (steps (S,) int64 in [1, most], deviation (S,) at those
+    steps)."""
     h = np.asarray(control, np.float64)
     tol = np.broadcast_to(np.asarray(tolerance, np.float64), (len(h),))
-    steps = steps_for(chord_deviation(h, 16), 16, tol, most)
+    steps = steps_for(chord_deviation(h, 16, spacing), 16, tol, most)
     for _ in range(rounds):
-        dev = chord_deviation(h, steps)
+        dev = chord_deviation(h, steps, spacing)
         over = (dev > tol) & (steps < most)
         if not over.any():
             return steps, dev
         steps = np.where(over, np.minimum(most, np.maximum(steps + 1, steps_for(dev, steps, tol, most))), steps)
-    return steps, chord_deviation(h, steps)
+    return steps, chord_deviation(h, steps, spacing)
 
 
 def curve_spacing(control):

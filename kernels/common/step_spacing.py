@@ -52,3 +52,15 @@ def params(cum, n):
     t = (idx + (y[None] - c0) / (c1 - c0)) / m
     t[:, 0], t[:, -1] = 0.0, 1.0
     return np.clip(t, 0.0, 1.0)
+
+
+def padded_params(cum, counts):
+    """Each table's parameters at its own step count: cum (S, M + 1), counts (S,) int -> (S, max count + 1)
+    float64, each row from 0 to 1 in counts[s] steps, padded with 1 past its end."""
+    counts = np.asarray(counts, np.int64)
+    out = np.ones((len(counts), int(counts.max(initial=1)) + 1))
+    for n in np.unique(counts):
+        rows = np.flatnonzero(counts == n)
+        out[rows, :n + 1] = params(cum[rows], int(n))
+    return out
+

@@ -133,12 +133,7 @@ class Spacing:
     def side_params(self, level):
         """Each edge's parameters at its level (E,) in its canonical direction: (E, max level + 1) float64, padded
         with 1 past each edge's end."""
-        level = np.asarray(level, np.int64)
-        out = np.ones((len(level), int(level.max()) + 1))
-        for n in np.unique(level):
-            es = np.flatnonzero(level == n)
-            out[es, :n + 1] = step_spacing.params(self.edge[es], int(n))
-        return out
+        return step_spacing.padded_params(self.edge, level)
 
     def of(self, ps):
         """The spacing of patches ps (p,) alone (their inner tables; the edges' all)."""
@@ -671,25 +666,31 @@ def fitted_inner(grid_dev, inner_levels, tolerance, most):
     """Inner steps (P, 2) int64 in [1, most] from the inner grids' deviations measured at inner_levels (P, 2)
     (`grid_deviation`: anywhere, at the cells' sides along u, along v). Each patch's grid is modelled as straying
     A / n² + B / m² + C / nm at n steps along u and m along v (A and B from the cells' sides, C what their diagonals
-    add); the fewest cells n m within the aimed tolerance take n / m = √(A / B), n m = (2√(AB) + C) / T. A patch whose
-    grid was not measured (fewer than 3 steps a way) keeps its levels."""
+    add); each patch gets the fewest cells n m that the model puts within FIT_AIM of the tolerance (every n tried,
+    each with the fewest m: B x² + (C / n) x + A / n² - T <= 0 in x = 1 / m), or Max Level both ways where none is.
+    A patch whose grid was not measured (fewer than 3 steps a way) keeps its levels."""
     g = np.asarray(grid_dev, np.float64)
     n = np.asarray(inner_levels, np.float64)
     aim = FIT_AIM * tolerance
     a, b = g[:, 1] * n[:, 0] ** 2, g[:, 2] * n[:, 1] ** 2
     c = np.maximum(g[:, 0] - g[:, 1] - g[:, 2], 0.0) * n[:, 0] * n[:, 1]
     small = 1e-3 * (a + b + c)
-    a, b = np.maximum(a, small), np.maximum(b, small)
-    measured = (n >= 3).all(axis=1) & (a + b + c > 0)
-    ratio = np.sqrt(np.divide(a, b, out=np.ones_like(a), where=b > 0))
-    m = np.sqrt(np.divide(a / ratio ** 2 + b + c / ratio, aim))
-    u = np.clip(np.ceil(ratio * m), 1, most)
-    # with u fixed (at Max Level, or rounded up): the fewest steps along v, B x² + (C / u) x + A / u² - T <= 0 in
-    # x = 1 / v
+    a, b = np.maximum(a, small)[:, None], np.maximum(b, small)[:, None]
+    c = c[:, None]
+    measured = (n >= 3).all(axis=1) & (a[:, 0] + b[:, 0] + c[:, 0] > 0)
+    u = np.arange(1, most + 1, dtype=np.float64)[None]  # (1, most): every count along u
     lin, rest = c / u, a / u ** 2 - aim
-    x = np.divide(-lin + np.sqrt(np.maximum(lin ** 2 - 4 * b * rest, 0.0)), 2 * b, out=np.zeros_like(b), where=b > 0)
-    v = np.where((rest < 0) & (x > 0), np.ceil(np.divide(1.0, x, out=np.full_like(x, most), where=x > 0)), most)
-    fit = np.stack([u, np.clip(v, 1, most)], axis=1).astype(np.int64)
+    root = np.sqrt(np.maximum(lin ** 2 - 4 * b * rest, 0.0))
+    x = np.divide(-lin + root, 2 * b, out=np.zeros_like(root), where=b > 0)  # the largest 1 / v allowed
+    ok = (rest < 0) & (x > 0)
+    v = np.where(ok, np.maximum(1.0, np.ceil(np.divide(1.0, x, out=np.full_like(x, np.inf), where=ok) - 1e-9)),
+                 np.inf)
+    v = np.where(v <= most, v, np.inf)
+    cells = u * v
+    best = np.argmin(cells, axis=1)
+    rows = np.arange(len(g))
+    found = np.isfinite(cells[rows, best])
+    fit = np.where(found[:, None], np.stack([u[0, best], v[rows, best]], axis=1), most).astype(np.int64)
     return np.where(measured[:, None], fit, np.asarray(inner_levels, np.int64))
 
 
@@ -762,12 +763,21 @@ def _tessellate_once(h, lod, camera, budget_bytes):
     return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > lod.tolerance))
 
 
+def stored_error(h):
+    """How far storing a mesh of nets h (P, k, k, 4) in float32 can move a measured distance: a position's
+    rounding (half a unit in the last place a coordinate, √3 of it a point) and its (u, v)'s, over the model's
+    size: 4 · 2⁻²⁴ of it."""
+    return 4.0 * 2.0 ** -24 * (float(np.abs(cartesian(h)).max()) + 1.0)
+
+
 def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower):
     """Levels raised until every triangle is within the tolerance, measured before any mesh is made: the inner
     grids by tensor products (`grid_deviation`), the triangles along the patches' sides one by one
     (`rim_triangles`), each side's chords; each round measures again only the patches and sides whose levels
-    changed. Returns (edge levels (E,), inner levels (P, 2), deviation (P,) measured at them)."""
-    tol, top = lod.tolerance, lod.max_level
+    changed. The measures are float64 and the mesh is stored in float32: the levels aim under the tolerance by
+    what storing it can move (`stored_error`). Returns (edge levels (E,), inner levels (P, 2), deviation (P,)
+    measured at them)."""
+    tol, top = lod.tolerance - stored_error(h), lod.max_level
     grid_dev = np.zeros((len(h), 3))
     side_dev = np.zeros(len(el))
     rim = [np.zeros((0, 3, 2)), np.zeros(0, np.int64), np.zeros(0)]  # (u, v), patch, deviation

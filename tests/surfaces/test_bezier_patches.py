@@ -192,3 +192,93 @@ def test_split_parts_lie_on_their_patches_and_keep_shared_sides():
     want = sum(3 * counts[q, sp.SIDE_AXIS[side]] for q in range(len(h)) for side in range(4)
                if once[edges.edge[q, side]] and not edges.collapsed[edges.edge[q, side]])
     assert uses.max() == 2 and (uses == 1).sum() == want
+
+
+def test_patches_that_share_a_side_put_its_steps_where_their_grids_put_theirs():
+    patches, _ = full_teapot()
+    h = bp.check_patches(patches)
+    edges = bp.patch_edges(h)
+    spacing = bp.patch_spacing(h, edges)
+    for level in (3, 17, 40):
+        side_t = spacing.side_params(np.full(len(edges.control), level))
+        for p in range(len(h)):
+            for side in range(4):
+                e = edges.edge[p, side]
+                if edges.collapsed[e]:
+                    continue
+                inner = spacing.inner_params(np.array([p]), side % 2, level)[0]
+                along = 1.0 - side_t[e, ::-1] if edges.reversed[p, side] else side_t[e]
+                assert np.abs(along - inner).max() < 1e-12
+    # a half-twisted loop (a Möbius band of bilinear patches) meets its own chain reversed: its steps read the
+    # same both ways
+    angle = np.linspace(0, 2 * np.pi, 5)
+
+    def at(a, w):
+        return [np.cos(a) * (1 + w * np.cos(a / 2)), np.sin(a) * (1 + w * np.cos(a / 2)), w * np.sin(a / 2)]
+
+    band = np.array([[[at(angle[i + di], w) for w in (-0.5, 0.5)] for di in (0, 1)] for i in range(4)])
+    band[3, 1] = band[0, 0, ::-1]  # the last side is the first, turned over (exactly, as a closed band shares it)
+    twisted = bp.patch_edges(band)
+    chain, flip, _, _, two_way = bp.direction_chains(twisted, len(band))
+    assert len(set(chain[:, 1])) == 1 and two_way[chain[0, 1]]
+    assert not two_way[chain[:, 0]].any()
+    table = bp.patch_spacing(bp.check_patches(band), twisted).inner[:, 1]
+    assert np.abs(table - (1.0 - table[:, ::-1])).max() < 1e-12
+
+
+def test_strips_zipped_by_parameter_are_valid_and_equal_the_pattern_on_equal_steps():
+    from tessera.kernels.common import quad_pattern as qp
+
+    rng = np.random.default_rng(5)
+    for p, q in ((3, 5), (9, 2), (6, 6), (1, 4)):
+        outer, inner = np.arange(p + 1), 100 + np.arange(q + 1)
+        even = qp.zip_by_params(outer, inner, (np.arange(p + 1) / p)[None], (np.arange(q + 1) / q)[None])[0]
+        assert sorted(map(tuple, even.tolist())) == sorted(qp._zip(list(outer), list(inner)))
+        # random increasing parameters: every triangle counter-clockwise between the rows (outer at y = 0,
+        # inner at y = 1), each segment of both rows used once
+        t_o = np.sort(np.r_[0, rng.random(p - 1), 1])[None]
+        t_i = np.sort(np.r_[0, rng.random(q - 1), 1])[None] * 0.8 + 0.1
+        tris = qp.zip_by_params(outer, inner, t_o, t_i)[0]
+        pos = {**{int(o): (t_o[0, k], 0.0) for k, o in enumerate(outer)},
+               **{int(i): (t_i[0, k], 1.0) for k, i in enumerate(inner)}}
+        xy = np.array([[pos[int(v)] for v in tri] for tri in tris])
+        e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+        area = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        assert (area > 0).all() and len(tris) == p + q
+
+
+def test_fitted_inner_levels_are_the_fewest_cells_of_their_model():
+    rng = np.random.default_rng(2)
+    tol, most = 1e-3, 64
+    for _ in range(40):
+        a, b, c = rng.uniform(0, 0.3, 3) * [1, 1, rng.choice([0, 1])]
+        n0 = rng.integers(3, 30, 2)
+        measured = np.array([[a / n0[0] ** 2 + b / n0[1] ** 2 + c / (n0[0] * n0[1]), a / n0[0] ** 2,
+                              b / n0[1] ** 2]])
+        fit = bp.fitted_inner(measured, n0[None], tol, most)[0]
+        n, m = np.meshgrid(np.arange(1, most + 1), np.arange(1, most + 1), indexing="ij")
+        model = a / n ** 2 + b / m ** 2 + c / (n * m)
+        aim = bp.FIT_AIM * tol
+        if (model <= aim).any():
+            assert a / fit[0] ** 2 + b / fit[1] ** 2 + c / (fit[0] * fit[1]) <= aim * (1 + 1e-9)
+            assert fit.prod() == (n * m)[model <= aim].min()
+
+
+def test_the_sides_measured_without_a_mesh_are_the_meshes_and_the_deviation_is_the_meshes():
+    patches, _ = full_teapot()
+    h = bp.check_patches(patches)
+    tol = 1e-3
+    r = bp.tessellate(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+    assert len(r.parent) == len(h)  # whole patches
+    spacing = bp.patch_spacing(h, r.edges)
+    corners, uv, patch = bp.rim_triangles(h, r.edge_levels, r.inner_levels, r.edges, spacing, np.arange(len(h)))
+    mesh = r.mesh
+    rim = np.flatnonzero(((mesh.corner_uv == 0) | (mesh.corner_uv == 1)).any(axis=(1, 2)))
+    assert len(rim) == len(patch)
+    on_mesh = np.sort(bp.triangle_deviation(h, mesh, rim))
+    assert np.abs(np.sort(bp._deviation(h, corners, uv, patch)) - on_mesh).max() < 1e-12
+    # every triangle of the mesh measured again: within the tolerance and within each patch's recorded deviation
+    every = bp.triangle_deviation(h, mesh)
+    worst = np.zeros(len(h))
+    np.maximum.at(worst, mesh.triangle_patch, every)
+    assert every.max() <= tol and (worst <= r.deviation + bp.stored_error(h)).all()
