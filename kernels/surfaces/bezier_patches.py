@@ -43,7 +43,7 @@ from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
-from ..common import step_spacing
+from ..common import step_spacing, workers
 from ..common.rational_bezier import (
     bernstein,
     bernstein_derivative,
@@ -576,59 +576,78 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
     """The largest distance between the surface and the triangles of each patch's inner grid (the cells between
     its inner points (i / n, j / m), or where ``spacing`` (a `Spacing`) puts them, each cut along its
     (i, j)-(i+1, j+1) diagonal as the pattern cuts it), measured at `_B` (or the barycentric ``points`` given) in
-    every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels). Returns (P, 3)
-    float64: the largest distance anywhere, at the cells' sides along u, and along v (0 for a patch with fewer than
-    2 cells a way)."""
+    every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels; the groups, or
+    halves of them, on worker threads: `kernels.common.workers`). Returns (P, 3) float64: the largest distance
+    anywhere, at the cells' sides along u, and along v (0 for a patch with fewer than 2 cells a way)."""
     h = check_patches(control)
     n_in = inner_pairs(inner_levels, len(h))
+    out = np.zeros((len(h), 3))
+    ok = (n_in >= 3).all(axis=1)
+    pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
+    jobs = []
+    for q, (nu, nv) in enumerate(pairs):
+        ps = np.flatnonzero((pair_of.ravel() == q) & ok)
+        jobs += [(part, int(nu), int(nv)) for part in np.array_split(ps, min(len(ps), workers.WORKERS + 1))]
+    if not jobs:
+        return out
+
+    def run(job):
+        ps, nu, nv = job
+        out[ps] = _grid_group(h[ps], nu, nv, None if spacing is None else spacing.of(ps), points)
+
+    with workers.parallel_section():
+        done = [workers.submit(run, job) for job in jobs[1:]]
+        run(jobs[0])
+        for future in done:
+            future.result()
+    return out
+
+
+def _grid_group(h, nu, nv, spacing, points):
+    """`grid_deviation` of nets h (p, k, k, 4) that all step nu along u and nv along v: (p, 3)."""
     d = h.shape[1] - 1
     out = np.zeros((len(h), 3))
     tri_offsets = (np.array([[0, 0], [1, 0], [1, 1]], np.float64), np.array([[0, 0], [1, 1], [0, 1]], np.float64))
-    ok = (n_in >= 3).all(axis=1)
-    pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
-    for q, (nu, nv) in enumerate(pairs):
-        ps = np.flatnonzero((pair_of.ravel() == q) & ok)
-        if len(ps) == 0:
-            continue
-        # the cells' corners (the inner grid) and each sample point of every cell, by offsets a in each
-        # direction: the v basis contracted once per distinct a along v, then the u basis per sample
-        cu, cv = np.arange(1, nu - 1), np.arange(1, nv - 1)
-        if spacing is None:
-            tu, tv = (np.arange(nu + 1) / nu)[None], (np.arange(nv + 1) / nv)[None]
+    # the cells' corners (the inner grid) and each sample point of every cell, by offsets a in each direction:
+    # the v basis contracted once per distinct a along v, then the u basis per sample
+    cu, cv = np.arange(1, nu - 1), np.arange(1, nv - 1)
+    if spacing is None:
+        tu, tv = (np.arange(nu + 1) / nu)[None], (np.arange(nv + 1) / nv)[None]
 
-            def at(t, c, a, n):
-                return (c + a) / n
-        else:
-            tu, tv = spacing.inner_params(ps, 0, nu), spacing.inner_params(ps, 1, nv)
+        def at(t, c, a, n):
+            return (c + a) / n
+    else:
+        every = np.arange(len(h))
+        tu, tv = spacing.inner_params(every, 0, nu), spacing.inner_params(every, 1, nv)
 
-            def at(t, c, a, n):
-                return t[:, c] + a * (t[:, c + 1] - t[:, c])
-        g = _grid_at(h[ps], tu[:, 1:-1], tv[:, 1:-1])
-        corners = g[:, :3] / g[:, 3:]  # (p, 3, nv - 1, nu - 1)
-        # every sample's offsets in its cell are sixths: the bases at each, computed together
-        sixths = np.arange(7) / 6
-        b_u = bernstein(np.stack([at(tu, cu, a, nu) for a in sixths]), d)  # (7, [p,] U, k)
-        b_v = bernstein(np.stack([at(tv, cv, a, nv) for a in sixths]), d)
-        along_v = {}
-        for offs in tri_offsets:
-            c0, c1, c2 = (corners[:, :, int(dv):int(dv) + nv - 2, int(du):int(du) + nu - 2] for du, dv in offs)
-            c1, c2 = c1 - c0, c2 - c0
-            for bary in points:
-                iu, iv = (round(float(x) * 6) for x in bary @ offs)
-                if iv not in along_v:
-                    along_v[iv] = _contract_v_basis(h[ps], b_v[iv])
-                on = _contract_u_basis(along_v[iv], b_u[iu])  # (p, 4, V, U) homogeneous
-                gap = on[:, :3] / on[:, 3:] - c0
-                gap -= bary[1] * c1
-                gap -= bary[2] * c2
-                gap *= gap
-                dev = np.sqrt((gap[:, 0] + gap[:, 1] + gap[:, 2]).reshape(len(ps), -1).max(axis=1))
-                a = bary @ offs
-                out[ps, 0] = np.maximum(out[ps, 0], dev)
-                if a[1] in (0.0, 1.0):  # on a side of the cell along u
-                    out[ps, 1] = np.maximum(out[ps, 1], dev)
-                elif a[0] in (0.0, 1.0):  # along v
-                    out[ps, 2] = np.maximum(out[ps, 2], dev)
+        def at(t, c, a, n):
+            return t[:, c] + a * (t[:, c + 1] - t[:, c])
+    g = _grid_at(h, tu[:, 1:-1], tv[:, 1:-1])
+    corners = g[:, :3] / g[:, 3:]  # (p, 3, nv - 1, nu - 1)
+    # every sample's offsets in its cell are sixths: the bases at each, computed together
+    sixths = np.arange(7) / 6
+    b_u = bernstein(np.stack([at(tu, cu, a, nu) for a in sixths]), d)  # (7, [p,] U, k)
+    b_v = bernstein(np.stack([at(tv, cv, a, nv) for a in sixths]), d)
+    along_v = {}
+    for offs in tri_offsets:
+        c0, c1, c2 = (corners[:, :, int(dv):int(dv) + nv - 2, int(du):int(du) + nu - 2] for du, dv in offs)
+        c1, c2 = c1 - c0, c2 - c0
+        for bary in points:
+            iu, iv = (round(float(x) * 6) for x in bary @ offs)
+            if iv not in along_v:
+                along_v[iv] = _contract_v_basis(h, b_v[iv])
+            on = _contract_u_basis(along_v[iv], b_u[iu])  # (p, 4, V, U) homogeneous
+            gap = on[:, :3] / on[:, 3:] - c0
+            gap -= bary[1] * c1
+            gap -= bary[2] * c2
+            gap *= gap
+            dev = np.sqrt((gap[:, 0] + gap[:, 1] + gap[:, 2]).reshape(len(h), -1).max(axis=1))
+            a = bary @ offs
+            out[:, 0] = np.maximum(out[:, 0], dev)
+            if a[1] in (0.0, 1.0):  # on a side of the cell along u
+                out[:, 1] = np.maximum(out[:, 1], dev)
+            elif a[0] in (0.0, 1.0):  # along v
+                out[:, 2] = np.maximum(out[:, 2], dev)
     return out
 
 
