@@ -587,7 +587,8 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
     jobs = []
     for q, (nu, nv) in enumerate(pairs):
         ps = np.flatnonzero((pair_of.ravel() == q) & ok)
-        jobs += [(part, int(nu), int(nv)) for part in np.array_split(ps, min(len(ps), workers.WORKERS + 1))]
+        if len(ps):
+            jobs += [(part, int(nu), int(nv)) for part in np.array_split(ps, min(len(ps), workers.WORKERS + 1))]
     if not jobs:
         return out
 
