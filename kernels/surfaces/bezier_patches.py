@@ -64,6 +64,10 @@ TOLERANCE_ROUNDS = 16
 #: triangle is largest).
 _B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6],
                [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+#: `fitted_inner`'s model of a grid is measured at this many steps each way.
+FIT_PROBE = 12
+#: With spaced steps, `grid_deviation` measures patches together whose counts round up to the same multiple of this.
+GRID_BUCKET = 8
 #: `fitted_inner` aims this far under the tolerance: the grids are measured again at the levels it gives, at the
 #: same points, so only the model's error needs room.
 FIT_AIM = 0.95
@@ -583,7 +587,10 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
     n_in = inner_pairs(inner_levels, len(h))
     out = np.zeros((len(h), 3))
     ok = (n_in >= 3).all(axis=1)
-    pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
+    # equal steps: one group a pair of counts (the bases shared); spaced steps (each patch its own bases): counts
+    # rounded up to a multiple of GRID_BUCKET, the cells past a patch's own count empty
+    key = n_in if spacing is None else -(-n_in // GRID_BUCKET) * GRID_BUCKET
+    pairs, pair_of = np.unique(key, axis=0, return_inverse=True)
     jobs = []
     for q, (nu, nv) in enumerate(pairs):
         ps = np.flatnonzero((pair_of.ravel() == q) & ok)
@@ -594,7 +601,7 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
 
     def run(job):
         ps, nu, nv = job
-        out[ps] = _grid_group(h[ps], nu, nv, None if spacing is None else spacing.of(ps), points)
+        out[ps] = _grid_group(h[ps], nu, nv, None if spacing is None else spacing.of(ps), points, n_in[ps])
 
     with workers.parallel_section():
         done = [workers.submit(run, job) for job in jobs[1:]]
@@ -604,8 +611,10 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
     return out
 
 
-def _grid_group(h, nu, nv, spacing, points):
-    """`grid_deviation` of nets h (p, k, k, 4) that all step nu along u and nv along v: (p, 3)."""
+def _grid_group(h, nu, nv, spacing, points, counts):
+    """`grid_deviation` of nets h (p, k, k, 4) that all step nu along u and nv along v (equal steps), or whose own
+    counts (p, 2) are at most that (spaced steps: their parameters past their own last inner point stay there, so
+    the cells past it are empty): (p, 3)."""
     d = h.shape[1] - 1
     out = np.zeros((len(h), 3))
     tri_offsets = (np.array([[0, 0], [1, 0], [1, 1]], np.float64), np.array([[0, 0], [1, 1], [0, 1]], np.float64))
@@ -618,8 +627,7 @@ def _grid_group(h, nu, nv, spacing, points):
         def at(t, c, a, n):
             return (c + a) / n
     else:
-        every = np.arange(len(h))
-        tu, tv = spacing.inner_params(every, 0, nu), spacing.inner_params(every, 1, nv)
+        tu, tv = (_padded_inner(spacing.inner[:, axis], counts[:, axis], n) for axis, n in ((0, nu), (1, nv)))
 
         def at(t, c, a, n):
             return t[:, c] + a * (t[:, c + 1] - t[:, c])
@@ -650,6 +658,16 @@ def _grid_group(h, nu, nv, spacing, points):
             elif a[0] in (0.0, 1.0):  # along v
                 out[:, 2] = np.maximum(out[:, 2], dev)
     return out
+
+
+def _padded_inner(cum, counts, n):
+    """Parameters (p, n + 1) of each table cum (p, M + 1) at its own count (p,) <= n, the values past its last
+    inner point (counts - 1) held there."""
+    t = step_spacing.padded_params(cum, counts)
+    t = np.concatenate([t, np.ones((len(t), n + 1 - t.shape[1]))], axis=1) if t.shape[1] < n + 1 else t[:, :n + 1]
+    last = counts - 1
+    held = np.arange(n + 1)[None] > last[:, None]
+    return np.where(held, t[np.arange(len(t)), last][:, None], t)
 
 
 def _contract_v(h, tv):
@@ -770,8 +788,10 @@ def _tessellate_once(h, lod, camera, budget_bytes):
         # patches beside it: no stretched triangles along it
         others = tuple(m for m in lod.metrics if m != "TOLERANCE")
         floor = patch_levels(h, edges, replace(lod, metrics=others), camera)[1] if others else 1
-        first = grid_deviation(h, inner, spacing, points=_B[:4])  # a model needs only the sides' and centroids'
-        inner = np.maximum(floor, fitted_inner(first, inner, lod.tolerance, lod.max_level))
+        # the model from a coarse grid (it falls with the square of the steps): only the sides' and centroids'
+        probe = np.full((len(h), 2), FIT_PROBE)
+        first = grid_deviation(h, probe, spacing, points=_B[:4])
+        inner = np.maximum(floor, fitted_inner(first, probe, lod.tolerance, lod.max_level))
         el = _sides_keep_up(el, inner, edges)
     lower = "a lower Max Level or a larger Tolerance" if "TOLERANCE" in lod.metrics else "a lower Max Level"
     if "TOLERANCE" in lod.metrics:
@@ -862,9 +882,13 @@ def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower):
             unmeasured = grid_dev[rim_over, 0] <= 0
             scaled[unmeasured] = rim_need[rim_over][unmeasured, None] * [1.0, 0.5, 0.5]
             want = np.maximum(new_inner[rim_over], fitted_inner(scaled, inner[rim_over], tol, top))
+            # no step more from the model: one more the way that strays most (unmeasured: the way with fewer
+            # steps), or the other way where that one is at Max Level
             same = (want <= inner[rim_over]).all(axis=1)
-            axis = (scaled[:, 2] > scaled[:, 1]).astype(np.int64)
-            want[same, axis[same]] = inner[rim_over][same, axis[same]] + 1
+            was = inner[rim_over]
+            axis = np.where(unmeasured, was[:, 1] < was[:, 0], scaled[:, 2] > scaled[:, 1]).astype(np.int64)
+            axis = np.where(was[np.arange(len(axis)), axis] >= top, 1 - axis, axis)
+            want[same, axis[same]] = was[same, axis[same]] + 1
             new_inner[rim_over] = want
         new_inner = np.minimum(new_inner, top)
         new_el = np.minimum(_sides_keep_up(new_el, new_inner, edges), top)
