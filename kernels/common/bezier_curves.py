@@ -18,9 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import nurbs
+from . import nurbs, step_spacing
 from . import rational_bezier as rb
-from . import step_spacing
 from .errors import InvalidInputError
 from .level_metrics import curvature_level, curve_kappa
 

@@ -24,11 +24,14 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
   through the linear (or inverse) map between Near and Far;
 - projected edge length (§4.4): a side as a sphere as wide as its control polygon is long, at its centroid, over
   Edge Pixels; the inside from the net's longest row or column at its centroid;
-- tolerance (chordal deviation, scene units): a side's level from the deviation of its chords at 16 steps, a patch's
-  from its triangles' at an 8 x 8 grid, both scaled as the square root (the deviation of a chord falls with the square
-  of its length); then `tessellate` measures every triangle of the mesh against the surface and raises the levels
-  where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is met or the patches that cannot meet
-  it within Max Level are named;
+- tolerance (chordal deviation, scene units): the steps are spaced where the surface bends (`patch_spacing`:
+  `kernels.common.step_spacing`, one table for every direction linked through shared sides, `direction_chains`); a
+  side's level from the deviation of its chords at 16 steps, a direction's from its iso-lines', both scaled as the
+  square root (the deviation of a chord falls with the square of its length); each inner grid is then fitted to a
+  model measured on a 12 x 12 probe (`fitted_inner`), and every triangle is measured against the surface, before the
+  mesh is made (the inner grids by `grid_deviation`, the strips along the sides by `rim_triangles`), raising the
+  levels where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is met or the patches that
+  cannot meet it within Max Level are named (and split, `tessellate`);
 - any of these together: the largest. Levels are whole segment counts. The inside of a patch has a count of steps
   along u and one along v: the same (the larger) for curvature, distance and edge length, each its own for the
   tolerance.
@@ -39,18 +42,16 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..common import step_spacing, workers
 from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
-from ..common import step_spacing, workers
 from ..common.rational_bezier import (
     bernstein,
     bernstein_derivative,
-    TOLERANCE_AIM,
     cartesian,
     chord_deviation,
-    curve_spacing,
     steps_for,
 )
 from . import patch_split
@@ -694,6 +695,11 @@ def _contract_u_basis(along_v, b):
     return np.matmul(np.swapaxes(along_v, -1, -2), bt if bt.ndim == 2 else bt[:, None])
 
 
+def _plane_points(planes):
+    """Coordinate planes (p, c, V, U) as points (p, V U, c), row by row."""
+    return planes.transpose(0, 2, 3, 1).reshape(len(planes), -1, planes.shape[1])
+
+
 def _grid_at(h, tu, tv):
     """Homogeneous points (p, c, V, U) (coordinate planes) of nets h (p, k, k, c) at tu (1 or p, U) along u and
     tv (1 or p, V)."""
@@ -963,13 +969,9 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
         else:
             t_u, t_v = spacing.inner_params(ps, 0, nu)[:, 1:-1], spacing.inner_params(ps, 1, nv)[:, 1:-1]
             along_v, along_dv = _contract_v(h[ps], t_v), _contract_v_basis(h[ps], bernstein_derivative(t_v, deg))
-
-            def points(planes):
-                return planes.transpose(0, 2, 3, 1).reshape(len(ps), -1, 4)
-
-            grid = points(_contract_u(along_v, t_u))
-            g_u = points(_contract_u_basis(along_v, bernstein_derivative(t_u, deg)))
-            g_v = points(_contract_u(along_dv, t_u))
+            grid = _plane_points(_contract_u(along_v, t_u))
+            g_u = _plane_points(_contract_u_basis(along_v, bernstein_derivative(t_u, deg)))
+            g_v = _plane_points(_contract_u(along_dv, t_u))
         rows = in_first[ps][:, None] + np.arange((nu - 1) * (nv - 1))[None]
         pts = cartesian(grid)
         inner_pts[rows] = pts
