@@ -7,6 +7,7 @@ it is held to one thread (threadpoolctl, when installed; without it the results 
 slower).
 """
 
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
@@ -19,6 +20,12 @@ except ImportError:  # optional: only the speed depends on it
 WORKERS = 2
 _pool = []
 _blas = []
+
+
+def in_worker():
+    """True on one of our worker threads (work it would hand to the pool and wait for runs in place instead: the
+    pool may have no free thread)."""
+    return threading.current_thread().name.startswith("tessera")
 
 
 def submit(fn, *args):

@@ -128,9 +128,10 @@ class PatchEdges:
 
 @dataclass
 class Spacing:
-    """Where the steps fall, for the tolerance (`kernels.common.step_spacing`): edge (E, M + 1) each shared side's
-    table in its canonical direction (from the side's own control points, so every patch on it agrees); inner
-    (P, 2, M + 1) each patch's tables along u and along v (the density the largest over 9 iso-lines)."""
+    """Where the steps fall, for the tolerance (`kernels.common.step_spacing`, made by `patch_spacing`): edge
+    (E, M + 1) each shared side's table in its canonical direction; inner (P, 2, M + 1) each patch's tables along u
+    and along v. A side's table is its chain's, as are the inner tables of the patches beside it along it, so they
+    put their points at the same parameters."""
 
     edge: np.ndarray
     inner: np.ndarray
@@ -260,10 +261,10 @@ class Tessellation:
         """Each triangle's corners' (u, v) in its patch (not its part): (T, 3, 2) float64. outer (P, 2, 2): each
         patch's ((u0, u1), (v0, v1)) in something larger (its spline: `kernels.common.nurbs.PatchSet.box`): the
         corners' (u, v) there instead, (T, 3, 2) float32, each part's two boxes composed first."""
-        lo, size = self.box[:, :, 0], self.box[:, :, 1] - self.box[:, :, 0]
         if outer is None:
             b = self.box[self.mesh.triangle_patch][:, None]
             return b[..., 0] + self.mesh.corner_uv.astype(np.float64) * (b[..., 1] - b[..., 0])
+        lo, size = self.box[:, :, 0], self.box[:, :, 1] - self.box[:, :, 0]
         o = np.asarray(outer, np.float64)[self.parent]
         o_lo, o_size = o[:, :, 0], o[:, :, 1] - o[:, :, 0]
         lo, size = o_lo + lo * o_size, size * o_size  # (P', 2): one affine map a part
@@ -604,6 +605,10 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
         ps, nu, nv = job
         out[ps] = _grid_group(h[ps], nu, nv, None if spacing is None else spacing.of(ps), points, n_in[ps])
 
+    if workers.in_worker():
+        for job in jobs:
+            run(job)
+        return out
     with workers.parallel_section():
         done = [workers.submit(run, job) for job in jobs[1:]]
         run(jobs[0])

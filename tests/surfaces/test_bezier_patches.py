@@ -282,3 +282,17 @@ def test_the_sides_measured_without_a_mesh_are_the_meshes_and_the_deviation_is_t
     worst = np.zeros(len(h))
     np.maximum.at(worst, mesh.triangle_patch, every)
     assert every.max() <= tol and (worst <= r.deviation + bp.stored_error(h)).all()
+
+
+def test_tessellating_on_a_worker_thread_measures_in_place_and_gives_the_same_mesh():
+    from tessera.kernels.common import workers
+
+    patches, _ = full_teapot()
+    lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=2e-3, max_level=64)
+    here = bp.tessellate(patches, lod)
+    # every worker busy with a tessellation that would hand its measuring to the pool: none waits on the others
+    there = [workers.submit(bp.tessellate, patches, lod) for _ in range(workers.WORKERS)]
+    for future in there:
+        mesh = future.result(timeout=120).mesh
+        assert np.array_equal(mesh.positions, here.mesh.positions)
+        assert np.array_equal(mesh.triangles, here.mesh.triangles)
