@@ -39,11 +39,8 @@ def bend_density(points):
 
 
 def params(cum, n):
-    """Parameters (S, n + 1) of n steps of each spacing table cum (S, M + 1): from exactly 0 to exactly 1; equal
-    steps i / n when cum is None (then S = 1)."""
+    """Parameters (S, n + 1) of n steps of each spacing table cum (S, M + 1): from exactly 0 to exactly 1."""
     y = np.arange(n + 1) / n
-    if cum is None:
-        return y[None]
     cum = np.asarray(cum, np.float64)
     m = cum.shape[1] - 1
     idx = np.clip((cum[:, None, :] <= y[None, :, None]).sum(axis=2) - 1, 0, m - 1)  # (S, n + 1)
