@@ -69,6 +69,8 @@ _B = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3], [2 
 FIT_PROBE = 12
 #: With spaced steps, `grid_deviation` measures patches together whose counts round up to the same multiple of this.
 GRID_BUCKET = 8
+#: `grid_deviation` measures at most this many cells at once (a few float64 arrays of 4 values a cell).
+GRID_CELLS = 1 << 18
 #: `fitted_inner` aims this far under the tolerance: the grids are measured again at the levels it gives, at the
 #: same points, so only the model's error needs room.
 FIT_AIM = 0.95
@@ -596,8 +598,9 @@ def grid_deviation(control, inner_levels, spacing=None, points=_B):
     jobs = []
     for q, (nu, nv) in enumerate(pairs):
         ps = np.flatnonzero((pair_of.ravel() == q) & ok)
-        if len(ps):
-            jobs += [(part, int(nu), int(nv)) for part in np.array_split(ps, min(len(ps), workers.WORKERS + 1))]
+        if len(ps):  # a share for each thread, and at most GRID_CELLS cells a job (its arrays' memory)
+            parts = max(min(len(ps), workers.WORKERS + 1), -(-len(ps) * int(nu) * int(nv) // GRID_CELLS))
+            jobs += [(part, int(nu), int(nv)) for part in np.array_split(ps, min(parts, len(ps)))]
     if not jobs:
         return out
 
