@@ -108,4 +108,3 @@ def curve_spacing(control):
     points (S, k, 4): their steps where they bend."""
     t = np.linspace(0.0, 1.0, 2 * step_spacing.SAMPLES + 1)
     return step_spacing.cumulative(step_spacing.bend_density(cartesian(curve_points(control, t))))
-

@@ -280,9 +280,8 @@ class Tessellation:
 
 def tensor_grid(b_u, b_v, h):
     """Homogeneous points of patches h (P, k, k, c) on a grid: b_u (U, k) and b_v (V, k) basis values along u and
-    v -> (P, V, U, c) (row j at the j-th v). Two matrix products."""
-    tmp = np.tensordot(h, b_v, axes=([2], [1]))  # (P, k_u, c, V)
-    return np.tensordot(tmp, b_u, axes=([1], [1])).transpose(0, 2, 3, 1)  # (P, V, U, c)
+    v -> (P, V, U, c) (row j at the j-th v). Two matrix products (`_contract_v_basis`, `_contract_u_basis`)."""
+    return _contract_u_basis(_contract_v_basis(h, b_v), b_u).transpose(0, 2, 3, 1)
 
 
 def homogeneous_nets(control):
@@ -966,20 +965,17 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
         ps = np.flatnonzero((pair_of.ravel() == q) & (count > 0))
         if len(ps) == 0:
             continue
-        if spacing is None:
-            t_u, t_v = np.arange(1, nu) / nu, np.arange(1, nv) / nv
-            b_u, b_v = bernstein(t_u, deg), bernstein(t_v, deg)
-            d_u, d_v = bernstein_derivative(t_u, deg), bernstein_derivative(t_v, deg)
-            grid = tensor_grid(b_u, b_v, h[ps]).reshape(len(ps), -1, 4)
-            g_u = tensor_grid(d_u, b_v, h[ps]).reshape(len(ps), -1, 4)
-            g_v = tensor_grid(b_u, d_v, h[ps]).reshape(len(ps), -1, 4)
-            t_u, t_v = t_u[None], t_v[None]
-        else:
+        if spacing is None:  # the bases shared by the group
+            t_u, t_v = (np.arange(1, nu) / nu)[None], (np.arange(1, nv) / nv)[None]
+            at_u, at_v = t_u[0], t_v[0]
+        else:  # each patch its own
             t_u, t_v = spacing.inner_params(ps, 0, nu)[:, 1:-1], spacing.inner_params(ps, 1, nv)[:, 1:-1]
-            along_v, along_dv = _contract_v(h[ps], t_v), _contract_v_basis(h[ps], bernstein_derivative(t_v, deg))
-            grid = _plane_points(_contract_u(along_v, t_u))
-            g_u = _plane_points(_contract_u_basis(along_v, bernstein_derivative(t_u, deg)))
-            g_v = _plane_points(_contract_u(along_dv, t_u))
+            at_u, at_v = t_u, t_v
+        along_v = _contract_v(h[ps], at_v)
+        along_dv = _contract_v_basis(h[ps], bernstein_derivative(at_v, deg))
+        grid = _plane_points(_contract_u(along_v, at_u))
+        g_u = _plane_points(_contract_u_basis(along_v, bernstein_derivative(at_u, deg)))
+        g_v = _plane_points(_contract_u(along_dv, at_u))
         rows = in_first[ps][:, None] + np.arange((nu - 1) * (nv - 1))[None]
         pts = cartesian(grid)
         inner_pts[rows] = pts
