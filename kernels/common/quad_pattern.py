@@ -92,11 +92,16 @@ def zip_by_params(outer, inner, t_outer, t_inner):
     outer, inner = np.asarray(outer), np.asarray(inner)
     mo = 0.5 * (t_outer[:, :-1] + t_outer[:, 1:])
     mi = 0.5 * (t_inner[:, :-1] + t_inner[:, 1:])
-    j_of_i = (mi[:, None, :] < mo[:, :, None]).sum(axis=2)  # inner steps taken before outer step i
-    i_of_j = (mo[:, None, :] <= mi[:, :, None]).sum(axis=2)  # outer steps taken before inner step j
-    by_outer = np.stack([np.broadcast_to(outer[:-1], j_of_i.shape), np.broadcast_to(outer[1:], j_of_i.shape),
-                         inner[j_of_i]], axis=-1)
-    by_inner = np.stack([outer[i_of_j], np.broadcast_to(inner[1:], i_of_j.shape),
-                         np.broadcast_to(inner[:-1], i_of_j.shape)], axis=-1)
-    return np.concatenate([by_outer, by_inner], axis=1)
+    # both rows' midpoints merged by a stable sort (the outer row's first on a tie): an outer step's place in the
+    # merge less its index is the inner steps taken before it, and an inner step's the outer steps before it
+    order = np.argsort(np.concatenate([mo, mi], axis=1), axis=1, kind="stable")
+    place = np.empty_like(order)
+    np.put_along_axis(place, order, np.arange(order.shape[1])[None], axis=1)
+    p = mo.shape[1]
+    j_of_i = place[:, :p] - np.arange(p)[None]  # inner steps taken before outer step i
+    i_of_j = place[:, p:] - np.arange(mi.shape[1])[None]  # outer steps taken before inner step j
+    out = np.empty((len(mo), p + mi.shape[1], 3), np.result_type(outer, inner))
+    out[:, :p, 0], out[:, :p, 1], out[:, :p, 2] = outer[:-1], outer[1:], inner[j_of_i]
+    out[:, p:, 0], out[:, p:, 1], out[:, p:, 2] = outer[i_of_j], inner[1:], inner[:-1]
+    return out
 

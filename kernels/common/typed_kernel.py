@@ -8,7 +8,13 @@ displacement dab's 12 scalars cost ~110 µs a launch, 30 times the launch itself
 `TypedKernel` declares them from the call: each distinct signature (the numpy dtype of every scalar argument, None
 for buffers and anything else) gets its own kernel object with those types. A scalar is packed as its own dtype,
 so the bytes the device receives are the ones the untyped call passed.
+
+A launch sets the kernel object's arguments and then enqueues it; OpenCL lets any call be made from any thread except
+setting the arguments of one kernel object from two at once (``clSetKernelArg``), so each launch holds the object's
+lock from the first argument to the enqueue.
 """
+
+import threading
 
 import numpy as np
 
@@ -21,6 +27,7 @@ class TypedKernel:
         self._program = program
         self.function_name = name
         self._kernels = {}  # signature -> kernel object with those scalar types
+        self._lock = threading.Lock()  # held from setting a launch's arguments to its enqueue
 
     def for_signature(self, args):
         """The kernel object typed for ``args``."""
@@ -33,4 +40,5 @@ class TypedKernel:
         return kernel
 
     def __call__(self, queue, global_size, local_size, *args, **kwargs):
-        return self.for_signature(args)(queue, global_size, local_size, *args, **kwargs)
+        with self._lock:
+            return self.for_signature(args)(queue, global_size, local_size, *args, **kwargs)

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..common import step_spacing, workers
 from ..common.budget import Estimate, check_budget
-from ..common.errors import InvalidInputError
+from ..common.errors import InvalidInputError, OpenCLUnavailableError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
 from ..common.rational_bezier import (
@@ -54,7 +54,8 @@ from ..common.rational_bezier import (
     chord_deviation,
     steps_for,
 )
-from . import patch_split
+from ..common.opencl_runtime import backend_runtime
+from . import patch_deviation_opencl, patch_split
 
 METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
 MAX_LEVEL = 64
@@ -505,9 +506,12 @@ def triangle_deviation(control, mesh, which=None):
                       mesh.corner_uv[which].astype(np.float64), mesh.triangle_patch[which])
 
 
-def _deviation(h, corners, uv, patch):
+def _deviation(h, corners, uv, patch, runtime=None):
     """`triangle_deviation` of triangles given by their corners' positions (T, 3, 3), (u, v) (T, 3, 2) and
-    patch (T,): (T,) float64."""
+    patch (T,): (T,) float64; on ``runtime``'s OpenCL device where it has double precision
+    (`patch_deviation_opencl`)."""
+    if patch_deviation_opencl.supports(runtime):
+        return patch_deviation_opencl.triangle_deviation(runtime, h, corners, uv, patch, _B)
     on_mesh = np.matmul(_B, corners)
     at = np.matmul(_B, uv)
     out = np.empty(len(corners))
@@ -517,11 +521,12 @@ def _deviation(h, corners, uv, patch):
     return out
 
 
-def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which):
+def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which, runtime=None):
     """The triangles of patches ``which`` (p,) that reach a side of their patch, as `tessellate_patches` makes
     them (a triangle flattened at a pole dropped, its fan's corner (u, v) at the pole moved as there), without
     making the mesh: (corners (R, 3, 3) positions, (u, v) (R, 3, 2), both rounded to float32 as the mesh stores
-    them, patch (R,) int64)."""
+    them, patch (R,) int64). The corners are evaluated on ``runtime``'s OpenCL device where it has double precision
+    (`patch_deviation_opencl.points`)."""
     h = check_patches(control)
     el = np.asarray(edge_levels, np.int64)
     side_counts = el[edges.edge]
@@ -533,10 +538,9 @@ def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which):
     for cls, key in enumerate(classes):
         ps = np.asarray(which)[inverse.ravel() == cls]
         key_t = tuple(int(x) for x in key)
-        tmpl = pattern(*key_t)
-        border = pattern_codes(*key_t)[:, 0] < 5
-        on_rim = border[tmpl].any(axis=1)  # the same triangles, however the strips are zipped
         if spacing is None:
+            tmpl = pattern(*key_t)
+            on_rim = (tmpl < sum(key_t[:4])).any(axis=1)  # a corner on a side: corners and sides' points come first
             local = np.broadcast_to(_pattern_uv(key_t), (len(ps),) + _pattern_uv(key_t).shape)
             own = np.broadcast_to(tmpl[on_rim], (len(ps),) + tmpl[on_rim].shape)
         else:
@@ -556,7 +560,10 @@ def rim_triangles(control, edge_levels, inner_levels, edges, spacing, which):
     u, v = uv[..., 0], uv[..., 1]
     on = np.stack([(v == 0) & collapsed[:, :1], (u == 1) & collapsed[:, 1:2], (v == 1) & collapsed[:, 2:3],
                    (u == 0) & collapsed[:, 3:]], axis=-1)  # (R, 3 corners, 4 sides)
-    corners = evaluate(h[patch], uv[..., 0], uv[..., 1])
+    if patch_deviation_opencl.supports(runtime):
+        corners = patch_deviation_opencl.points(runtime, h, uv.reshape(-1, 2), np.repeat(patch, 3)).reshape(-1, 3, 3)
+    else:
+        corners = evaluate(h[patch], uv[..., 0], uv[..., 1])
     at_pole = on.any(axis=2)
     if at_pole.any():  # the one point of the pole, as the mesh has it; two corners there: flattened, dropped
         side = on.argmax(axis=2)
@@ -579,17 +586,27 @@ def inner_pairs(inner_levels, count):
     return np.maximum(n, 1)
 
 
-def grid_deviation(control, inner_levels, spacing=None, points=_B):
+def grid_deviation(control, inner_levels, spacing=None, points=_B, runtime=None):
     """The largest distance between the surface and the triangles of each patch's inner grid (the cells between
     its inner points (i / n, j / m), or where ``spacing`` (a `Spacing`) puts them, each cut along its
     (i, j)-(i+1, j+1) diagonal as the pattern cuts it), measured at `_B` (or the barycentric ``points`` given) in
     every triangle as `triangle_deviation` does, by tensor products (one per pair of inner levels; the groups, or
-    halves of them, on worker threads: `kernels.common.workers`). Returns (P, 3) float64: the largest distance
-    anywhere, at the cells' sides along u, and along v (0 for a patch with fewer than 2 cells a way)."""
+    halves of them, on worker threads: `kernels.common.workers`), or on ``runtime``'s OpenCL device where it has
+    double precision (`patch_deviation_opencl`: the same points and parameters). Returns (P, 3) float64: the largest
+    distance anywhere, at the cells' sides along u, and along v (0 for a patch with fewer than 2 cells a way)."""
     h = check_patches(control)
     n_in = inner_pairs(inner_levels, len(h))
     out = np.zeros((len(h), 3))
     ok = (n_in >= 3).all(axis=1)
+    if patch_deviation_opencl.supports(runtime):
+        ps = np.flatnonzero(ok)
+        if spacing is None:
+            tu, tv = (step_spacing.padded_params(np.array([[0.0, 1.0]]).repeat(len(ps), 0), n_in[ps, axis])
+                      for axis in (0, 1))
+        else:
+            tu, tv = (step_spacing.padded_params(spacing.inner[ps, axis], n_in[ps, axis]) for axis in (0, 1))
+        out[ps] = patch_deviation_opencl.grid_deviation(runtime, h[ps], n_in[ps], tu, tv, points)
+        return out
     # equal steps: one group a pair of counts (the bases shared); spaced steps (each patch its own bases): counts
     # rounded up to a multiple of GRID_BUCKET, the cells past a patch's own count empty
     key = n_in if spacing is None else -(-n_in // GRID_BUCKET) * GRID_BUCKET
@@ -764,19 +781,22 @@ def estimate(edge_levels, inner_levels):
     return Estimate(vertices, triangles, vertices * 200 + triangles * 160)
 
 
-def tessellate(control, lod, camera=None, budget_bytes=None):
+def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
     """Levels from ``lod`` and the welded mesh at them: a `Tessellation`. With TOLERANCE among the metrics, every
     triangle is measured against the surface (`triangle_deviation`) and each side
     (`kernels.common.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
     within the tolerance or at Max Level; a patch still over it at Max Level is split in two along each direction at
     Max Level (`kernels.surfaces.patch_split`, with every patch that shares those sides) and the whole is made again,
     up to SPLIT_ROUNDS times. Every mesh is checked against ``budget_bytes`` (`kernels.common.budget.check_budget`)
-    before it is made."""
+    before it is made. backend: where the triangles are measured: "auto" (an OpenCL device with double precision
+    where one is set up, else numpy), "numpy", or "opencl" (`patch_deviation_opencl`; an error without such a
+    device)."""
     h = check_patches(control)
+    runtime = _measuring_runtime(backend)
     parent = np.arange(len(h))
     box = np.broadcast_to(np.array([[0.0, 1.0], [0.0, 1.0]]), (len(h), 2, 2))
     for attempt in range(SPLIT_ROUNDS + 1):
-        result = _tessellate_once(h, lod, camera, budget_bytes)
+        result = _tessellate_once(h, lod, camera, budget_bytes, runtime)
         result.parent, result.box = parent, box
         if len(result.unmet) == 0 or attempt == SPLIT_ROUNDS:
             return result
@@ -791,7 +811,18 @@ def tessellate(control, lod, camera=None, budget_bytes=None):
     return result
 
 
-def _tessellate_once(h, lod, camera, budget_bytes):
+def _measuring_runtime(backend):
+    """The OpenCL runtime that measures for `tessellate`'s ``backend``, or None (numpy)."""
+    runtime = backend_runtime(backend, "measuring Tessellate Surface's triangles")
+    if runtime is not None and not patch_deviation_opencl.supports(runtime):
+        if backend == "opencl":
+            raise OpenCLUnavailableError(f"The OpenCL device {runtime.description} has no double precision, which "
+                                         "measuring the triangles needs; use the numpy backend")
+        return None
+    return runtime
+
+
+def _tessellate_once(h, lod, camera, budget_bytes, runtime=None):
     """`tessellate` without splitting: a `Tessellation` of these patches (parent and box left to the caller)."""
     edges = patch_edges(h)
     spacing = patch_spacing(h, edges) if "TOLERANCE" in lod.metrics else None
@@ -803,12 +834,12 @@ def _tessellate_once(h, lod, camera, budget_bytes):
         floor = patch_levels(h, edges, replace(lod, metrics=others), camera)[1] if others else 1
         # the model from a coarse grid (it falls with the square of the steps): only the sides' and centroids'
         probe = np.full((len(h), 2), FIT_PROBE)
-        first = grid_deviation(h, probe, spacing, points=_B[:4])
+        first = grid_deviation(h, probe, spacing, points=_B[:4], runtime=runtime)
         inner = np.maximum(floor, fitted_inner(first, probe, lod.tolerance, lod.max_level))
         el = _sides_keep_up(el, inner, edges)
     lower = "a lower Max Level or a larger Tolerance" if "TOLERANCE" in lod.metrics else "a lower Max Level"
     if "TOLERANCE" in lod.metrics:
-        el, inner, dev = _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower)
+        el, inner, dev = _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower, runtime)
     check_budget(estimate(el, inner), budget_bytes, lower)
     mesh = tessellate_patches(h, el, inner, edges, spacing)
     if "TOLERANCE" not in lod.metrics:
@@ -823,12 +854,12 @@ def stored_error(h):
     return 4.0 * 2.0 ** -24 * (float(np.abs(cartesian(h)).max()) + 1.0)
 
 
-def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower):
+def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower, runtime=None):
     """Levels raised until every triangle is within the tolerance, measured before any mesh is made: the inner
     grids by tensor products (`grid_deviation`), the triangles along the patches' sides one by one
     (`rim_triangles`), each side's chords; each round measures again only the patches and sides whose levels
-    changed. The measures are float64 and the mesh is stored in float32: the levels aim under the tolerance by
-    what storing it can move (`stored_error`). Returns (edge levels (E,), inner levels (P, 2), deviation (P,)
+    changed (on ``runtime``'s OpenCL device where given). The measures are float64 and the mesh is stored in
+    float32: the levels aim under the tolerance by what storing it can move (`stored_error`). Returns (edge levels (E,), inner levels (P, 2), deviation (P,)
     measured at them)."""
     tol, top = lod.tolerance - stored_error(h), lod.max_level
     grid_dev = np.zeros((len(h), 3))
@@ -839,11 +870,12 @@ def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower):
         """Measure again what changed; the deviation of each patch (P,)."""
         ps = np.flatnonzero(changed)
         if len(ps):
-            grid_dev[ps] = grid_deviation(h[ps], inner[ps], None if spacing is None else spacing.of(ps))
-            corners, uv, patch = rim_triangles(h, el, inner, edges, spacing, ps)
+            grid_dev[ps] = grid_deviation(h[ps], inner[ps], None if spacing is None else spacing.of(ps),
+                                          runtime=runtime)
+            corners, uv, patch = rim_triangles(h, el, inner, edges, spacing, ps, runtime)
             keep = ~changed[rim[1]]
             rim[:] = (np.concatenate([rim[0][keep], uv]), np.concatenate([rim[1][keep], patch]),
-                      np.concatenate([rim[2][keep], _deviation(h, corners, uv, patch)]))
+                      np.concatenate([rim[2][keep], _deviation(h, corners, uv, patch, runtime)]))
         es = np.flatnonzero(changed_sides)
         side_dev[es] = chord_deviation(edges.control[es], el[es], None if spacing is None else spacing.edge[es])
         dev = grid_dev[:, 0].copy()

@@ -5,9 +5,11 @@ highest at the knob and the base, distance levels high near and low far."""
 import numpy as np
 import pytest
 from tessera.kernels.common import camera
-from tessera.kernels.common.errors import InvalidInputError
+from tessera.kernels.common.errors import InvalidInputError, OpenCLUnavailableError
 from tessera.kernels.surfaces import bezier_patches as bp
 from tessera.kernels.surfaces.revolved_teapot import teapot_patches
+
+pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL: test_opencl_surfaces.py
 
 
 def edge_uses(tris):
@@ -296,3 +298,16 @@ def test_tessellating_on_a_worker_thread_measures_in_place_and_gives_the_same_me
         mesh = future.result(timeout=120).mesh
         assert np.array_equal(mesh.positions, here.mesh.positions)
         assert np.array_equal(mesh.triangles, here.mesh.triangles)
+
+
+def test_backends_are_checked():
+    h = bp.check_patches(full_teapot()[0][:2])
+    lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-2)
+    with pytest.raises(InvalidInputError, match="backend"):
+        bp.tessellate(h, lod, backend="cuda")
+
+
+def test_opencl_asked_for_without_a_device_is_an_error():
+    h = bp.check_patches(full_teapot()[0][:2])
+    with pytest.raises(OpenCLUnavailableError, match="Tessellate Surface"):
+        bp.tessellate(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-2), backend="opencl")
