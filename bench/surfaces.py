@@ -22,7 +22,9 @@ a GPU's; the device tool runs the same on a real GPU where one is lent.
   the mesh) on Blender's NURBS sphere and torus and Newell's teapot (32 patches), against Blender's own conversion of
   the same surface object to a mesh copied into a new object, at the lowest resolution whose mesh is as close to the
   surface (both measured the same way: each triangle at 7 points against the surface at the same parameters):
-  triangles and seconds over the baseline's, and triangles per second.
+  triangles and seconds over the baseline's, and triangles per second; where the triangles were measured (the
+  OpenCL device, `kernels.surfaces.patch_deviation_opencl`, or numpy), and the same operator's seconds with OpenCL
+  off (numpy measuring) over them.
 Run: .venv/bin/python bench/surfaces.py [--full]   (--full: N up to 20,000; else up to 2,500)
 """
 
@@ -204,6 +206,15 @@ def run_tessellate_surface(bpy, mod, name, make):
         bpy.data.meshes.remove(me)
     n_blender = blenders()
     t_ours, t_blender = seconds(ours, 3), seconds(blenders, 3)
+    # the same operator with its triangles measured by numpy (OpenCL off), in the same run
+    ocl = mod("kernels.common.opencl_runtime")
+    runtime, mode = ocl.get_runtime(), ocl.current_mode()
+    measured_on = runtime.description if mod("kernels.surfaces.patch_deviation_opencl").supports(runtime) else "numpy"
+    ocl.configure(mode="0")
+    try:
+        t_numpy = seconds(ours, 3)
+    finally:
+        ocl.configure(mode=mode)
     print(json.dumps({"bench": "surfaces", "case": f"tessellate_surface_{name}", "patches": len(result.inner_levels),
                       "tolerance": round(tol, 6), "triangles": n_ours, "deviation": round(ours_dev, 6),
                       "seconds": round(t_ours, 4),
@@ -212,7 +223,9 @@ def run_tessellate_surface(bpy, mod, name, make):
                       "baseline_seconds": round(t_blender, 4),
                       "triangles_over_baseline": round(n_ours / n_blender, 3),
                       "seconds_over_baseline": round(t_ours / t_blender, 2),
-                      "speedup_per_triangle": round((n_ours / t_ours) / (n_blender / t_blender), 2)}), flush=True)
+                      "speedup_per_triangle": round((n_ours / t_ours) / (n_blender / t_blender), 2),
+                      "measured_on": measured_on, "numpy_seconds": round(t_numpy, 4),
+                      "numpy_over_measured_on": round(t_numpy / t_ours, 2)}), flush=True)
     bpy.data.objects.remove(surface)
 
 

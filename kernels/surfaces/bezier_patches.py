@@ -37,6 +37,7 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
   tolerance.
 """
 
+import logging
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -44,7 +45,7 @@ import numpy as np
 
 from ..common import step_spacing, workers
 from ..common.budget import Estimate, check_budget
-from ..common.errors import InvalidInputError, OpenCLUnavailableError
+from ..common.errors import InvalidInputError, OpenCLUnavailableError, TesseraError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
 from ..common.rational_bezier import (
@@ -792,7 +793,7 @@ def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
     where one is set up, else numpy), "numpy", or "opencl" (`patch_deviation_opencl`; an error without such a
     device)."""
     h = check_patches(control)
-    runtime = _measuring_runtime(backend)
+    runtime = _measuring_runtime(backend, h.shape[1])
     parent = np.arange(len(h))
     box = np.broadcast_to(np.array([[0.0, 1.0], [0.0, 1.0]]), (len(h), 2, 2))
     for attempt in range(SPLIT_ROUNDS + 1):
@@ -811,15 +812,31 @@ def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
     return result
 
 
-def _measuring_runtime(backend):
-    """The OpenCL runtime that measures for `tessellate`'s ``backend``, or None (numpy)."""
+def _measuring_runtime(backend, k):
+    """The OpenCL runtime that measures for `tessellate`'s ``backend`` nets of k x k points, its program built, or
+    None (numpy). With "auto", a device without double precision, or whose compiler refuses the program, leaves the
+    measuring to numpy (the refusal logged once); with "opencl", either is an error."""
     runtime = backend_runtime(backend, "measuring Tessellate Surface's triangles")
-    if runtime is not None and not patch_deviation_opencl.supports(runtime):
+    if runtime is None:
+        return None
+    if not patch_deviation_opencl.supports(runtime):
         if backend == "opencl":
             raise OpenCLUnavailableError(f"The OpenCL device {runtime.description} has no double precision, which "
                                          "measuring the triangles needs; use the numpy backend")
         return None
+    try:
+        patch_deviation_opencl.build(runtime, k)
+    except TesseraError as err:
+        if backend == "opencl":
+            raise
+        _log_once(f"Tessera: measuring Tessellate Surface's triangles with numpy: {err}")
+        return None
     return runtime
+
+
+@lru_cache(maxsize=None)
+def _log_once(message):
+    logging.getLogger(__name__).warning(message)
 
 
 def _tessellate_once(h, lod, camera, budget_bytes, runtime=None):

@@ -3,11 +3,15 @@
 // references are `bezier_patches.grid_deviation` (cells of an inner grid) and `bezier_patches._deviation` (triangles
 // given one by one). Double precision throughout, as the references.
 //
-// Built with -DK=<k>: the nets are k x k homogeneous points (w x, w y, w z, w), degree K - 1 both ways.
+// The nets are K x K homogeneous points (w x, w y, w z, w), degree K - 1 both ways: K is 4 (bicubic, what the warm-up
+// builds) unless the build defines it (-DK=<k>, k from 2 to 7).
 
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
 
+#ifndef K
+#define K 4
+#endif
 #define DEGREE (K - 1)
 
 // Bernstein basis of degree K - 1 at t, by products of powers (as rational_bezier.bernstein).

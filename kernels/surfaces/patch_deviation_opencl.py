@@ -22,7 +22,13 @@ def supports(runtime):
 
 
 def _options(k):
-    return (f"-DK={int(k)}",)
+    """Build options for nets of k x k points: none for bicubic nets (the program as the warm-up builds it)."""
+    return () if int(k) == 4 else (f"-DK={int(k)}",)
+
+
+def build(runtime, k):
+    """Build the program for nets of k x k points now (raises `TesseraError` with the compiler's log)."""
+    runtime.program(PROGRAM, _options(k))
 
 
 def _upload(runtime, array, dtype):

@@ -99,3 +99,22 @@ def test_tessellations_on_many_threads_share_the_device(opencl):
         r = future.result(timeout=120)
         assert np.array_equal(r.mesh.positions, here.mesh.positions)
         assert np.array_equal(r.deviation, here.deviation)
+
+
+def test_a_program_the_device_refuses_leaves_the_measuring_to_numpy(opencl, monkeypatch, caplog):
+    from tessera.kernels.common.errors import TesseraError
+
+    def refuse(runtime, k):
+        raise TesseraError("OpenCL program surfaces/patch_deviation.cl failed to build: (a driver's log)")
+
+    monkeypatch.setattr(pd, "build", refuse)
+    bp._log_once.cache_clear()
+    h = bp.check_patches(teapot_patches()[0][:4])
+    lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-3)
+    with caplog.at_level("WARNING"):
+        r = bp.tessellate(h, lod)  # auto: numpy, said once
+        bp.tessellate(h, lod)
+    assert sum("with numpy" in m for m in caplog.messages) == 1
+    assert np.array_equal(r.mesh.positions, bp.tessellate(h, lod, backend="numpy").mesh.positions)
+    with pytest.raises(TesseraError, match="failed to build"):
+        bp.tessellate(h, lod, backend="opencl")
