@@ -239,12 +239,30 @@ def program_names():
     return sorted(f"{path.parent.name}/{path.stem}" for path in KERNELS_DIR.glob("*/*.cl"))
 
 
+#: A line of a program's source that names the build options of its other variants, separated by ``|``
+#: (``// build variants: -DK=3 | -DK=5``): programs specialised at build time, which the warm-up builds too.
+VARIANTS_LINE = "// build variants:"
+
+
+def program_variants():
+    """Every program shipped with the kernels as it is built without options, ``(name, ())``, and each variant its
+    source names on a `VARIANTS_LINE`, ``(name, (option, ...))``: what `warm_up` builds in the add-on."""
+    out = []
+    for name in program_names():
+        out.append((name, ()))
+        for line in _read_source(name).splitlines():
+            if line.startswith(VARIANTS_LINE):
+                out += [(name, tuple(v.split())) for v in line[len(VARIANTS_LINE):].split("|") if v.strip()]
+    return out
+
+
 def warm_up(names, stop=None):
-    """Create the runtime and build the programs ``names`` now, so that their first use does not wait for them.
+    """Create the runtime and build the programs ``names`` now, so that their first use does not wait for them: each
+    a name (built without options) or a ``(name, options)`` pair (`program_variants`).
 
     For a background thread: never raises (an unavailable device or a failing build is logged, and reported again
     by the first real use). Stops early when ``stop`` (a `threading.Event`) is set or `configure` changes the
-    settings meanwhile. Returns the names built (or found built).
+    settings meanwhile. Returns the names (or pairs) built (or found built).
     """
     try:
         runtime = get_runtime()
@@ -257,8 +275,9 @@ def warm_up(names, stop=None):
     for name in names:
         if (stop is not None and stop.is_set()) or _state["runtime"] is not runtime:
             break
+        program, options = (name, ()) if isinstance(name, str) else name
         try:
-            runtime.program(name)
+            runtime.program(program, options)
         except TesseraError as err:
             log.warning("Tessera OpenCL warm-up: %s", err)
             continue

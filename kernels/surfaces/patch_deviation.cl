@@ -3,8 +3,9 @@
 // references are `bezier_patches.grid_deviation` (cells of an inner grid) and `bezier_patches._deviation` (triangles
 // given one by one). Double precision throughout, as the references.
 //
-// The nets are K x K homogeneous points (w x, w y, w z, w), degree K - 1 both ways: K is 4 (bicubic, what the warm-up
-// builds) unless the build defines it (-DK=<k>, k from 2 to 7).
+// The nets are K x K homogeneous points (w x, w y, w z, w), degree K - 1 both ways: K is 4 (bicubic) unless the build
+// defines it (-DK=<k>, k from 2 to 7: patch_deviation_opencl._options). The warm-up builds each of them:
+// build variants: -DK=2 | -DK=3 | -DK=5 | -DK=6 | -DK=7
 
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF

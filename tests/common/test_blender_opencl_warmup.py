@@ -21,8 +21,9 @@ def test_warm_up_thread_builds_every_program_and_is_waited_for(bpy_module, addon
         assert not thread.is_alive()
         warmup.wait()  # what disabling the add-on does: nothing left to wait for
         runtime = runtime_module.get_runtime()
-        names = runtime_module.program_names()
-        assert {(name, ()) for name in names} <= set(runtime._programs)
+        variants = runtime_module.program_variants()
+        assert {(name, ()) for name in runtime_module.program_names()} <= set(variants)
+        assert set(variants) <= set(runtime._programs)
         runtime_module.configure(mode="require")  # a new runtime; disabling stops the thread between programs
         thread = warmup.start()
         warmup.wait()

@@ -203,6 +203,16 @@ def test_program_names_are_the_shipped_sources():
     assert all((opencl_runtime.KERNELS_DIR / f"{name}.cl").is_file() for name in names)
 
 
+def test_program_variants_are_every_program_and_the_variants_their_sources_name():
+    from tessera.kernels.surfaces import patch_deviation_opencl as pd
+
+    variants = opencl_runtime.program_variants()
+    assert [v for v in variants if v[1] == ()] == [(name, ()) for name in opencl_runtime.program_names()]
+    # every build Tessellate Surface's measuring asks for (nets of 2 to 7 points a side) is warmed up
+    assert {(pd.PROGRAM, pd._options(k)) for k in range(2, 8)} <= set(variants)
+    assert len(variants) == len(set(variants))
+
+
 @pytest.mark.opencl
 def test_warm_up_builds_every_shipped_program(opencl):
     """Every program the kernels ship builds on the device, and after `warm_up` asking for one builds nothing."""
@@ -212,6 +222,10 @@ def test_warm_up_builds_every_shipped_program(opencl):
     built = dict(runtime._programs)
     assert {(name, ()) for name in names} <= set(built)
     assert all(runtime.program(name) is built[(name, ())] for name in names)
+    variants = opencl_runtime.program_variants()  # the variants too: built, then found built
+    assert opencl_runtime.warm_up(variants) == variants
+    built = dict(runtime._programs)
+    assert all(runtime.program(name, options) is built[(name, options)] for name, options in variants)
 
 
 @pytest.mark.opencl
