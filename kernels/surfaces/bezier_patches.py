@@ -39,7 +39,7 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
 
 import logging
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 
@@ -47,6 +47,7 @@ from ..common import step_spacing, workers
 from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError, OpenCLUnavailableError, TesseraError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
+from ..common.opencl_runtime import backend_runtime
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
 from ..common.rational_bezier import (
     bernstein,
@@ -55,7 +56,6 @@ from ..common.rational_bezier import (
     chord_deviation,
     steps_for,
 )
-from ..common.opencl_runtime import backend_runtime
 from . import patch_deviation_opencl, patch_split
 
 METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
@@ -834,7 +834,7 @@ def _measuring_runtime(backend, k):
     return runtime
 
 
-@lru_cache(maxsize=None)
+@cache
 def _log_once(message):
     logging.getLogger(__name__).warning(message)
 
@@ -876,8 +876,8 @@ def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower, runt
     grids by tensor products (`grid_deviation`), the triangles along the patches' sides one by one
     (`rim_triangles`), each side's chords; each round measures again only the patches and sides whose levels
     changed (on ``runtime``'s OpenCL device where given). The measures are float64 and the mesh is stored in
-    float32: the levels aim under the tolerance by what storing it can move (`stored_error`). Returns (edge levels (E,), inner levels (P, 2), deviation (P,)
-    measured at them)."""
+    float32: the levels aim under the tolerance by what storing it can move (`stored_error`). Returns (edge levels
+    (E,), inner levels (P, 2), deviation (P,) measured at them)."""
     tol, top = lod.tolerance - stored_error(h), lod.max_level
     grid_dev = np.zeros((len(h), 3))
     side_dev = np.zeros(len(el))
@@ -1022,14 +1022,19 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
             at_u, at_v = t_u, t_v
         along_v = _contract_v(h[ps], at_v)
         along_dv = _contract_v_basis(h[ps], bernstein_derivative(at_v, deg))
-        grid = _plane_points(_contract_u(along_v, at_u))
-        g_u = _plane_points(_contract_u_basis(along_v, bernstein_derivative(at_u, deg)))
-        g_v = _plane_points(_contract_u(along_dv, at_u))
+        grid = _contract_u(along_v, at_u)  # coordinate planes (p, 4, V, U), and the derivatives'
+        g_u = _contract_u_basis(along_v, bernstein_derivative(at_u, deg))
+        g_v = _contract_u(along_dv, at_u)
         rows = in_first[ps][:, None] + np.arange((nu - 1) * (nv - 1))[None]
-        pts = cartesian(grid)
-        inner_pts[rows] = pts
-        w = grid[..., 3:]
-        inner_nrm[rows] = np.cross(g_u[..., :3] - pts * g_u[..., 3:], g_v[..., :3] - pts * g_v[..., 3:]) / (w * w)
+        w = grid[:, 3:]
+        pts = grid[:, :3] / w
+        inner_pts[rows] = _plane_points(pts)
+        # the normal dS/du x dS/dv (up to w², which the division puts back), plane by plane
+        a, b = g_u[:, :3] - pts * g_u[:, 3:], g_v[:, :3] - pts * g_v[:, 3:]
+        w2 = w[:, 0] * w[:, 0]
+        cross = np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                          a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+        inner_nrm[rows] = _plane_points(cross / w2[:, None])
         jj, ii = np.divmod(np.arange((nu - 1) * (nv - 1)), nu - 1)
         inner_uv[rows] = np.stack(np.broadcast_arrays(t_u[:, ii], t_v[:, jj]), -1)
 
@@ -1039,7 +1044,7 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side_uv, inner_uv])
     patch = np.concatenate([np.repeat(np.arange(n_p), 4), fp[e_of], p_of])
 
-    tris, tri_patch, tri_uv = [], [], []
+    tris, tri_patch, strip_uv = [], [], []  # the strips' corner (u, v); the cells' are their inner points'
     keys = np.concatenate([side_counts, n_in], axis=1)
     classes, inverse = np.unique(keys, axis=0, return_inverse=True)
     for cls, key in enumerate(classes):
@@ -1056,30 +1061,37 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
         tri_patch.append(np.repeat(ps, len(tmpl)))
         if spacing is None:
             tris.append(lmap[:, tmpl].reshape(-1, 3))
-            local_uv = _pattern_uv(tuple(int(x) for x in key))
-            tri_uv.append(np.broadcast_to(local_uv[tmpl], (len(ps),) + tmpl.shape + (2,)).reshape(-1, 3, 2))
+            on_rim = tmpl[(tmpl < sum(int(c) for c in key[:4])).any(axis=1)]  # a corner or a side's point in it
+            strip_uv.append(np.broadcast_to(_pattern_uv(tuple(int(x) for x in key))[on_rim],
+                                            (len(ps),) + on_rim.shape + (2,)).reshape(-1, 3, 2))
         else:
             local_uv = _spaced_pattern_uv(ps, key, edges, side_t, inner_uv[cols[-1] - base_i])
             strip, cells = _spaced_template(key, local_uv)
             own = strip.reshape(len(ps), -1)  # (p, 3S)
             tris.append(np.concatenate([np.take_along_axis(lmap, own, axis=1).reshape(len(ps), -1, 3),
                                         lmap[:, cells]], axis=1).reshape(-1, 3))
-            tri_uv.append(np.concatenate([
-                np.take_along_axis(local_uv, own[..., None], axis=1).reshape(len(ps), -1, 3, 2),
-                local_uv[:, cells]], axis=1).reshape(-1, 3, 2))
-    tris, tri_patch, tri_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(tri_uv)
+            strip_uv.append(np.take_along_axis(local_uv, own[..., None], axis=1).reshape(-1, 3, 2))
+    tris, tri_patch, strip_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(strip_uv)
+    # a cell's corners are all inner points (a strip's triangle has a corner or a side's point), which are never
+    # merged: its corners' (u, v) are theirs, taken once the triangles are known
+    is_cell = (tris >= base_i).all(axis=1)
     # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
     # of corners and side points (inner points are never merged)
     shared = n_c + len(edge_pts)
     _, first, inv = np.unique(positions[:shared], axis=0, return_index=True, return_inverse=True)
     remap = np.concatenate([first[inv.ravel()], np.arange(shared, len(positions))])
-    tris = remap[tris]
-    keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
-    tris, tri_patch, tri_uv = tris[keep], tri_patch[keep], tri_uv[keep]
-    if edges.collapsed.any():  # only the triangles with a corner on a pole move
-        near = np.flatnonzero(edges.collapsed[edges.edge].any(axis=1)[tri_patch]
-                              & (((tri_uv == 0) | (tri_uv == 1)).any(axis=(1, 2))))
-        tri_uv[near] = _pole_corners(tri_uv[near], edges.collapsed[edges.edge[tri_patch[near]]])
+    merged = remap[tris]
+    keep = (merged[:, 0] != merged[:, 1]) & (merged[:, 1] != merged[:, 2]) & (merged[:, 0] != merged[:, 2])
+    strip_uv = strip_uv[keep[~is_cell]]  # only strips flatten (at a pole)
+    if edges.collapsed.any():  # only the strips' triangles with a corner on a pole move
+        strip_patch = tri_patch[~is_cell & keep]
+        near = np.flatnonzero(edges.collapsed[edges.edge].any(axis=1)[strip_patch]
+                              & (((strip_uv == 0) | (strip_uv == 1)).any(axis=(1, 2))))
+        strip_uv[near] = _pole_corners(strip_uv[near], edges.collapsed[edges.edge[strip_patch[near]]])
+    uv32 = uv.astype(np.float32)
+    tri_uv = uv32[tris[keep][:, ::-1]]  # reversed, as the triangles are below; the strips' then set
+    tri_uv[np.flatnonzero(~is_cell[keep])] = strip_uv[:, ::-1]
+    tris, tri_patch = merged[keep], tri_patch[keep]
     used = np.zeros(len(positions), bool)
     used[tris.ravel()] = True
     new_id = np.cumsum(used) - 1
@@ -1098,7 +1110,7 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     normals = np.concatenate([normals, inner_nrm / np.where(length > 0, length, 1.0)[:, None]])
     # Blender's orientation: the pattern's counter-clockwise (u, v) triangles reversed, the normals along dS/dv x dS/du
     return PatchMesh(positions[used].astype(np.float32), new_id[tris[:, ::-1]].astype(np.int32),
-                     uv[used].astype(np.float32), patch[used], tri_patch, tri_uv[:, ::-1].astype(np.float32),
+                     uv32[used], patch[used], tri_patch, tri_uv,
                      -normals[used].astype(np.float32))
 
 
