@@ -185,26 +185,30 @@ def surface_patches(points, u, v, what="surface"):
     Returns (patches (Su * Sv, ku, kv, 4) homogeneous, patch[i, j] the point i along u and j along v; grid (Su, Sv)
     shape of the patches, patch q at (q // Sv, q % Sv); spans (Su, 2) and (Sv, 2))."""
     p = check_points(points, what)
-    nv, nu = p.shape[:2]
-    ku_knots = direction_knots(nu, u, what)
-    kv_knots = direction_knots(nv, v, what)
-    h = wrap_cyclic(wrap_cyclic(homogeneous(p), u.order, u.cyclic, axis=1), v.order, v.cyclic, axis=0)
-    mv, mu = h.shape[:2]
-    # along u: every row at once, the rows' coordinates side by side
-    rows = h.transpose(1, 0, 2).reshape(mu, mv * 4)
-    pu, span_u = bezier_pieces(rows, ku_knots, u.order)  # (Su, ku, mv * 4)
+    knots = direction_knots(p.shape[1], u, what), direction_knots(p.shape[0], v, what)
+    patches, grid, span_u, span_v = _batch_patches(homogeneous(p)[None], u, v, *knots)
+    return patches[0], grid, span_u, span_v
+
+
+def _batch_patches(h, u, v, ku_knots, kv_knots):
+    """`surface_patches` of B splines that share their shape and directions at once: homogeneous points h
+    (B, nv, nu, 4) -> (patches (B, Su * Sv, ku, kv, 4), grid, spans). Each coordinate column goes through the knot
+    insertions on its own, so a spline's patches are bitwise those it has alone."""
+    h = wrap_cyclic(wrap_cyclic(h, u.order, u.cyclic, axis=2), v.order, v.cyclic, axis=1)
+    n, mv, mu = h.shape[:3]
+    # along u: every row of every spline at once, the rows' coordinates side by side
+    rows = h.transpose(2, 0, 1, 3).reshape(mu, n * mv * 4)
+    pu, span_u = bezier_pieces(rows, ku_knots, u.order)  # (Su, ku, B * mv * 4)
     if u.cyclic:
         pu[-1, -1] = pu[0, 0]
     su = len(pu)
-    cols = pu.reshape(su * u.order, mv, 4).transpose(1, 0, 2).reshape(mv, su * u.order * 4)
-    pv, span_v = bezier_pieces(cols, kv_knots, v.order)  # (Sv, kv, Su * ku * 4)
+    cols = pu.reshape(su * u.order, n, mv, 4).transpose(2, 1, 0, 3).reshape(mv, n * su * u.order * 4)
+    pv, span_v = bezier_pieces(cols, kv_knots, v.order)  # (Sv, kv, B * Su * ku * 4)
     if v.cyclic:
         pv[-1, -1] = pv[0, 0]
     sv = len(pv)
-    patches = pv.reshape(sv, v.order, su, u.order, 4).transpose(2, 0, 3, 1, 4).reshape(su * sv, u.order, v.order, 4)
-    return patches, (su, sv), span_u, span_v
-
-
+    patches = pv.reshape(sv, v.order, n, su, u.order, 4).transpose(2, 3, 0, 4, 1, 5)
+    return patches.reshape(n, su * sv, u.order, v.order, 4), (su, sv), span_u, span_v
 
 
 def degree_elevate(pieces, degree):
@@ -265,10 +269,22 @@ def patches_of(splines, numbers=None):
     if not splines:
         raise InvalidInputError("There is no surface spline to tessellate")
     numbers = range(len(splines)) if numbers is None else numbers
-    parts, owner, boxes = [], [], []
+    # each spline checked on its own (a refusal names it); splines of one shape and the same directions (a model of
+    # many Bézier patches) then go through the knot insertions together
+    groups = {}
     for i, sp in enumerate(splines):
-        patches, (su, sv), span_u, span_v = surface_patches(sp.points, sp.u, sp.v,
-                                                            what=f"surface spline {numbers[i]}")
+        what = f"surface spline {numbers[i]}"
+        p = check_points(sp.points, what)
+        knots = direction_knots(p.shape[1], sp.u, what), direction_knots(p.shape[0], sp.v, what)
+        groups.setdefault((p.shape, sp.u, sp.v), (knots, []))[1].append((i, homogeneous(p)))
+    made = {}
+    for (_, u, v), (knots, members) in groups.items():
+        patches, grid, span_u, span_v = _batch_patches(np.stack([h for _, h in members]), u, v, *knots)
+        for (i, _), own in zip(members, patches, strict=True):
+            made[i] = own, grid, span_u, span_v
+    parts, owner, boxes = [], [], []
+    for i in range(len(splines)):
+        patches, (su, sv), span_u, span_v = made[i]
         parts.append(patches)
         owner.append(np.full(len(patches), i, np.int64))
         nu = (span_u - span_u[0, 0]) / (span_u[-1, 1] - span_u[0, 0])
