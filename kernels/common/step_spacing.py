@@ -40,24 +40,25 @@ def bend_density(points):
 
 def params(cum, n):
     """Parameters (S, n + 1) of n steps of each spacing table cum (S, M + 1): from exactly 0 to exactly 1."""
-    y = np.arange(n + 1) / n
     cum = np.asarray(cum, np.float64)
-    m = cum.shape[1] - 1
-    idx = np.clip((cum[:, None, :] <= y[None, :, None]).sum(axis=2) - 1, 0, m - 1)  # (S, n + 1)
-    c0 = np.take_along_axis(cum, idx, axis=1)
-    c1 = np.take_along_axis(cum, idx + 1, axis=1)
-    t = (idx + (y[None] - c0) / (c1 - c0)) / m
-    t[:, 0], t[:, -1] = 0.0, 1.0
-    return np.clip(t, 0.0, 1.0)
+    return padded_params(cum, np.full(len(cum), int(n)))
 
 
 def padded_params(cum, counts):
     """Each table's parameters at its own step count: cum (S, M + 1), counts (S,) int -> (S, max count + 1)
-    float64, each row from 0 to 1 in counts[s] steps, padded with 1 past its end."""
+    float64, each row from 0 to 1 in counts[s] steps, padded with 1 past its end. All rows at once: the share
+    i / n each step reaches, found in its table's cumulative shares, and the parameter interpolated in that
+    part."""
+    cum = np.asarray(cum, np.float64)
     counts = np.asarray(counts, np.int64)
-    out = np.ones((len(counts), int(counts.max(initial=1)) + 1))
-    for n in np.unique(counts):
-        rows = np.flatnonzero(counts == n)
-        out[rows, :n + 1] = params(cum[rows], int(n))
-    return out
-
+    top = int(counts.max(initial=1))
+    m = cum.shape[1] - 1
+    i = np.arange(top + 1)[None]
+    y = i / np.maximum(counts, 1)[:, None]  # (S, top + 1): the shares i / n
+    idx = np.clip((cum[:, None, :] <= y[:, :, None]).sum(axis=2) - 1, 0, m - 1)
+    c0 = np.take_along_axis(cum, idx, axis=1)
+    c1 = np.take_along_axis(cum, idx + 1, axis=1)
+    t = (idx + (y - c0) / (c1 - c0)) / m
+    t[:, 0] = 0.0
+    t = np.where(i >= counts[:, None], 1.0, t)  # each row's last point exactly 1, and past it
+    return np.clip(t, 0.0, 1.0)

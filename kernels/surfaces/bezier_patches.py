@@ -1147,17 +1147,20 @@ def _spaced_pattern_uv(ps, key, edges, side_t, inner):
     """(u, v) (p, L, 2) of each local vertex of the pattern of class key for patches ps (p,) whose steps are
     spaced: corners, each side's points at its edge's parameters (side_t (E, ·), canonical direction) read in the
     patch's direction, and the inner points' (u, v) inner (p, (n - 1)(m - 1), 2)."""
-    parts = [np.broadcast_to(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64), (len(ps), 4, 2))]
-    for side in range(4):
-        c = int(key[side])
+    counts = [int(c) for c in key[:4]]
+    out = np.empty((len(ps), sum(counts) + inner.shape[1], 2))
+    out[:, :4] = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    start = 4
+    for side, c in enumerate(counts):
         e, r = edges.edge[ps, side], edges.reversed[ps, side]
         q = np.arange(1, c)[None]
         t = side_t[e[:, None], np.where(r[:, None], c - q, q)]
-        t = np.where(r[:, None], 1.0 - t, t)
-        fixed = np.full_like(t, 1.0 if side in (1, 2) else 0.0)
-        parts.append(np.stack([t, fixed] if side in (0, 2) else [fixed, t], axis=-1))
-    parts.append(inner)
-    return np.concatenate(parts, axis=1)
+        along, fixed = (0, 1) if side in (0, 2) else (1, 0)  # BOTTOM, TOP run along u; RIGHT, LEFT along v
+        out[:, start:start + c - 1, along] = np.where(r[:, None], 1.0 - t, t)
+        out[:, start:start + c - 1, fixed] = 1.0 if side in (1, 2) else 0.0
+        start += c - 1
+    out[:, start:] = inner
+    return out
 
 
 def _pole_corners(tri_uv, collapsed):
