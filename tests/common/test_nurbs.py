@@ -150,6 +150,25 @@ def test_bad_splines_are_refused_with_the_reason(points, direction, words):
         nb.curve_pieces(points, direction)
 
 
+def test_splines_of_one_shape_converted_together_equal_each_alone_and_a_bad_one_is_named():
+    rng = np.random.default_rng(9)
+    u, v = nb.Direction(4, "UNIFORM", True), nb.Direction(3, "ENDPOINT")
+    same = [nb.SurfaceSpline(np.concatenate([rng.normal(size=(4, 6, 3)), rng.uniform(.5, 2, (4, 6, 1))], 2), u, v)
+            for _ in range(3)]
+    other = nb.SurfaceSpline(np.concatenate([rng.normal(size=(3, 5, 3)), np.ones((3, 5, 1))], 2),
+                             nb.Direction(3, "ENDPOINT"), nb.Direction(2, "UNIFORM"))
+    splines = [same[0], other, same[1], same[2]]  # a group interleaved with another shape
+    together = nb.patches_of(splines)
+    for i, sp in enumerate(splines):
+        alone = nb.patches_of([sp, other] if i != 1 else [other, same[0]])  # the same degree as together
+        mine = together.patches[together.spline == i]
+        assert np.array_equal(mine, alone.patches[alone.spline == 0])  # bit for bit
+        assert np.array_equal(together.box[together.spline == i], alone.box[alone.spline == 0])
+    bad = nb.SurfaceSpline(same[2].points.copy(), u, v)
+    bad.points[1, 2, 3] = 0.0
+    with pytest.raises(InvalidInputError, match="surface spline 3 has weights of zero"):
+        nb.patches_of([same[0], other, same[1], bad])
+
 def test_tolerance_steps_meet_the_tolerance_measured_densely():
     rng = np.random.default_rng(11)
     pieces, _ = nb.curve_pieces(np.c_[rng.normal(size=(9, 3)) * 3, rng.uniform(0.2, 5.0, 9)],
