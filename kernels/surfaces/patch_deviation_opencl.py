@@ -98,39 +98,31 @@ def triangle_deviation(runtime, h, corners, uv, patch, points):
     """The largest distance of each triangle from its patch at barycentric ``points`` (S, 3), as
     `bezier_patches._deviation` measures it: nets h (P, k, k, 4) float64, corners (T, 3, 3), their (u, v)
     (T, 3, 2), patch (T,) -> (T,) float64."""
-    cl, queue = runtime.cl, runtime.queue
-    n = len(corners)
-    out = np.empty(n)
-    if n == 0:
-        return out
-    kernel = runtime.kernel(PROGRAM, "triangles", _options(h.shape[1]))
-    nets, bary = _upload(runtime, h, np.float64), _upload(runtime, points, np.float64)
-    for first in range(0, n, CHUNK):
-        last = min(first + CHUNK, n)
-        res = runtime.buffer(cl.mem_flags.WRITE_ONLY, (last - first) * 8)
-        kernel(queue, (last - first,), LOCAL, nets, _upload(runtime, corners[first:last], np.float64),
-               _upload(runtime, uv[first:last], np.float64), _upload(runtime, patch[first:last], np.int64), bary,
-               np.int32(len(points)), np.int64(last - first), res)
-        cl.enqueue_copy(queue, out[first:last], res)
-    queue.finish()
-    return out
+    return _per_item(runtime, "triangles", h, np.empty(len(corners)),
+                     [(corners, np.float64), (uv, np.float64), (patch, np.int64)],
+                     (_upload(runtime, points, np.float64), np.int32(len(points))))
 
 
 def points(runtime, h, uv, patch):
     """Points of the surface, as `bezier_patches.evaluate` gives them: nets h (P, k, k, 4) float64, (u, v)
     (N, 2) on patches patch (N,) -> (N, 3) float64."""
+    return _per_item(runtime, "points", h, np.empty((len(uv), 3)), [(uv, np.float64), (patch, np.int64)])
+
+
+def _per_item(runtime, name, h, out, items, extra=()):
+    """Kernel ``name`` launched with one work-item an item, at most CHUNK items a launch: its arguments the nets
+    h, each of ``items`` ((array (N, ...), dtype)) sliced to the launch's items, ``extra`` (buffers and scalars
+    shared by all), the count, and the result, copied into out (N, ...) float64."""
     cl, queue = runtime.cl, runtime.queue
-    n = len(uv)
-    out = np.empty((n, 3))
-    if n == 0:
+    if len(out) == 0:
         return out
-    kernel = runtime.kernel(PROGRAM, "points", _options(h.shape[1]))
+    kernel = runtime.kernel(PROGRAM, name, _options(h.shape[1]))
     nets = _upload(runtime, h, np.float64)
-    for first in range(0, n, CHUNK):
-        last = min(first + CHUNK, n)
-        res = runtime.buffer(cl.mem_flags.WRITE_ONLY, (last - first) * 3 * 8)
-        kernel(queue, (last - first,), LOCAL, nets, _upload(runtime, uv[first:last], np.float64),
-               _upload(runtime, patch[first:last], np.int64), np.int64(last - first), res)
+    for first in range(0, len(out), CHUNK):
+        last = min(first + CHUNK, len(out))
+        res = runtime.buffer(cl.mem_flags.WRITE_ONLY, out[first:last].nbytes)
+        kernel(queue, (last - first,), LOCAL, nets, *(_upload(runtime, a[first:last], t) for a, t in items), *extra,
+               np.int64(last - first), res)
         cl.enqueue_copy(queue, out[first:last], res)
     queue.finish()
     return out
