@@ -3,9 +3,9 @@
 Without it, the first tubes, brush stroke, terrain, Loop or Tessellate Surface run of a session waits for the device
 to be chosen and each of its programs (and their variants: `opencl_runtime.program_variants`) to be built (0.2 s for
 the context and 0.06-0.08 s a program from pyopencl's cache; 0.2-1.4 s a program after an install or an update, when
-the cache is cold). Register only schedules the warm-up: a
-timer starts the thread a second after registration, in the UI alone (background and `bpy` module runs have no
-event loop to fire it, and a script's first operator would only wait for the same work). The build releases the
+the cache is cold). Register only schedules the warm-up: a timer starts the thread a second after registration, in
+the UI alone (background and `bpy` module runs have no event loop to fire it, and a script's first operator would
+only wait for the same work). The build releases the
 GIL, so the interface does not stall. A thread still building when the add-on is disabled or Blender quits is
 stopped between programs and waited for (a build in flight is finished, never abandoned inside the driver).
 """

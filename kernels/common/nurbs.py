@@ -184,10 +184,16 @@ def surface_patches(points, u, v, what="surface"):
     points: (nv, nu, 4) Cartesian + weight (row b holds the nu points along u at the b-th v); u, v: `Direction`.
     Returns (patches (Su * Sv, ku, kv, 4) homogeneous, patch[i, j] the point i along u and j along v; grid (Su, Sv)
     shape of the patches, patch q at (q // Sv, q % Sv); spans (Su, 2) and (Sv, 2))."""
-    p = check_points(points, what)
-    knots = direction_knots(p.shape[1], u, what), direction_knots(p.shape[0], v, what)
+    p, knots = _checked_surface(points, u, v, what)
     patches, grid, span_u, span_v = _batch_patches(homogeneous(p)[None], u, v, *knots)
     return patches[0], grid, span_u, span_v
+
+
+def _checked_surface(points, u, v, what):
+    """A surface spline's points (nv, nu, 4) checked (`check_points`) and its knots along u and v
+    (`direction_knots`): refusals name it as ``what``."""
+    p = check_points(points, what)
+    return p, (direction_knots(p.shape[1], u, what), direction_knots(p.shape[0], v, what))
 
 
 def _batch_patches(h, u, v, ku_knots, kv_knots):
@@ -273,9 +279,7 @@ def patches_of(splines, numbers=None):
     # many Bézier patches) then go through the knot insertions together
     groups = {}
     for i, sp in enumerate(splines):
-        what = f"surface spline {numbers[i]}"
-        p = check_points(sp.points, what)
-        knots = direction_knots(p.shape[1], sp.u, what), direction_knots(p.shape[0], sp.v, what)
+        p, knots = _checked_surface(sp.points, sp.u, sp.v, f"surface spline {numbers[i]}")
         groups.setdefault((p.shape, sp.u, sp.v), (knots, []))[1].append((i, homogeneous(p)))
     made = {}
     for (_, u, v), (knots, members) in groups.items():
