@@ -12,5 +12,12 @@ class Sidebar:
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
+        ob = active_object(context)
         return ob is not None and ob.type in cls.object_types
+
+
+def active_object(context):
+    """The view layer's active object, hidden or not: a hidden object keeps its panels (its preview and settings stay
+    reachable), where ``context.active_object`` is None."""
+    view_layer = getattr(context, "view_layer", None)
+    return view_layer.objects.active if view_layer is not None else context.active_object

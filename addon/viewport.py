@@ -8,6 +8,12 @@
   the 3D viewports to redraw.
 - `clear_previews` forgets every preview's uploads, the compiled shaders and the pattern batches (one place;
   the add-on calls it when it is disabled).
+- A preview that stands for its object's surface (tessellation, Loop) is drawn *instead of* the object, as a
+  modifier's result is: while it is on, `sync_source` gives the object a last, viewport-only modifier
+  (`SOURCE_MODIFIER`) that hands Blender the evaluated geometry as one instance of zero size, so Blender draws none
+  of the object's faces or wires, while its edit cage (the modifier is off in Edit Mode), its modifier stack and
+  renders stay as they were. `source_mesh` reads the evaluated mesh back from that instance. The modifier is added
+  and removed only by `sync_source` (from the preview switches, file loads and saves: saved files never hold it).
 """
 
 from dataclasses import dataclass, field
@@ -45,9 +51,12 @@ def unsubscribe(topic, callback):
 
 
 def invalidate(topic, owner):
-    """Settings of ``topic`` changed on ``owner``: tell the subscribers, then redraw."""
+    """Settings of ``topic`` changed on ``owner``: tell the subscribers, give or take the object's
+    `SOURCE_MODIFIER` (a preview switched on or off), then redraw."""
     for callback in tuple(_subscribers.get(topic, ())):
         callback(owner)
+    if isinstance(owner, bpy.types.Object):
+        sync_source(owner)
     tag_view3d_redraw()
 
 
@@ -141,6 +150,158 @@ class PreviewCache:
                     self._drop(uid)
 
 
+# --- the source a preview stands for -------------------------------------------------------------------------
+
+#: The modifier that keeps Blender from drawing an object while a preview stands for it, and its node group.
+SOURCE_MODIFIER = "Tessera Preview"
+SOURCE_GROUP = ".Tessera Preview Source"
+_GROUP_TAG = "tessera_preview_source"
+
+
+def _source_group():
+    """The node group of `SOURCE_MODIFIER`: the geometry as one instance scaled to zero (made once per file)."""
+    group = bpy.data.node_groups.get(SOURCE_GROUP)
+    if group is not None and group.get(_GROUP_TAG):
+        return group
+    group = bpy.data.node_groups.new(SOURCE_GROUP, "GeometryNodeTree")
+    group[_GROUP_TAG] = 1
+    group.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes, links = group.nodes, group.links
+    source, result = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    instance = nodes.new("GeometryNodeGeometryToInstance")
+    scale = nodes.new("GeometryNodeScaleInstances")
+    scale.inputs["Scale"].default_value = (0.0, 0.0, 0.0)
+    links.new(source.outputs[0], instance.inputs[0])
+    links.new(instance.outputs[0], scale.inputs[0])
+    links.new(scale.outputs[0], result.inputs[0])
+    return group
+
+
+def stands_for(ob):
+    """True when a preview that stands for ``ob``'s surface is on for it."""
+    return any(p.replaces is not None and p.replaces(ob) for p in _previews)
+
+
+def sync_source(ob):
+    """Give ``ob`` the `SOURCE_MODIFIER` exactly while a preview stands for it (last in its stack, viewport only,
+    off in Edit Mode); remove it otherwise. Returns True when something changed."""
+    if getattr(ob, "type", None) != "MESH" or ob.library is not None:
+        return False
+    mod = ob.modifiers.get(SOURCE_MODIFIER)
+    want = stands_for(ob) and not bpy.app.background
+    if want and mod is None:
+        mod = ob.modifiers.new(SOURCE_MODIFIER, "NODES")
+        mod.node_group = _source_group()
+        mod.show_render = False
+        mod.show_in_editmode = False
+        mod.show_expanded = False
+        return True
+    if want and ob.modifiers[-1] != mod:  # the user added a modifier after it: it stays last
+        ob.modifiers.move(list(ob.modifiers).index(mod), len(ob.modifiers) - 1)
+        return True
+    if not want and mod is not None:
+        ob.modifiers.remove(mod)
+        return True
+    return False
+
+
+def source_mesh(ob, depsgraph):
+    """The mesh a preview of ``ob`` reads: its evaluated mesh with its modifiers (as the operators read it), from
+    the zero-size instance of `SOURCE_MODIFIER` when that is on. Returns ``(mesh, release)``; call ``release()``
+    when done reading."""
+    evaluated = ob.evaluated_get(depsgraph)
+    if ob.modifiers.get(SOURCE_MODIFIER) is not None:
+        for instance in depsgraph.object_instances:
+            if instance.is_instance and instance.parent is not None and instance.parent.original == ob \
+                    and instance.object.type == "MESH":
+                return instance.object.data, lambda: None
+    return evaluated.to_mesh(), evaluated.to_mesh_clear
+
+
+def previewed_objects(context, wanted):
+    """The objects of this viewport a preview draws: visible here (not hidden, in Local View when it is on), in
+    Object Mode, and ``wanted(ob)``."""
+    space = context.space_data
+    for ob in context.view_layer.objects:
+        if ob.mode == "EDIT" or not wanted(ob):
+            continue
+        if ob.visible_get(view_layer=context.view_layer, viewport=space):
+            yield ob
+
+
+@dataclass
+class PreviewStyle:
+    """How one object's preview is drawn in this view: ``alpha`` of its surface (below 1 in X-ray) and
+    ``wire_color`` (rgba, linear) of its wire, or None when no wire is drawn."""
+
+    alpha: float = 1.0
+    wire_color: tuple | None = None
+
+    def surface_color(self, rgba):
+        return (*rgba[:3], rgba[3] * self.alpha)
+
+
+def _linear(rgb):
+    """The theme's sRGB colour in the viewport's linear space."""
+    c = [float(v) for v in rgb[:3]]
+    return tuple(v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4 for v in c)
+
+
+class preview_state:  # noqa: N801 -- used as ``with preview_state(context, ob) as style``
+    """The GPU state and `PreviewStyle` of ``ob``'s preview as the viewport draws objects: see-through in X-ray (its
+    alpha, no depth writes), its wire in Wireframe shading, with the Wireframe overlay or the object's own Wireframe
+    display, in the theme's wire colour (selected and active as Blender draws them)."""
+
+    def __init__(self, context, ob):
+        space = context.space_data
+        shading = space.shading
+        wireframe = shading.type == "WIREFRAME"
+        xray = shading.show_xray_wireframe if wireframe else shading.show_xray
+        self.style = PreviewStyle(alpha=(shading.xray_alpha_wireframe if wireframe else shading.xray_alpha)
+                                  if xray else 1.0)
+        overlay = space.overlay
+        if wireframe or (overlay.show_overlays and (overlay.show_wireframes or ob.show_wire)):
+            theme = context.preferences.themes[0].view_3d
+            if ob.select_get():
+                rgb = theme.object_active if ob == context.view_layer.objects.active else theme.object_selected
+            else:
+                rgb = theme.wire
+            self.style.wire_color = (*_linear(rgb), 1.0)
+        self.xray = xray
+
+    def __enter__(self):
+        import gpu
+
+        if self.xray:
+            gpu.state.blend_set("ALPHA")
+            gpu.state.depth_mask_set(False)
+        return self.style
+
+    def __exit__(self, *exc):
+        import gpu
+
+        if self.xray:
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_mask_set(True)
+        return False
+
+
+@bpy.app.handlers.persistent
+def _sync_all(*_args):
+    """After a file loads: the modifier where previews are on. Before a save: none (a file never holds one)."""
+    for ob in bpy.data.objects:
+        sync_source(ob)
+
+
+@bpy.app.handlers.persistent
+def _strip_all(*_args):
+    for ob in bpy.data.objects:
+        mod = ob.modifiers.get(SOURCE_MODIFIER) if ob.type == "MESH" and ob.library is None else None
+        if mod is not None:
+            ob.modifiers.remove(mod)
+
+
 # --- previews ------------------------------------------------------------------------------------------------
 
 def _view_draw(preview):
@@ -178,11 +339,13 @@ class Preview:
 
     draw(context, region, view, projection): draws every object it previews; data_types: data-block types whose
     edits drop an object's upload (depsgraph); topic: the settings topic whose changes call ``on_settings(ob)``
-    (default: forget ``ob``'s upload).
+    (default: forget ``ob``'s upload); replaces(ob): the preview is on for ``ob`` and is drawn instead of it
+    (`sync_source`).
     """
 
-    def __init__(self, draw, data_types=(), topic=None, on_settings=None):
+    def __init__(self, draw, data_types=(), topic=None, on_settings=None, replaces=None):
         self.draw, self.data_types, self.topic = draw, tuple(data_types), topic
+        self.replaces = replaces  # replaces(ob): True when the preview stands for ob's surface (`sync_source`)
         self.on_settings = on_settings or self.forget
         self.cache = PreviewCache()
         self._handler = None
@@ -226,6 +389,9 @@ class Preview:
             _previews.append(self)
         if _on_depsgraph not in bpy.app.handlers.depsgraph_update_post:
             bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph)
+        for handlers, handler in _FILE_HANDLERS:
+            if handler not in handlers:
+                handlers.append(handler)
         if self.topic is not None:
             subscribe(self.topic, self.on_settings)
         if not bpy.app.background and self._handler is None:
@@ -243,6 +409,14 @@ class Preview:
             _previews.remove(self)
         if not _previews and _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
             bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
+        if not _previews:
+            for handlers, handler in _FILE_HANDLERS:
+                if handler in handlers:
+                    handlers.remove(handler)
+
+
+_FILE_HANDLERS = ((bpy.app.handlers.load_post, _sync_all), (bpy.app.handlers.save_pre, _strip_all),
+                  (bpy.app.handlers.save_post, _sync_all))
 
 
 def stopped_previews():
@@ -262,5 +436,7 @@ def register():
 
 
 def unregister():
+    if not bpy.app.background:
+        _strip_all()
     clear_previews()
     _subscribers.clear()

@@ -5,6 +5,8 @@ buffer and returns the pixels as numpy; with ``lit=False`` every pixel of the me
 ``color``, which makes silhouette and crack comparisons exact.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..kernels.common.tolerances import FLOAT32_TINY
@@ -12,9 +14,32 @@ from . import loader
 
 #: The view and shading constants every drawing shader shares, as the uniform buffer ``shading`` (std140, every member
 #: a whole vec4 or mat4): the push constants stay within the 128 bytes Vulkan and Metal guarantee. GLSL reads
-#: ``shading.view_projection``, ``shading.color``, ``shading.light_dir.xyz``, ``shading.lit_range.xy``.
+#: ``shading.view_projection``, ``shading.color``, ``shading.light_dir.xyz``, ``shading.lit_range`` (x, y: the check
+#: shade; z: studio lighting on; w: orthographic view) and, for studio lighting (`ViewLighting`), ``model_view`` and
+#: ``normal_matrix`` (object to view space), ``material`` (roughness, metallic), ``ambient`` (rgb; a: specular on) and
+#: the four lights' ``light_direction``, ``light_diffuse`` (rgb; a: wrap) and ``light_specular``.
 VIEW_STRUCT = ("struct TesseraView {\n  mat4 view_projection;\n  vec4 color;\n  vec4 light_dir;\n  vec4 lit_range;\n"
-               "};\n")
+               "  mat4 model_view;\n  mat4 normal_matrix;\n  vec4 material;\n  vec4 ambient;\n"
+               "  vec4 light_direction[4];\n  vec4 light_diffuse[4];\n  vec4 light_specular[4];\n};\n")
+_BLOCK_FLOATS = 16 + 4 * 3 + 16 * 2 + 4 * 2 + 4 * 12
+
+
+@dataclass(frozen=True)
+class ViewLighting:
+    """How the viewport lights objects, for a preview drawn instead of one (`addon.viewport_lighting` reads it from
+    the 3D view): model_view (4, 4) row-major, object to view space; lights: up to four ``(direction (3,) toward the
+    light in view space, diffuse rgb, specular rgb, wrap)``; ambient rgb; roughness, metallic of the object's surface;
+    specular: the highlights are on; orthographic: the view is."""
+
+    model_view: tuple
+    lights: tuple
+    ambient: tuple = (0.0, 0.0, 0.0)
+    roughness: float = 0.4
+    metallic: float = 0.0
+    specular: bool = True
+    orthographic: bool = False
+
+
 HEADLIGHT = (0.3, -0.5, 0.81)
 
 
@@ -24,38 +49,60 @@ def add_view_block(info):
     info.uniform_buf(0, "TesseraView", "shading")
 
 
-def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT, lit_range=(1.0, 0.0)):
-    """The ``shading`` uniform buffer for these values; view_projection (4, 4) row-major."""
-    data = np.zeros(28, np.float32)
+def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT, lit_range=(1.0, 0.0),
+               lighting=None):
+    """The ``shading`` uniform buffer for these values; view_projection (4, 4) row-major; lighting: a
+    `ViewLighting` (studio lighting as the viewport's, in place of the check shade) or None."""
+    data = np.zeros(_BLOCK_FLOATS, np.float32)
     data[:16] = np.asarray(view_projection, np.float32).T.ravel()  # GLSL's matrices are column-major
     data[16:20] = color
     data[20:23] = light_dir
     data[24:26] = lit_range
+    if lighting is not None:
+        model_view = np.asarray(lighting.model_view, np.float64)
+        normal = np.eye(4)
+        det = np.linalg.det(model_view[:3, :3])
+        normal[:3, :3] = np.linalg.inv(model_view[:3, :3]).T if abs(det) > 1e-30 else model_view[:3, :3]
+        data[26:28] = (1.0, 1.0 if lighting.orthographic else 0.0)
+        data[28:44] = model_view.astype(np.float32).T.ravel()
+        data[44:60] = normal.astype(np.float32).T.ravel()
+        data[60:62] = (lighting.roughness, lighting.metallic)
+        data[64:67] = lighting.ambient
+        data[67] = 1.0 if lighting.specular else 0.0
+        for i, (direction, diffuse, specular, wrap) in enumerate(lighting.lights[:4]):
+            data[68 + 4 * i:71 + 4 * i] = direction
+            data[84 + 4 * i:87 + 4 * i] = diffuse
+            data[87 + 4 * i] = wrap
+            data[100 + 4 * i:103 + 4 * i] = specular
     return loader.block(data)
 
 
 def shaded_create_info(name, *vertex_files):
-    """A create-info with the shading every Tessera check shader shares: a ``shade`` varying, the ``shading``
-    uniform buffer (`add_view_block`) and ``flat_mesh_frag.glsl``. The vertex stage is ``vertex_files`` joined in
-    order. The caller adds its vertex inputs, push constants and samplers."""
+    """A create-info with the shading every Tessera check shader shares: ``shade``, ``view_normal`` and
+    ``view_position`` varyings (the vertex stage writes all three), the ``shading`` uniform buffer (`add_view_block`)
+    and ``flat_mesh_frag.glsl`` with ``solid_light.glsl``. The vertex stage is ``vertex_files`` joined in order.
+    The caller adds its vertex inputs, push constants and samplers."""
     import gpu
 
     iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
     iface.smooth("FLOAT", "shade")
+    iface.smooth("VEC3", "view_normal")
+    iface.smooth("VEC3", "view_position")
     info = gpu.types.GPUShaderCreateInfo()
     add_view_block(info)
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
     info.vertex_source(loader.sources(*vertex_files))
-    info.fragment_source(loader.source("flat_mesh_frag.glsl"))
+    info.fragment_source(loader.sources("solid_light.glsl", "flat_mesh_frag.glsl"))
     return info
 
 
-def set_shading(shader, view_projection, color, lit):
-    """Bind ``shader`` and its shared ``shading`` block; view_projection: (4, 4) row-major."""
+def set_shading(shader, view_projection, color, lit, lighting=None):
+    """Bind ``shader`` and its shared ``shading`` block; view_projection: (4, 4) row-major; lighting: a
+    `ViewLighting` to light as the viewport does (when ``lit``), or None for the check shade."""
     shader.bind()
     shader.uniform_block("shading", view_block(view_projection, tuple(color), HEADLIGHT,
-                                               (0.25, 0.75) if lit else (1.0, 0.0)))
+                                               (0.25, 0.75) if lit else (1.0, 0.0), lighting if lit else None))
 
 
 def _describe_flat_mesh():

@@ -30,7 +30,7 @@ class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
     bl_idname = "tessera.displacement_brush"
     bl_label = "Displacement Brush"
     bl_description = "Paint the active object's displacement map (Tessera)"
-    bl_icon = "brush.sculpt.draw"
+    bl_icon = "brush.sculpt.displacement_smear"  # in every supported Blender (4.2 to 5.2)
     bl_widget = "TESSERA_GGT_brush_cursor"  # the ring follows the mouse before and between strokes
     bl_keymap = (
         ("tessera.displacement_stroke", {"type": "LEFTMOUSE", "value": "PRESS"}, None),

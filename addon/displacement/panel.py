@@ -3,7 +3,7 @@
 import bpy
 
 from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .brush_tool import draw_brush_settings
 
 
@@ -13,7 +13,7 @@ class TESSERA_PT_displacement(Sidebar, bpy.types.Panel):
 
     def draw(self, context):
         layout = self.layout
-        settings = context.active_object.tessera.displacement
+        settings = active_object(context).tessera.displacement
         if settings.image is None:
             layout.operator("tessera.displacement_add", icon="IMAGE_DATA")
             return
@@ -25,7 +25,7 @@ class TESSERA_PT_displacement(Sidebar, bpy.types.Panel):
             layout.prop(settings, "space")
             if settings.space == "TANGENT" and not has_uv_tangent_node():
                 layout.label(text=f"{UV_TANGENT_MESSAGE}: the map is not shown", icon="ERROR")
-        layout.prop_search(settings, "uv_map", context.active_object.data, "uv_layers")
+        layout.prop_search(settings, "uv_map", active_object(context).data, "uv_layers")
         layout.prop(settings, "mid_level")
         layout.prop(settings, "strength")
         row = layout.row()

@@ -5,7 +5,7 @@ import bpy
 
 from ...kernels.common.errors import InvalidInputError
 from ..guarded import check_numbers
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .preview import MANAGER
 
 
@@ -15,7 +15,7 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        s = context.active_object.tessera.nailboard
+        s = active_object(context).tessera.nailboard
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
@@ -29,7 +29,7 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
         except InvalidInputError as err:
             col.label(text=str(err), icon="ERROR")
         if s.enabled:
-            live = MANAGER.boards.get(context.active_object.session_uid)
+            live = MANAGER.boards.get(active_object(context).session_uid)
             state = live.state if live is not None else "Waiting for the first render"
             col.label(text=state, icon="ERROR" if state.startswith("Failed") else "INFO")
         row = layout.row()

@@ -3,7 +3,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .build import HCE_PROPERTY
 from .settings import copy_subdivision_settings, draw_subdivision_settings
 
@@ -14,11 +14,11 @@ class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw_header(self, context):
-        self.layout.prop(context.active_object.tessera.loop, "preview", text="")
+        self.layout.prop(active_object(context).tessera.loop, "preview", text="")
 
     def draw(self, context):
         layout = self.layout
-        ob = context.active_object
+        ob = active_object(context)
         settings = ob.tessera.loop
         draw_subdivision_settings(layout, settings)
         me = ob.data

@@ -1,5 +1,6 @@
 """Live Loop preview in the 3D viewport: meshes with ``tessera.loop.preview`` are drawn Loop-subdivided, with
-their baked lighting, from the kernel's result (uploaded once; rebuilt when the mesh or the settings change).
+their baked lighting, from the kernel's result (uploaded once; rebuilt when the mesh or the settings change),
+instead of the object itself (`viewport.sync_source`); like *Loop Subdivision*, it reads the object's own mesh.
 Nothing is drawn or compiled in background mode."""
 
 import bpy
@@ -8,7 +9,7 @@ import numpy as np
 from ...kernels.common.normals import shared_vertex_normals
 from ..bridge import read_edge_marks, read_mesh
 from ..preferences import get_preferences
-from ..viewport import Preview, PreviewEntry
+from ..viewport import Preview, PreviewEntry, previewed_objects
 from .build import HCE_PROPERTY, subdivide
 from .settings import TOPIC
 
@@ -29,14 +30,17 @@ def entry_for(ob):
                                                   data_uid=ob.data.session_uid))
 
 
+def previewing(ob):
+    """The preview is on for ``ob``."""
+    return ob.type == "MESH" and ob.tessera.loop.preview
+
+
 def _draw(context, region, view, proj):
-    for ob in context.visible_objects:
-        if ob.type != "MESH" or not ob.tessera.loop.preview:
-            continue
+    for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
         if entry is not None:
             entry.draw.draw(view @ np.array(ob.matrix_world), proj)
 
 
-PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC)
+PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, replaces=previewing)
 register, unregister = PREVIEW.register, PREVIEW.unregister

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .settings import draw_surface_options
 
 
@@ -13,13 +13,13 @@ class TESSERA_PT_surfaces(Sidebar, bpy.types.Panel):
 
     @classmethod
     def poll(cls, context):
-        return super().poll(context) and context.active_object.tessera.surface.is_surface
+        return super().poll(context) and active_object(context).tessera.surface.is_surface
 
     def draw_header(self, context):
-        self.layout.prop(context.active_object.tessera.surface, "is_surface", text="")
+        self.layout.prop(active_object(context).tessera.surface, "is_surface", text="")
 
     def draw(self, context):
-        s = context.active_object.tessera.surface
+        s = active_object(context).tessera.surface
         layout = self.layout
         draw_surface_options(layout, s)
         col = layout.column()

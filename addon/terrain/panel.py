@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .settings import draw_terrain_settings
 
 
@@ -12,14 +12,14 @@ class TESSERA_PT_terrain(Sidebar, bpy.types.Panel):
 
     @classmethod
     def poll(cls, context):
-        ob = context.active_object
+        ob = active_object(context)
         return ob is not None and ob.tessera.terrain.is_terrain
 
     def draw_header(self, context):
-        self.layout.prop(context.active_object.tessera.terrain, "preview", text="")
+        self.layout.prop(active_object(context).tessera.terrain, "preview", text="")
 
     def draw(self, context):
-        draw_terrain_settings(self.layout, context.active_object.tessera.terrain)
+        draw_terrain_settings(self.layout, active_object(context).tessera.terrain)
         row = self.layout.row()
         row.scale_y = 1.4
         row.operator("tessera.terrain_bake", icon="VIEW_CAMERA")

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .settings import draw_settings
 
 
@@ -11,7 +11,7 @@ class TESSERA_PT_tessellation(Sidebar, bpy.types.Panel):
     bl_label = "Tessellate"
 
     def draw(self, context):
-        settings = context.active_object.tessera.tessellate
+        settings = active_object(context).tessera.tessellate
         self.layout.prop(settings, "preview", icon="HIDE_OFF")
         draw_settings(self.layout, settings)
         row = self.layout.row()

@@ -5,7 +5,8 @@ Per object the mesh is read once and its control texture uploaded; it is read ag
 the surface settings change (depsgraph handler, settings key). Adaptive levels are recomputed only when the
 view (or the object's transform) changes; uniform levels only when the settings do. A displacement map set on
 the object (Tessera > Displacement) is sampled in the vertex shader, so brush strokes show live on the
-tessellated surface. The preview is drawn even while the object is hidden, so the original can be hidden.
+tessellated surface. The preview is drawn instead of the object (`viewport.sync_source`), from the object's
+evaluated mesh (its modifiers applied, as *Tessellate* reads it); hiding the object hides it, as does Edit Mode.
 Nothing is drawn or compiled in background mode.
 """
 
@@ -16,7 +17,8 @@ from ...kernels.common.camera import Camera
 from ...kernels.tessellation.adaptive import adaptive_levels
 from ...kernels.tessellation.tessellate import surface_inputs, uniform_levels
 from .. import bridge
-from ..viewport import Preview, PreviewEntry
+from ..viewport import Preview, PreviewEntry, preview_state, previewed_objects, source_mesh
+from ..viewport_lighting import view_lighting
 from .settings import SETTING_NAMES, TOPIC, adaptive_settings, surface_options
 
 #: Settings that change what is uploaded per mesh (the rest only change levels).
@@ -53,13 +55,17 @@ def entry_for(ob):
         from ...gpu_shaders.tessellation.draw import PatchDrawData
 
         s = ob.tessera.tessellate
-        arrays, _ = bridge.read_mesh(ob.data)
+        mesh, release = source_mesh(ob, bpy.context.evaluated_depsgraph_get())
+        try:
+            arrays, _ = bridge.read_mesh(mesh)
+            uv_name = _uv_name(ob)
+            uvs = arrays.corner_attributes.get(uv_name) if uv_name else None
+            tangents = bridge.corner_tangents(mesh, uv_name) if uvs is not None and _tangent_space(ob) else None
+        finally:
+            release()
         method = s.method
         inputs = surface_inputs(arrays, uniform_levels(arrays, 1), method if method != "LINEAR" else "PN",
                                 surface_options(s))
-        uv_name = _uv_name(ob)
-        uvs = arrays.corner_attributes.get(uv_name) if uv_name else None
-        tangents = bridge.corner_tangents(ob.data, uv_name) if uvs is not None and _tangent_space(ob) else None
         draw = PatchDrawData(inputs, method, s.alpha, s.pn_normals == "QUADRATIC", uvs=uvs, tangents=tangents)
         return PreviewEntry(draw, data_uid=ob.data.session_uid, source=surface)
 
@@ -102,21 +108,28 @@ def displacement_for(ob):
     return Displacement(gpu.texture.from_image(d.image), mode, d.mid_level, d.strength)
 
 
+def previewing(ob):
+    """The preview is on for ``ob``."""
+    return ob.type == "MESH" and ob.tessera.tessellate.preview
+
+
 def _draw(context, region, view, proj):
-    shading = context.space_data.shading.type if context.space_data else "SOLID"
-    for ob in context.view_layer.objects:
-        if ob.type != "MESH" or not ob.tessera.tessellate.preview:
-            continue
+    space = context.space_data
+    shading = space.shading.type if space else "SOLID"
+    for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
         if entry is None:
             continue
         update_levels(ob, entry, view, proj, region.width, region.height)
         vp = proj @ view @ np.array(ob.matrix_world)
         disp = displacement_for(ob)
-        if shading != "WIREFRAME":
-            entry.draw.draw(vp, displacement=disp)
-        if shading == "WIREFRAME" or context.space_data.overlay.show_wireframes:
-            entry.draw.draw(vp, color=(0.05, 0.05, 0.05, 1.0), lit=False, displacement=disp, wireframe=True)
+        with preview_state(context, ob) as style:
+            if shading != "WIREFRAME":
+                color, lighting = view_lighting(context, ob, view)
+                entry.draw.draw(vp, color=style.surface_color(color), lit=lighting is not None, displacement=disp,
+                                lighting=lighting)
+            if style.wire_color is not None:
+                entry.draw.draw(vp, color=style.wire_color, lit=False, displacement=disp, wireframe=True)
 
 
 def _settings_changed(ob):
@@ -125,5 +138,6 @@ def _settings_changed(ob):
         PREVIEW.cache.forget_error(ob)
 
 
-PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, on_settings=_settings_changed)
+PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, on_settings=_settings_changed,
+                  replaces=previewing)
 register, unregister = PREVIEW.register, PREVIEW.unregister

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar
+from ..sidebar import Sidebar, active_object
 from .settings import copy_tubes_settings, draw_tubes_settings
 from .sources import SOURCE_TYPES
 
@@ -13,10 +13,10 @@ class TESSERA_PT_tubes(Sidebar, bpy.types.Panel):
     object_types = frozenset(SOURCE_TYPES)
 
     def draw_header(self, context):
-        self.layout.prop(context.active_object.tessera.tubes, "preview", text="")
+        self.layout.prop(active_object(context).tessera.tubes, "preview", text="")
 
     def draw(self, context):
-        settings = context.active_object.tessera.tubes
+        settings = active_object(context).tessera.tubes
         draw_tubes_settings(self.layout, settings)
         row = self.layout.row()
         row.scale_y = 1.4

@@ -4,7 +4,10 @@
 void main()
 {
   vec3 p = surface_point(kind, uv, shape);
-  gl_Position = shading.view_projection * vec4(control_point(first_instance + gl_InstanceID).xyz + p, 1.0);
+  vec3 world = control_point(first_instance + gl_InstanceID).xyz + p;
+  gl_Position = shading.view_projection * vec4(world, 1.0);
+  view_position = (shading.model_view * vec4(world, 1.0)).xyz;
+  view_normal = vec3(0.0, 0.0, 1.0);
   if (shading.lit_range.y == 0.0) {
     shade = 1.0;
     return;
@@ -16,4 +19,5 @@ void main()
   float len = length(n);
   n = len > 1e-20 ? n / len : normalize(p + vec3(0.0, 0.0, 1e-6));
   shade = abs(dot(n, shading.light_dir.xyz));
+  view_normal = mat3(shading.normal_matrix) * n;
 }

@@ -57,4 +57,6 @@ void main()
                           (height_at(s - vec2(0.0, height_stride)) - height_at(s + vec2(0.0, height_stride))) * grid.z,
                           2.0 * grid.z * grid.w * height_stride));
   shade = abs(dot(n, shading.light_dir.xyz));
+  view_normal = mat3(shading.normal_matrix) * n;
+  view_position = (shading.model_view * vec4(world, 1.0)).xyz;
 }

@@ -118,11 +118,13 @@ class PatchDrawData:
         """Triangles one draw produces."""
         return sum(len(pi.pattern(*key)[1]) * count for key, (_, count) in self.buckets.items())
 
-    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, displacement=None, wireframe=False):
+    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, displacement=None, wireframe=False,
+             lighting=None):
         """Draw into the bound framebuffer. view_projection: (4, 4) row-major, mesh space to clip space;
-        displacement: a `Displacement` or None; wireframe: draw the edges of the output triangles instead."""
+        displacement: a `Displacement` or None; wireframe: draw the edges of the output triangles instead;
+        lighting: an `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
         shader = loader.shader("patch_preview", _describe_preview)
-        set_shading(shader, view_projection, color, lit)
+        set_shading(shader, view_projection, color, lit, lighting)
         _set_surface(shader, self.method, self.pn_quadratic, self.fractional, self.control)
         if displacement is None:
             shader.uniform_int("displace", 0)

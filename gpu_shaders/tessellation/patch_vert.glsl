@@ -49,4 +49,6 @@ void main()
   }
   gl_Position = shading.view_projection * vec4(pos, 1.0);
   shade = abs(dot(nor, shading.light_dir.xyz));
+  view_normal = mat3(shading.normal_matrix) * nor;
+  view_position = (shading.model_view * vec4(pos, 1.0)).xyz;
 }

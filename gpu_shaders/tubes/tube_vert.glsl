@@ -36,4 +36,6 @@ void main()
   vec3 world = centre.xyz + radius * radial;
   gl_Position = shading.view_projection * vec4(world, 1.0);
   shade = abs(dot(radial, shading.light_dir.xyz));
+  view_normal = mat3(shading.normal_matrix) * radial;
+  view_position = (shading.model_view * vec4(world, 1.0)).xyz;
 }
