@@ -129,8 +129,8 @@ class TESSERA_PG_tessellation(TessellateOptions, bpy.types.PropertyGroup):
                                    default=False)
     preview: bpy.props.BoolProperty(
         name="Live Preview", default=False, update=_redraw,
-        description="Draw this mesh tessellated on the GPU with these settings (adaptive levels follow the "
-                    "view); the object itself can be hidden meanwhile")
+        description="Draw this mesh tessellated on the GPU with these settings, in place of the mesh, with its "
+                    "modifiers (adaptive levels follow the view); no mesh is made")
 
 
 def copy_settings(source, target):
