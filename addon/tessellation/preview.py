@@ -6,7 +6,8 @@ the surface settings change (depsgraph handler, settings key). Adaptive levels a
 view (or the object's transform) changes; uniform levels only when the settings do. A displacement map set on
 the object (Tessera > Displacement) is sampled in the vertex shader, so brush strokes show live on the
 tessellated surface. The preview is drawn instead of the object (`viewport.sync_source`), from the object's
-evaluated mesh (its modifiers applied, as *Tessellate* reads it); hiding the object hides it, as does Edit Mode.
+evaluated mesh (its modifiers applied, as *Tessellate* reads it; its own mesh while it samples the object's
+displacement map, whose modifier would displace it twice); hiding the object hides it, as does Edit Mode.
 Nothing is drawn or compiled in background mode.
 """
 
@@ -39,9 +40,15 @@ def _tangent_space(ob):
     return d.mode == "VECTOR" and d.space == "TANGENT"
 
 
+def _samples_map(ob):
+    """The preview displaces by the object's map itself (`displacement_for`)."""
+    d = ob.tessera.displacement
+    return d.image is not None and not (d.mode == "VECTOR" and d.space == "GLOBAL")
+
+
 def _surface_key(ob):
-    """What the uploaded control data depends on: surface settings, the UV map, tangents or not."""
-    return _key(ob.tessera.tessellate, SURFACE_NAMES) + (_uv_name(ob), _tangent_space(ob))
+    """What the uploaded control data depends on: surface settings, the UV map, tangents or not, the map sampled."""
+    return _key(ob.tessera.tessellate, SURFACE_NAMES) + (_uv_name(ob), _tangent_space(ob), _samples_map(ob))
 
 
 def entry_for(ob):
@@ -55,7 +62,10 @@ def entry_for(ob):
         from ...gpu_shaders.tessellation.draw import PatchDrawData
 
         s = ob.tessera.tessellate
-        mesh, release = source_mesh(ob, bpy.context.evaluated_depsgraph_get())
+        if _samples_map(ob):  # the map's own modifier would displace a second time: the undisplaced mesh
+            mesh, release = ob.data, (lambda: None)
+        else:
+            mesh, release = source_mesh(ob, bpy.context.evaluated_depsgraph_get())
         try:
             arrays, _ = bridge.read_mesh(mesh)
             uv_name = _uv_name(ob)
