@@ -8,11 +8,12 @@
   the 3D viewports to redraw.
 - `clear_previews` forgets every preview's uploads, the compiled shaders and the pattern batches (one place;
   the add-on calls it when it is disabled).
-- A preview that stands for its object's surface (tessellation, Loop) is drawn *instead of* the object, as a
-  modifier's result is: while it is on, `sync_source` gives the object a last, viewport-only modifier
-  (`SOURCE_MODIFIER`) that hands Blender the evaluated geometry as one instance of zero size, so Blender draws none
-  of the object's faces or wires, while its edit cage (the modifier is off in Edit Mode), its modifier stack and
-  renders stay as they were. `source_mesh` reads the evaluated mesh back from that instance. The modifier is added
+- A preview that stands for its object's surface (tessellation, Loop, terrain, the live board) is drawn *instead
+  of* the object, as a modifier's result is: while it is on, `sync_source` gives the object a last, viewport-only
+  modifier (`SOURCE_MODIFIER`) that hands Blender the evaluated geometry as instances of zero size (two, at the
+  far corners of its bounding box, so the object keeps its bounds), so Blender draws none of the
+  object's faces or wires, while its edit cage (the modifier is off in Edit Mode), its modifier stack and renders
+  stay as they were. `source_mesh` reads the evaluated mesh back from that instance. The modifier is added
   and removed only by `sync_source` (from the preview switches, file loads and saves: saved files never hold it).
 """
 
@@ -156,25 +157,35 @@ class PreviewCache:
 SOURCE_MODIFIER = "Tessera Preview"
 SOURCE_GROUP = ".Tessera Preview Source"
 _GROUP_TAG = "tessera_preview_source"
+_GROUP_VERSION = 3  # 3: two zero-size instances, at the box's corners, so the object keeps its bounds
 
 
 def _source_group():
-    """The node group of `SOURCE_MODIFIER`: the geometry as one instance scaled to zero (made once per file)."""
+    """The node group of `SOURCE_MODIFIER` (made once per file): the geometry as two instances scaled to zero, one
+    at each far corner of its bounding box. Blender draws neither, while the object keeps its bounds: Frame
+    Selected, the view's clipping and a board's framing see the object's size. (Loose vertices would keep the bounds
+    too, but Blender draws them as dots.)"""
     group = bpy.data.node_groups.get(SOURCE_GROUP)
-    if group is not None and group.get(_GROUP_TAG):
+    if group is not None and group.get(_GROUP_TAG) == _GROUP_VERSION:
         return group
     group = bpy.data.node_groups.new(SOURCE_GROUP, "GeometryNodeTree")
-    group[_GROUP_TAG] = 1
+    group[_GROUP_TAG] = _GROUP_VERSION
     group.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
     group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
     nodes, links = group.nodes, group.links
     source, result = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
     instance = nodes.new("GeometryNodeGeometryToInstance")
-    scale = nodes.new("GeometryNodeScaleInstances")
-    scale.inputs["Scale"].default_value = (0.0, 0.0, 0.0)
+    box = nodes.new("GeometryNodeBoundBox")
+    join = nodes.new("GeometryNodeJoinGeometry")
     links.new(source.outputs[0], instance.inputs[0])
-    links.new(instance.outputs[0], scale.inputs[0])
-    links.new(scale.outputs[0], result.inputs[0])
+    links.new(source.outputs[0], box.inputs[0])
+    for corner in ("Min", "Max"):
+        scale = nodes.new("GeometryNodeScaleInstances")
+        scale.inputs["Scale"].default_value = (0.0, 0.0, 0.0)
+        links.new(instance.outputs[0], scale.inputs[0])
+        links.new(box.outputs[corner], scale.inputs["Center"])
+        links.new(scale.outputs[0], join.inputs[0])
+    links.new(join.outputs[0], result.inputs[0])
     return group
 
 
@@ -208,7 +219,7 @@ def sync_source(ob):
 
 def source_mesh(ob, depsgraph):
     """The mesh a preview of ``ob`` reads: its evaluated mesh with its modifiers (as the operators read it), from
-    the zero-size instance of `SOURCE_MODIFIER` when that is on. Returns ``(mesh, release)``; call ``release()``
+    the first zero-size instance of `SOURCE_MODIFIER` when that is on. Returns ``(mesh, release)``; call ``release()``
     when done reading."""
     evaluated = ob.evaluated_get(depsgraph)
     if ob.modifiers.get(SOURCE_MODIFIER) is not None:

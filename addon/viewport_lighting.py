@@ -57,7 +57,22 @@ def view_lighting(context, ob, view):
                                float(solid.smooth)))
     ambient = tuple(light.light_ambient) if light is not None else (0.0, 0.0, 0.0)
     rv3d = context.region_data
+    # Solid mode remaps the material's roughness to its square root before it lights with it
     return color, ViewLighting(model_view=tuple(map(tuple, model_view)), lights=tuple(lights), ambient=ambient,
-                               roughness=float(roughness), metallic=float(metallic),
+                               roughness=math.sqrt(max(float(roughness), 0.0)), metallic=float(metallic),
                                specular=bool(shading.show_specular_highlight),
                                orthographic=not rv3d.is_perspective)
+
+
+def draw_as_object(context, ob, view, surface, wire=None):
+    """Draw ``ob``'s preview as the viewport draws the object (`viewport.preview_state`): ``surface(rgba,
+    lighting)`` unless the shading is Wireframe (``lighting`` a `ViewLighting`, or None for Flat lighting), then
+    ``wire(rgba)`` where the viewport draws the object's wire (a preview without ``wire`` draws none)."""
+    from .viewport import preview_state
+
+    with preview_state(context, ob) as style:
+        if context.space_data.shading.type != "WIREFRAME":
+            color, lighting = view_lighting(context, ob, view)
+            surface(style.surface_color(color), lighting)
+        if style.wire_color is not None and wire is not None:
+            wire(style.wire_color)

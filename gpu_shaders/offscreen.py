@@ -15,7 +15,8 @@ from . import loader
 #: The view and shading constants every drawing shader shares, as the uniform buffer ``shading`` (std140, every member
 #: a whole vec4 or mat4): the push constants stay within the 128 bytes Vulkan and Metal guarantee. GLSL reads
 #: ``shading.view_projection``, ``shading.color``, ``shading.light_dir.xyz``, ``shading.lit_range`` (x, y: the check
-#: shade; z: studio lighting on; w: orthographic view) and, for studio lighting (`ViewLighting`), ``model_view`` and
+#: shade; z: studio lighting on; w: orthographic view), ``light_dir.w`` (1: the base colour is the vertex colour, in
+#: shaders made with ``vertex_color``) and, for studio lighting (`ViewLighting`), ``model_view`` and
 #: ``normal_matrix`` (object to view space), ``material`` (roughness, metallic), ``ambient`` (rgb; a: specular on) and
 #: the four lights' ``light_direction``, ``light_diffuse`` (rgb; a: wrap) and ``light_specular``.
 VIEW_STRUCT = ("struct TesseraView {\n  mat4 view_projection;\n  vec4 color;\n  vec4 light_dir;\n  vec4 lit_range;\n"
@@ -28,13 +29,14 @@ _BLOCK_FLOATS = 16 + 4 * 3 + 16 * 2 + 4 * 2 + 4 * 12
 class ViewLighting:
     """How the viewport lights objects, for a preview drawn instead of one (`addon.viewport_lighting` reads it from
     the 3D view): model_view (4, 4) row-major, object to view space; lights: up to four ``(direction (3,) toward the
-    light in view space, diffuse rgb, specular rgb, wrap)``; ambient rgb; roughness, metallic of the object's surface;
-    specular: the highlights are on; orthographic: the view is."""
+    light in view space, diffuse rgb, specular rgb, wrap)``; ambient rgb; roughness (as Solid mode takes it: the
+    square root of the material's) and metallic of the object's surface; specular: the highlights are on;
+    orthographic: the view is."""
 
     model_view: tuple
     lights: tuple
     ambient: tuple = (0.0, 0.0, 0.0)
-    roughness: float = 0.4
+    roughness: float = 0.6325  # the square root of Blender's default 0.4
     metallic: float = 0.0
     specular: bool = True
     orthographic: bool = False
@@ -50,13 +52,15 @@ def add_view_block(info):
 
 
 def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT, lit_range=(1.0, 0.0),
-               lighting=None):
+               lighting=None, vertex_colors=False):
     """The ``shading`` uniform buffer for these values; view_projection (4, 4) row-major; lighting: a
-    `ViewLighting` (studio lighting as the viewport's, in place of the check shade) or None."""
+    `ViewLighting` (studio lighting as the viewport's, in place of the check shade) or None; vertex_colors: the
+    base colour is the vertex colour (shaders made with ``vertex_color``) instead of ``color``."""
     data = np.zeros(_BLOCK_FLOATS, np.float32)
     data[:16] = np.asarray(view_projection, np.float32).T.ravel()  # GLSL's matrices are column-major
     data[16:20] = color
     data[20:23] = light_dir
+    data[23] = 1.0 if vertex_colors else 0.0
     data[24:26] = lit_range
     if lighting is not None:
         model_view = np.asarray(lighting.model_view, np.float64)
@@ -77,18 +81,24 @@ def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT,
     return loader.block(data)
 
 
-def shaded_create_info(name, *vertex_files):
+def shaded_create_info(name, *vertex_files, vertex_color=False):
     """A create-info with the shading every Tessera check shader shares: ``shade``, ``view_normal`` and
     ``view_position`` varyings (the vertex stage writes all three), the ``shading`` uniform buffer (`add_view_block`)
     and ``flat_mesh_frag.glsl`` with ``solid_light.glsl``. The vertex stage is ``vertex_files`` joined in order.
-    The caller adds its vertex inputs, push constants and samplers."""
+    vertex_color: a fourth varying ``vertex_color`` (vec4, the vertex stage writes it) is the base colour where the
+    block says so (`view_block`'s ``vertex_colors``). The caller adds its vertex inputs, push constants and
+    samplers."""
     import gpu
 
     iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
     iface.smooth("FLOAT", "shade")
     iface.smooth("VEC3", "view_normal")
     iface.smooth("VEC3", "view_position")
+    if vertex_color:
+        iface.smooth("VEC4", "vertex_color")
     info = gpu.types.GPUShaderCreateInfo()
+    if vertex_color:
+        info.define("TESSERA_VERTEX_COLOR")
     add_view_block(info)
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
@@ -97,12 +107,14 @@ def shaded_create_info(name, *vertex_files):
     return info
 
 
-def set_shading(shader, view_projection, color, lit, lighting=None):
+def set_shading(shader, view_projection, color, lit, lighting=None, vertex_colors=False):
     """Bind ``shader`` and its shared ``shading`` block; view_projection: (4, 4) row-major; lighting: a
-    `ViewLighting` to light as the viewport does (when ``lit``), or None for the check shade."""
+    `ViewLighting` to light as the viewport does (when ``lit``), or None for the check shade; vertex_colors: the
+    vertex colour is the base colour (`view_block`)."""
     shader.bind()
     shader.uniform_block("shading", view_block(view_projection, tuple(color), HEADLIGHT,
-                                               (0.25, 0.75) if lit else (1.0, 0.0), lighting if lit else None))
+                                               (0.25, 0.75) if lit else (1.0, 0.0), lighting if lit else None,
+                                               vertex_colors))
 
 
 def _describe_flat_mesh():

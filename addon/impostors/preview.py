@@ -1,8 +1,8 @@
 """Live nailboards in the 3D viewport: objects with ``tessera.nailboard.enabled`` are drawn from their current
 board (`live.NailboardManager`), pre-warped for the eye every frame on the CPU (8 bytes a texel uploaded) and drawn
 by the GPU with per-texel depth. The draw callback never waits: a board is asked for through a timer (a draw
-callback may not save files or start processes), rendered by the worker process, and swapped in when done. Nothing
-is drawn in background mode."""
+callback may not save files or start processes), rendered by the worker process, and swapped in when done. The board
+is drawn instead of its object (`viewport.sync_source`), hidden with it. Nothing is drawn in background mode."""
 
 import bpy
 import numpy as np
@@ -11,7 +11,7 @@ from ...kernels.common.errors import InvalidInputError
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.prewarp import fill_holes, forward_splat
 from ..guarded import check_numbers
-from ..viewport import Preview, tag_view3d_redraw
+from ..viewport import Preview, previewed_objects, tag_view3d_redraw
 from . import worker
 from .live import NailboardManager
 from .settings import TOPIC
@@ -98,9 +98,9 @@ def _draw(context, region, view, proj):
 
     eye = np.linalg.inv(view)[:3, 3]
     fov = 2.0 * np.arctan(1.0 / proj[1, 1])
-    for ob in context.visible_objects:
+    for ob in previewed_objects(context, previewing):
         s = ob.tessera.nailboard
-        if not s.enabled or ob.type != "MESH" or not _finite(s):
+        if not _finite(s):
             continue
         MANAGER.k, MANAGER.relief_factor, MANAGER.lead = s.tolerance, 0.25 if s.relief else 1.0, s.lead
         live = MANAGER.update(ob, eye, region.height, fov)
@@ -118,6 +118,11 @@ def _draw(context, region, view, proj):
         live.draw.draw(proj @ view)
 
 
+def previewing(ob):
+    """The live board is on for mesh ``ob``: it is drawn instead of the object."""
+    return ob.type == "MESH" and ob.tessera.nailboard.enabled
+
+
 def _forget(ob):
     """Settings of ``ob`` changed: its boards go, and a render still running for them is stopped (its folder too)."""
     live = MANAGER.boards.pop(getattr(ob, "session_uid", None), None)
@@ -125,5 +130,5 @@ def _forget(ob):
         live.pending.cancel()
 
 
-PREVIEW = Preview(_draw, topic=TOPIC, on_settings=_forget)
+PREVIEW = Preview(_draw, topic=TOPIC, on_settings=_forget, replaces=previewing)
 register, unregister = PREVIEW.register, PREVIEW.unregister

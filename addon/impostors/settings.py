@@ -13,8 +13,7 @@ class TESSERA_PG_impostors(bpy.types.PropertyGroup):
     enabled: bpy.props.BoolProperty(
         name="Nailboard", default=False, update=_changed,
         description="Draw this object in the viewport from a board rendered by Cycles in a background process "
-                    "(colour, depth and normals), regenerated when the view makes it invalid; hide the object to see "
-                    "only the board")
+                    "(colour, depth and normals) instead of its geometry, regenerated when the view makes it invalid")
     relief: bpy.props.BoolProperty(name="Relief Mapping", default=True, update=_changed,
                                    description="Pre-warp the board for the eye (parallax corrected, per-texel "
                                                "depth); off: a plain sprite, regenerated sooner")

@@ -1,7 +1,8 @@
-"""Live Loop preview in the 3D viewport: meshes with ``tessera.loop.preview`` are drawn Loop-subdivided, with
-their baked lighting, from the kernel's result (uploaded once; rebuilt when the mesh or the settings change),
-instead of the object itself (`viewport.sync_source`); like *Loop Subdivision*, it reads the object's own mesh.
-Nothing is drawn or compiled in background mode."""
+"""Live Loop preview in the 3D viewport: meshes with ``tessera.loop.preview`` are drawn Loop-subdivided, lit as
+Solid mode lights objects (their baked colours where the viewport's Color is Attribute), from the kernel's result
+(uploaded once; rebuilt when the mesh or the settings change), instead of the object itself
+(`viewport.sync_source`); like *Loop Subdivision*, it reads the object's own mesh. Nothing is drawn or compiled in
+background mode."""
 
 import bpy
 import numpy as np
@@ -10,6 +11,7 @@ from ...kernels.common.normals import shared_vertex_normals
 from ..bridge import read_edge_marks, read_mesh
 from ..preferences import get_preferences
 from ..viewport import Preview, PreviewEntry, previewed_objects
+from ..viewport_lighting import draw_as_object
 from .build import HCE_PROPERTY, subdivide
 from .settings import TOPIC
 
@@ -36,10 +38,17 @@ def previewing(ob):
 
 
 def _draw(context, region, view, proj):
+    colour_type = context.space_data.shading.color_type
     for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
-        if entry is not None:
-            entry.draw.draw(view @ np.array(ob.matrix_world), proj)
+        if entry is None:
+            continue
+        draw = entry.draw
+        vp = proj @ view @ np.array(ob.matrix_world)
+        # Color: Attribute shows the baked colours, as it shows the applied mesh's; lit as every object is
+        baked = draw.baked and colour_type == "VERTEX"
+        draw_as_object(context, ob, view, lambda color, lighting: draw.draw(
+            vp, color=color, lit=lighting is not None or not baked, lighting=lighting, vertex_colors=baked))
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, replaces=previewing)

@@ -2,14 +2,15 @@
 Tessera › Parametric Surface* with Output Live) are drawn on the GPU, one instance of the quad-domain pattern per
 control point (the object's origin, or the vertices of its Control Points mesh), the formula evaluated in the
 vertex shader. The control points are uploaded once, and again when either object moves, the control mesh is edited
-or a setting changes; with Factor From Camera each instance's factor follows the view. Nothing is drawn in
-background mode."""
+or a setting changes; with Factor From Camera each instance's factor follows the view. It is drawn as the
+viewport draws objects (lit as Solid mode lights them, hidden with the empty). Nothing is drawn in background mode."""
 
 import bpy
 import numpy as np
 
 from ...kernels.common.camera import Camera
-from ..viewport import Preview, PreviewEntry
+from ..viewport import Preview, PreviewEntry, previewed_objects
+from ..viewport_lighting import draw_as_object
 from .settings import TOPIC, surface_from
 from .sources import control_points, instance_factors
 
@@ -44,13 +45,16 @@ def entry_for(ob, camera=None):
 
 
 def _draw(context, region, view, proj):
-    for ob in context.visible_objects:
-        if not ob.tessera.surface.is_surface:
-            continue
+    for ob in previewed_objects(context, lambda ob: ob.tessera.surface.is_surface):
         model = np.array(ob.matrix_world)
         entry = entry_for(ob, Camera(view @ model, proj, region.width, region.height))
-        if entry is not None:
-            entry.draw.draw(proj @ view @ model)
+        if entry is None:
+            continue
+        vp = proj @ view @ model
+        draw_as_object(context, ob, view,
+                       lambda color, lighting: entry.draw.draw(vp, color=color, lit=lighting is not None,
+                                                                lighting=lighting),
+                       lambda color: entry.draw.draw(vp, color=color, lit=False, wireframe=True))
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC)

@@ -2,8 +2,9 @@
 
 The height map is uploaded once per object (until its source settings change); levels are selected again
 only when the view changes (numpy, a few milliseconds for 65k tiles), and only the tile table of the new
-selection is uploaded. The preview is drawn even while the object itself is hidden, so the baked mesh can be
-hidden during a fly-through. Nothing is drawn or compiled in background mode.
+selection is uploaded. The preview is drawn instead of the terrain object's baked mesh (`viewport.sync_source`) and
+lit as Solid mode lights objects; hiding the object hides it, as does Edit Mode. Nothing is drawn or compiled in
+background mode.
 """
 
 import bpy
@@ -11,7 +12,8 @@ import numpy as np
 
 from ...kernels.common.camera import Camera
 from ...kernels.terrain.lod import select
-from ..viewport import Preview, PreviewEntry
+from ..viewport import Preview, PreviewEntry, previewed_objects
+from ..viewport_lighting import draw_as_object
 from . import data as terrain_data
 from .settings import TOPIC, lod_settings, source_key
 
@@ -53,19 +55,24 @@ def update_view(ob, entry, view, projection, width, height):
     return True
 
 
+def previewing(ob):
+    """The preview is on for terrain object ``ob``."""
+    s = ob.tessera.terrain
+    return s.is_terrain and s.preview
+
+
 def _draw(context, region, view, proj):
-    for ob in context.view_layer.objects:
-        s = ob.tessera.terrain
-        if not (s.is_terrain and s.preview):
-            continue
+    for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
         if entry is None:
             continue
         update_view(ob, entry, view, proj, region.width, region.height)
-        entry.draw.draw(proj @ view @ np.array(ob.matrix_world))
+        vp = proj @ view @ np.array(ob.matrix_world)
+        draw_as_object(context, ob, view, lambda color, lighting: entry.draw.draw(
+            vp, color=color, lit=lighting is not None, lighting=lighting))
 
 
-PREVIEW = Preview(_draw, topic=TOPIC, on_settings=settings_changed)
+PREVIEW = Preview(_draw, topic=TOPIC, on_settings=settings_changed, replaces=previewing)
 
 
 def register():

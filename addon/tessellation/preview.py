@@ -18,8 +18,8 @@ from ...kernels.common.camera import Camera
 from ...kernels.tessellation.adaptive import adaptive_levels
 from ...kernels.tessellation.tessellate import surface_inputs, uniform_levels
 from .. import bridge
-from ..viewport import Preview, PreviewEntry, preview_state, previewed_objects, source_mesh
-from ..viewport_lighting import view_lighting
+from ..viewport import Preview, PreviewEntry, previewed_objects, source_mesh
+from ..viewport_lighting import draw_as_object
 from .settings import SETTING_NAMES, TOPIC, adaptive_settings, surface_options
 
 #: Settings that change what is uploaded per mesh (the rest only change levels).
@@ -124,8 +124,6 @@ def previewing(ob):
 
 
 def _draw(context, region, view, proj):
-    space = context.space_data
-    shading = space.shading.type if space else "SOLID"
     for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
         if entry is None:
@@ -133,13 +131,10 @@ def _draw(context, region, view, proj):
         update_levels(ob, entry, view, proj, region.width, region.height)
         vp = proj @ view @ np.array(ob.matrix_world)
         disp = displacement_for(ob)
-        with preview_state(context, ob) as style:
-            if shading != "WIREFRAME":
-                color, lighting = view_lighting(context, ob, view)
-                entry.draw.draw(vp, color=style.surface_color(color), lit=lighting is not None, displacement=disp,
-                                lighting=lighting)
-            if style.wire_color is not None:
-                entry.draw.draw(vp, color=style.wire_color, lit=False, displacement=disp, wireframe=True)
+        draw_as_object(context, ob, view,
+                       lambda color, lighting: entry.draw.draw(vp, color=color, lit=lighting is not None,
+                                                                displacement=disp, lighting=lighting),
+                       lambda color: entry.draw.draw(vp, color=color, lit=False, displacement=disp, wireframe=True))
 
 
 def _settings_changed(ob):

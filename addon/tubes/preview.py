@@ -3,7 +3,8 @@
 Per object the curves are read and framed once (`kernels.tubes.builder.tube_sections`) and uploaded as section
 textures; they are rebuilt only when the object or its settings change (depsgraph and the "tubes" settings
 topic). Sides per tube are recomputed when the view changes (camera LOD); the anti-aliasing clamp runs in the
-vertex shader every frame. Nothing is drawn or compiled in background mode.
+vertex shader every frame. It is drawn as the viewport draws objects (lit as Solid mode lights them, hidden with
+its source). Nothing is drawn or compiled in background mode.
 """
 
 import bpy
@@ -11,7 +12,8 @@ import numpy as np
 
 from ...kernels.common.camera import Camera
 from ...kernels.tubes.builder import lod_sides, tube_sections
-from ..viewport import Preview, PreviewEntry
+from ..viewport import Preview, PreviewEntry, previewed_objects
+from ..viewport_lighting import draw_as_object
 from .settings import TOPIC, kernel_settings
 from .sources import SOURCE_TYPES, read_lines
 
@@ -30,10 +32,13 @@ def entry_for(ob):
     return PREVIEW.entry(ob, build)
 
 
+def previewing(ob):
+    """The preview is on for ``ob`` (a curve, hair or wire mesh)."""
+    return ob.type in SOURCE_TYPES and ob.tessera.tubes.preview
+
+
 def _draw(context, region, view, proj):
-    for ob in context.visible_objects:
-        if ob.type not in SOURCE_TYPES or not ob.tessera.tubes.preview:
-            continue
+    for ob in previewed_objects(context, previewing):
         entry = entry_for(ob)
         if entry is None:
             continue
@@ -44,7 +49,10 @@ def _draw(context, region, view, proj):
             cam = Camera(view @ model, proj, region.width, region.height)
             entry.draw.set_sides(lod_sides(entry.draw.lines, kernel_settings(s), cam))
             entry.view = key
-        entry.draw.draw(proj @ view @ model, region.width, clamp=s.aa_clamp, max_radius=s.max_radius)
+        vp = proj @ view @ model
+        draw_as_object(context, ob, view, lambda color, lighting: entry.draw.draw(
+            vp, region.width, color=color, lit=lighting is not None, clamp=s.aa_clamp, max_radius=s.max_radius,
+            lighting=lighting))
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Curve, bpy.types.Mesh, bpy.types.Curves), topic=TOPIC)

@@ -1,31 +1,21 @@
 """A Loop-subdivided mesh on the GPU: positions, normals and colours per vertex and the triangles, uploaded once
-per result (`LoopDrawData`); drawn with a headlight in the viewport's view, the colours as they are (baked light)
-when ``lit_range`` is (1, 0)."""
+per result (`LoopDrawData`); drawn as every preview is (`offscreen.shaded_create_info`): lit as Solid mode lights
+objects, the base colour either the object's or the vertex colours (the baked light, as Solid mode's Color:
+Attribute shows the applied result's colours), or drawn as they are (the check shade with ``lit=False``)."""
 
 import numpy as np
 
 from .. import loader
-from ..offscreen import add_view_block, view_block
+from ..offscreen import set_shading, shaded_create_info
 
 CLAY = (0.72, 0.72, 0.72, 1.0)
 
 
 def _describe():
-    import gpu
-
-    iface = gpu.types.GPUStageInterfaceInfo("tessera_loop_iface")
-    iface.smooth("FLOAT", "shade")
-    iface.smooth("VEC4", "vertex_color")
-    info = gpu.types.GPUShaderCreateInfo()
-    add_view_block(info)
-    info.push_constant("MAT4", "model_view")
+    info = shaded_create_info("loop_mesh", "subdivision/loop_vert.glsl", vertex_color=True)
     info.vertex_in(0, "VEC3", "pos")
     info.vertex_in(1, "VEC3", "nor")
     info.vertex_in(2, "VEC4", "col")
-    info.vertex_out(iface)
-    info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(loader.source("subdivision/loop_vert.glsl"))
-    info.fragment_source(loader.source("subdivision/loop_frag.glsl"))
     return info
 
 
@@ -42,9 +32,11 @@ class LoopDrawData:
         self.triangles = np.ascontiguousarray(triangles, np.int32)
         self._batch = None
 
-    def draw(self, model_view, projection, lit=None):
-        """Draw with ``model_view`` and ``projection`` (4, 4) row-major; lit: shade by the headlight (default: only
-        without baked colours, which carry their own light)."""
+    def draw(self, view_projection, color=CLAY, lit=None, lighting=None, vertex_colors=None):
+        """Draw into the bound framebuffer; view_projection: (4, 4) row-major, object space to clip. lit: shade
+        (default: only without baked colours, which carry their own light); lighting: an `offscreen.ViewLighting`
+        to light as the viewport does, or None for the check shade; vertex_colors: the base colour is the vertex
+        colours (default: when baked), else ``color``."""
         from gpu_extras.batch import batch_for_shader
 
         shader = loader.shader("loop_mesh", _describe)
@@ -52,10 +44,8 @@ class LoopDrawData:
             self._batch = batch_for_shader(shader, "TRIS", {"pos": self.positions, "nor": self.normals,
                                                             "col": self.colours}, indices=self.triangles)
         lit = not self.baked if lit is None else lit
-        shader.bind()
-        mvp = np.asarray(projection, np.float32) @ np.asarray(model_view, np.float32)
-        shader.uniform_block("shading", view_block(mvp, lit_range=(0.3, 0.7) if lit else (1.0, 0.0)))
-        shader.uniform_float("model_view", np.asarray(model_view, np.float32).T.ravel().tolist())
+        vertex_colors = self.baked if vertex_colors is None else vertex_colors
+        set_shading(shader, view_projection, color, lit, lighting, vertex_colors)
         self._batch.draw(shader)
 
 

@@ -1,9 +1,10 @@
-/* A Loop-subdivided mesh with vertex colours: object-space position, normal and colour in; a headlight shade
- * from the view-space normal, both sides lit. */
+/* A Loop-subdivided mesh with vertex colours: object-space position, normal and colour in; the view-space normal and
+ * position for the shared fragment stage (`offscreen.shaded_create_info`), a headlight shade for the check shade. */
 void main()
 {
   gl_Position = shading.view_projection * vec4(pos, 1.0);
-  vec3 n = normalize(mat3(model_view) * nor);
-  shade = abs(n.z);
+  view_normal = mat3(shading.normal_matrix) * nor;
+  view_position = (shading.model_view * vec4(pos, 1.0)).xyz;
+  shade = abs(normalize(view_normal).z);
   vertex_color = col;
 }

@@ -106,10 +106,11 @@ class SurfaceDrawData:
         """Control points plus each factor's pattern batch (shared by every surface drawn at that factor)."""
         return self.control_bytes + sum(pattern_bytes(factor) for factor, _, _ in self.ranges)
 
-    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, wireframe=False):
-        """Draw into the bound framebuffer; view_projection: (4, 4) row-major, object space to clip space."""
+    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, wireframe=False, lighting=None):
+        """Draw into the bound framebuffer; view_projection: (4, 4) row-major, object space to clip space; lighting:
+        an `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
         shader = loader.shader("surface_preview", _describe_preview)
-        set_shading(shader, view_projection, color, lit)
+        set_shading(shader, view_projection, color, lit, lighting)
         shader.uniform_int("kind", self.kind)
         shader.uniform_float("shape", self.shape)
         shader.uniform_int("tex_width", TEX_WIDTH)

@@ -74,10 +74,11 @@ class TerrainDrawData:
             self.buckets[key] = (rgba_texture(rows.reshape(-1, 4)), len(tiles))
             self.tile_bytes += rows.nbytes
 
-    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True):
-        """Draw into the bound framebuffer. view_projection: (4, 4) row-major, terrain-local space to clip."""
+    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, lighting=None):
+        """Draw into the bound framebuffer. view_projection: (4, 4) row-major, terrain-local space to clip;
+        lighting: an `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
         shader = loader.shader("terrain_preview", _describe)
-        set_shading(shader, view_projection, color, lit)
+        set_shading(shader, view_projection, color, lit, lighting)
         hm = self.hm
         shader.uniform_float("grid", ((hm.width - 1) * 0.5, (hm.height - 1) * 0.5, *hm.texel))
         shader.uniform_float("height_stride", float(self.stride))

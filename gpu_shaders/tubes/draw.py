@@ -106,11 +106,12 @@ class TubeDrawData:
             self.patch_bytes += rows.nbytes
 
     def draw(self, view_projection, viewport_width, color=(0.8, 0.8, 0.8, 1.0), lit=True, clamp=False,
-             max_radius=0.0):
-        """Draw into the bound framebuffer. view_projection: (4, 4) row-major, object space to clip."""
+             max_radius=0.0, lighting=None):
+        """Draw into the bound framebuffer. view_projection: (4, 4) row-major, object space to clip; lighting: an
+        `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
         shader = loader.shader("tube_preview", _describe)
         vp = np.asarray(view_projection, np.float64)
-        set_shading(shader, vp, color, lit)
+        set_shading(shader, vp, color, lit, lighting)
         shader.uniform_float("inverse_view_projection", np.linalg.inv(vp).astype(np.float32).T.ravel().tolist())
         shader.uniform_float("clamp_radius", (1.0 if clamp else 0.0, max_radius))
         shader.uniform_float("viewport_width", float(viewport_width))

@@ -22,7 +22,7 @@ def test_preview_draws_the_kernels_mesh(clean_scene, bpy_module, addon_module, g
     out.attributes["position"].data.foreach_get("vector", pos)
     assert np.array_equal(data.positions, pos.reshape(-1, 3)) and len(data.triangles) == len(out.polygons)
     cam = Camera.looking_at((0.5, -4.0, 1.0), (0, 0, 0), width=160, height=160)
-    image = offscreen.render(lambda: data.draw(cam.view, cam.projection), size=(160, 160))
+    image = offscreen.render(lambda: data.draw(cam.projection @ cam.view), size=(160, 160))
     cpu = offscreen.render_triangles(data.positions, data.triangles, cam.projection @ cam.view, size=(160, 160),
                                      color=(1, 1, 1, 1), lit=False)
     drawn, expect = image[..., :3].max(axis=2) > 0, cpu[..., 0] > 127
@@ -45,7 +45,7 @@ def test_preview_shows_the_baked_colours(clean_scene, bpy_module, addon_module, 
     data = preview.build_draw_data(ob)
     assert data.baked and np.allclose(data.colours, [1, 0, 0, 1])
     cam = Camera.looking_at((0, -4.0, 0), (0, 0, 0), width=96, height=96)
-    image = offscreen.render(lambda: data.draw(cam.view, cam.projection), size=(96, 96))
+    image = offscreen.render(lambda: data.draw(cam.projection @ cam.view), size=(96, 96))
     red_pixels = (image[..., 0] > 240) & (image[..., 1] < 10) & (image[..., 2] < 10)
     assert red_pixels[48, 48]  # the baked colour, drawn as it is (not shaded)
     assert red_pixels.sum() > 1000

@@ -12,21 +12,30 @@ import numpy as np
 THRESHOLD = 16
 
 
-def clean_scene():
-    """No objects, no leftover meshes; Solid shading, overlays on."""
+def clean_scene(w):
+    """No objects, no leftover meshes; Solid shading, overlays on except the text (it names the active object, which
+    the compared screenshots need not share)."""
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
     for mesh in list(bpy.data.meshes):
         bpy.data.meshes.remove(mesh)
+    w.space.shading.type = "SOLID"
+    w.space.overlay.show_text = False
 
 
-def frame(w, objects, front=True):
-    """Look at ``objects`` from the front (numpad 1) and frame them, as an artist would; nothing stays selected."""
+def frame(w, objects, view="FRONT"):
+    """Look at ``objects`` along ``view`` (an axis of numpad 1, 3, 7: "FRONT", "RIGHT", "TOP", or Euler angles in
+    radians of a free view) and frame them, as an artist would; nothing stays selected."""
+    from mathutils import Euler
+
     for ob in bpy.data.objects:
         ob.select_set(ob in objects)
     with bpy.context.temp_override(**w.context()):
-        if front:
-            bpy.ops.view3d.view_axis(type="FRONT")
+        if isinstance(view, str):
+            bpy.ops.view3d.view_axis(type=view)
+        else:
+            w.space.region_3d.view_rotation = Euler(view).to_quaternion()
+            w.space.region_3d.view_perspective = "PERSP"
         bpy.ops.view3d.view_selected()
     for ob in objects:
         ob.select_set(False)
@@ -44,3 +53,46 @@ def differing_share(a, b, empty):
     differ = (np.abs(a.astype(np.int16) - b.astype(np.int16)) > THRESHOLD).any(axis=2) & union
     count = int(union.sum())
     return (float(differ.sum()) / count if count else 0.0), count
+
+
+def shot(w, name):
+    """A screenshot of the 3D viewport after two redraws."""
+    w.redraw(2)
+    return w.screenshot(name)
+
+
+def operate(w, operator, ob=None, **props):
+    """Run ``operator`` (e.g. ``bpy.ops.tessera.tubes``) in the 3D viewport on ``ob`` (active and only selected);
+    returns the new active object, deselected."""
+    override = dict(w.context())
+    if ob is not None:
+        for other in bpy.data.objects:
+            other.select_set(other is ob)
+        bpy.context.view_layer.objects.active = ob
+        override.update(active_object=ob, object=ob, selected_objects=[ob])
+    with bpy.context.temp_override(**override):
+        result = operator(**props)
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"{operator.idname_py()} returned {result}")
+    made = bpy.context.view_layer.objects.active
+    made.select_set(False)
+    return made
+
+
+def oracle(w, name, empty, preview, applied, source=None):
+    """The preview oracle: a screenshot with ``preview(True)`` on (then ``preview(False)``) against one of the
+    applied result, the object ``applied()`` makes, with ``source`` hidden; the applied object is removed again.
+    Records and returns the share of differing pixels over the union of both silhouettes."""
+    preview(True)
+    with_preview = shot(w, f"{name}_preview")
+    preview(False)
+    made = applied()
+    if source is not None:
+        source.hide_set(True)
+    result = shot(w, f"{name}_applied")
+    bpy.data.objects.remove(made)
+    if source is not None:
+        source.hide_set(False)
+    share, union = differing_share(with_preview, result, empty)
+    w.results[f"{name}_vs_applied"], w.results[f"{name}_union_pixels"] = share, union
+    return share

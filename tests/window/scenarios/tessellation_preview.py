@@ -2,39 +2,24 @@
 Blender, hidden with its source, in Local View of another object, with an Array modifier, and in Edit Mode."""
 
 import bpy
-from common import clean_scene, differing_share, frame, silhouette
+from common import clean_scene, differing_share, frame, operate, oracle, shot, silhouette
 
 SETTLE = 0.3  # seconds between steps: the window draws in between
 
 
-def shot(w, name):
-    w.redraw(2)
-    return w.screenshot(name)
+def tessellation_oracle(w, ob, empty, name, **op):
+    """The oracle for ``ob``'s tessellation preview against *Tessellate* with ``op``."""
 
+    def preview(on):
+        ob.tessera.tessellate.preview = on
+        w.redraw()
 
-def oracle(w, ob, empty, name, **op):
-    """Screenshots with the preview on, and of the applied result (source hidden); the applied object is removed
-    again. Returns the share of differing pixels over the union of both silhouettes."""
-    ob.tessera.tessellate.preview = True
-    w.redraw()
-    preview = shot(w, f"{name}_preview")
-    ob.tessera.tessellate.preview = False
-    with bpy.context.temp_override(**w.context(), active_object=ob, object=ob, selected_objects=[ob]):
-        bpy.ops.tessera.tessellate(**op)
-    applied_ob = bpy.context.active_object
-    applied_ob.select_set(False)
-    ob.hide_set(True)
-    applied = shot(w, f"{name}_applied")
-    bpy.data.objects.remove(applied_ob)
-    ob.hide_set(False)
-    share, union = differing_share(preview, applied, empty)
-    w.results[f"{name}_vs_applied"], w.results[f"{name}_union_pixels"] = share, union
-    return share
+    return oracle(w, name, empty, preview, lambda: operate(w, bpy.ops.tessera.tessellate, ob, **op), source=ob)
 
 
 def run(w):
     r = w.results
-    clean_scene()
+    clean_scene(w)
     bpy.ops.mesh.primitive_monkey_add()
     ob = bpy.context.active_object
     bpy.ops.object.shade_smooth()
@@ -47,7 +32,11 @@ def run(w):
     source = shot(w, "source")
     s = ob.tessera.tessellate
     s.level = 3
-    oracle(w, ob, empty, "uniform", method="PN", level=3)
+    tessellation_oracle(w, ob, empty, "uniform", method="PN", level=3)
+    yield SETTLE
+    s.level_mode = "ADAPTIVE"
+    tessellation_oracle(w, ob, empty, "adaptive", method="PN", level_mode="ADAPTIVE", camera_source="VIEWPORT")
+    s.level_mode = "UNIFORM"
     yield SETTLE
     with bpy.context.temp_override(**w.context(), active_object=ob, object=ob, selected_objects=[ob]):
         bpy.ops.tessera.tessellate(method="PN", level=3)
@@ -98,7 +87,7 @@ def run(w):
     ob.hide_set(True)
     empty_array = shot(w, "array_empty")
     ob.hide_set(False)
-    oracle(w, ob, empty_array, "array", method="PN", level=3)
+    tessellation_oracle(w, ob, empty_array, "array", method="PN", level=3)
     ob.modifiers.remove(array)
     frame(w, [ob])
     yield SETTLE

@@ -1,0 +1,36 @@
+"""Loop, tubes, terrain and live parametric surface previews in a real Blender window (scenario ``previews``), on
+OpenGL and Vulkan: each drawn instead of its source and lit as Solid mode lights Blender's own objects, so that it
+looks like its applied result drawn by Blender; hiding the source hides the preview."""
+
+import pytest
+from test_window_tessellation import PREVIEW_BAR
+from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- fixtures
+
+pytestmark = pytest.mark.window
+
+PREVIEWS = ("loop", "tubes", "terrain", "surface")
+
+
+@pytest.fixture(params=BACKENDS)
+def previews(request, run_scenario):  # noqa: F811
+    return run_scenario("previews", request.param)
+
+
+@pytest.mark.parametrize("name", PREVIEWS)
+def test_preview_looks_like_the_applied_result(previews, name):
+    r, _, out = previews
+    assert r[f"{name}_union_pixels"] > 10_000, f"the {name} should fill part of the view"
+    assert r[f"{name}_vs_applied"] <= PREVIEW_BAR, (
+        f"{r[f'{name}_vs_applied']:.1%} of the pixels of the {name} preview differ from Blender's drawing of the "
+        f"applied result ({r['gpu']}; screenshots in {out})")
+
+
+@pytest.mark.parametrize("name", ("loop", "tubes", "terrain"))
+def test_hiding_the_source_hides_its_preview(previews, name):
+    r, _, _ = previews
+    assert r[f"{name}_source_hidden_pixels"] < 0.01 * r[f"{name}_union_pixels"]
+
+
+def test_no_traceback(previews):
+    _, log, _ = previews
+    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
