@@ -243,11 +243,12 @@ def previewed_objects(context, wanted):
 
 @dataclass
 class PreviewStyle:
-    """How one object's preview is drawn in this view: ``alpha`` of its surface (below 1 in X-ray) and
-    ``wire_color`` (rgba, linear) of its wire, or None when no wire is drawn."""
+    """How one object's preview is drawn in this view (`preview_style`): ``alpha`` of its surface (below 1 in
+    X-ray), ``wire_color`` (rgba, linear) of its wire or None when no wire is drawn, and ``xray``: X-ray is on."""
 
     alpha: float = 1.0
     wire_color: tuple | None = None
+    xray: bool = False
 
     def surface_color(self, rgba):
         return (*rgba[:3], rgba[3] * self.alpha)
@@ -259,43 +260,25 @@ def _linear(rgb):
     return tuple(v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4 for v in c)
 
 
-class preview_state:  # noqa: N801 -- used as ``with preview_state(context, ob) as style``
-    """The GPU state and `PreviewStyle` of ``ob``'s preview as the viewport draws objects: see-through in X-ray (its
-    alpha, no depth writes), its wire in Wireframe shading, with the Wireframe overlay or the object's own Wireframe
-    display, in the theme's wire colour (selected and active as Blender draws them)."""
-
-    def __init__(self, context, ob):
-        space = context.space_data
-        shading = space.shading
-        wireframe = shading.type == "WIREFRAME"
-        xray = shading.show_xray_wireframe if wireframe else shading.show_xray
-        self.style = PreviewStyle(alpha=(shading.xray_alpha_wireframe if wireframe else shading.xray_alpha)
-                                  if xray else 1.0)
-        overlay = space.overlay
-        if wireframe or (overlay.show_overlays and (overlay.show_wireframes or ob.show_wire)):
-            theme = context.preferences.themes[0].view_3d
-            if ob.select_get():
-                rgb = theme.object_active if ob == context.view_layer.objects.active else theme.object_selected
-            else:
-                rgb = theme.wire
-            self.style.wire_color = (*_linear(rgb), 1.0)
-        self.xray = xray
-
-    def __enter__(self):
-        import gpu
-
-        if self.xray:
-            gpu.state.blend_set("ALPHA")
-            gpu.state.depth_mask_set(False)
-        return self.style
-
-    def __exit__(self, *exc):
-        import gpu
-
-        if self.xray:
-            gpu.state.blend_set("NONE")
-            gpu.state.depth_mask_set(True)
-        return False
+def preview_style(context, ob):
+    """The `PreviewStyle` of ``ob``'s preview as the viewport draws objects: see-through in X-ray (its alpha), its
+    wire in Wireframe shading, with the Wireframe overlay or the object's own Wireframe display, in the theme's wire
+    colour (selected and active as Blender draws them)."""
+    space = context.space_data
+    shading = space.shading
+    wireframe = shading.type == "WIREFRAME"
+    xray = shading.show_xray_wireframe if wireframe else shading.show_xray
+    style = PreviewStyle(alpha=(shading.xray_alpha_wireframe if wireframe else shading.xray_alpha) if xray else 1.0,
+                         xray=xray)
+    overlay = space.overlay
+    if wireframe or (overlay.show_overlays and (overlay.show_wireframes or ob.show_wire)):
+        theme = context.preferences.themes[0].view_3d
+        if ob.select_get():
+            rgb = theme.object_active if ob == context.view_layer.objects.active else theme.object_selected
+        else:
+            rgb = theme.wire
+        style.wire_color = (*_linear(rgb), 1.0)
+    return style
 
 
 @bpy.app.handlers.persistent

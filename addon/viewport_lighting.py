@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from ..gpu_shaders.offscreen import ViewLighting
+from .viewport import preview_style
 
 #: Blender's default surface when an object has no material (grey 0.8, roughness 0.4, not metallic).
 DEFAULT_SURFACE = ((0.8, 0.8, 0.8, 1.0), 0.4, 0.0)
@@ -64,15 +65,35 @@ def view_lighting(context, ob, view):
                                orthographic=not rv3d.is_perspective)
 
 
-def draw_as_object(context, ob, view, surface, wire=None):
-    """Draw ``ob``'s preview as the viewport draws the object (`viewport.preview_state`): ``surface(rgba,
-    lighting)`` unless the shading is Wireframe (``lighting`` a `ViewLighting`, or None for Flat lighting), then
-    ``wire(rgba)`` where the viewport draws the object's wire (a preview without ``wire`` draws none)."""
-    from .viewport import preview_state
+def draw_as_object(context, ob, view, draw, *args, wire=False, **kwargs):
+    """Draw ``ob``'s preview as the viewport draws the object (`viewport.preview_style`): its surface by
+    ``draw(*args, color=, lit=, lighting=, **kwargs)`` unless the shading is Wireframe (``lighting`` a
+    `ViewLighting`, or None and unlit for Flat lighting), then, where the viewport draws the object's wire and the
+    preview has one (``wire``), the wire by ``draw(*args, color=, lit=False, wireframe=True, **kwargs)``.
 
-    with preview_state(context, ob) as style:
-        if context.space_data.shading.type != "WIREFRAME":
-            color, lighting = view_lighting(context, ob, view)
-            surface(style.surface_color(color), lighting)
-        if style.wire_color is not None and wire is not None:
-            wire(style.wire_color)
+    In X-ray the surface is see-through as Blender's objects are: its nearest layer only (a depth pass first, then
+    the colour blended where the depth is equal), so overlapping layers never blotch; its wire shows through."""
+    import gpu
+
+    style = preview_style(context, ob)
+    if context.space_data.shading.type != "WIREFRAME":
+        color, lighting = view_lighting(context, ob, view)
+        color = style.surface_color(color)
+        if style.xray:
+            gpu.state.color_mask_set(False, False, False, False)
+            draw(*args, color=color, lit=False, **kwargs)
+            gpu.state.color_mask_set(True, True, True, True)
+            gpu.state.blend_set("ALPHA")
+            gpu.state.depth_mask_set(False)
+        try:
+            draw(*args, color=color, lit=lighting is not None, lighting=lighting, **kwargs)
+        finally:
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_mask_set(True)
+    if style.wire_color is not None and wire:
+        if style.xray:
+            gpu.state.depth_test_set("ALWAYS")
+        try:
+            draw(*args, color=style.wire_color, lit=False, wireframe=True, **kwargs)
+        finally:
+            gpu.state.depth_test_set("LESS_EQUAL")

@@ -43,12 +43,9 @@ def _draw(context, region, view, proj):
         entry = entry_for(ob)
         if entry is None:
             continue
-        draw = entry.draw
-        vp = proj @ view @ np.array(ob.matrix_world)
         # Color: Attribute shows the baked colours, as it shows the applied mesh's; lit as every object is
-        baked = draw.baked and colour_type == "VERTEX"
-        draw_as_object(context, ob, view, lambda color, lighting: draw.draw(
-            vp, color=color, lit=lighting is not None or not baked, lighting=lighting, vertex_colors=baked))
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ np.array(ob.matrix_world), wire=True,
+                       vertex_colors=entry.draw.baked and colour_type == "VERTEX")
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC, replaces=previewing)

@@ -50,11 +50,7 @@ def _draw(context, region, view, proj):
         entry = entry_for(ob, Camera(view @ model, proj, region.width, region.height))
         if entry is None:
             continue
-        vp = proj @ view @ model
-        draw_as_object(context, ob, view,
-                       lambda color, lighting: entry.draw.draw(vp, color=color, lit=lighting is not None,
-                                                                lighting=lighting),
-                       lambda color: entry.draw.draw(vp, color=color, lit=False, wireframe=True))
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ model, wire=True)
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Mesh,), topic=TOPIC)

@@ -67,9 +67,7 @@ def _draw(context, region, view, proj):
         if entry is None:
             continue
         update_view(ob, entry, view, proj, region.width, region.height)
-        vp = proj @ view @ np.array(ob.matrix_world)
-        draw_as_object(context, ob, view, lambda color, lighting: entry.draw.draw(
-            vp, color=color, lit=lighting is not None, lighting=lighting))
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ np.array(ob.matrix_world))
 
 
 PREVIEW = Preview(_draw, topic=TOPIC, on_settings=settings_changed, replaces=previewing)

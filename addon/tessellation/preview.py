@@ -130,11 +130,7 @@ def _draw(context, region, view, proj):
             continue
         update_levels(ob, entry, view, proj, region.width, region.height)
         vp = proj @ view @ np.array(ob.matrix_world)
-        disp = displacement_for(ob)
-        draw_as_object(context, ob, view,
-                       lambda color, lighting: entry.draw.draw(vp, color=color, lit=lighting is not None,
-                                                                displacement=disp, lighting=lighting),
-                       lambda color: entry.draw.draw(vp, color=color, lit=False, displacement=disp, wireframe=True))
+        draw_as_object(context, ob, view, entry.draw.draw, vp, wire=True, displacement=displacement_for(ob))
 
 
 def _settings_changed(ob):

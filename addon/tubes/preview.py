@@ -49,10 +49,8 @@ def _draw(context, region, view, proj):
             cam = Camera(view @ model, proj, region.width, region.height)
             entry.draw.set_sides(lod_sides(entry.draw.lines, kernel_settings(s), cam))
             entry.view = key
-        vp = proj @ view @ model
-        draw_as_object(context, ob, view, lambda color, lighting: entry.draw.draw(
-            vp, region.width, color=color, lit=lighting is not None, clamp=s.aa_clamp, max_radius=s.max_radius,
-            lighting=lighting))
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ model, region.width, clamp=s.aa_clamp,
+                       max_radius=s.max_radius)
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Curve, bpy.types.Mesh, bpy.types.Curves), topic=TOPIC)

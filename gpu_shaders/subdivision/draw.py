@@ -30,19 +30,31 @@ class LoopDrawData:
         self.colours = np.ascontiguousarray(
             np.broadcast_to(np.float32(CLAY), (len(self.positions), 4)) if colours is None else colours, np.float32)
         self.triangles = np.ascontiguousarray(triangles, np.int32)
-        self._batch = None
+        self._batch = self._wire = None
 
-    def draw(self, view_projection, color=CLAY, lit=None, lighting=None, vertex_colors=None):
+    def _edges(self):
+        """Every edge of the triangles once: (E, 2) int32."""
+        pairs = np.sort(self.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+        return np.unique(pairs, axis=0).astype(np.int32)
+
+    def draw(self, view_projection, color=CLAY, lit=None, lighting=None, vertex_colors=None, wireframe=False):
         """Draw into the bound framebuffer; view_projection: (4, 4) row-major, object space to clip. lit: shade
         (default: only without baked colours, which carry their own light); lighting: an `offscreen.ViewLighting`
         to light as the viewport does, or None for the check shade; vertex_colors: the base colour is the vertex
-        colours (default: when baked), else ``color``."""
+        colours (default: when baked), else ``color``; wireframe: the edges in ``color``, unlit."""
         from gpu_extras.batch import batch_for_shader
 
         shader = loader.shader("loop_mesh", _describe)
         if self._batch is None:
             self._batch = batch_for_shader(shader, "TRIS", {"pos": self.positions, "nor": self.normals,
                                                             "col": self.colours}, indices=self.triangles)
+        if wireframe:
+            if self._wire is None:
+                self._wire = batch_for_shader(shader, "LINES", {"pos": self.positions, "nor": self.normals,
+                                                                "col": self.colours}, indices=self._edges())
+            set_shading(shader, view_projection, color, False)
+            self._wire.draw(shader)
+            return
         lit = not self.baked if lit is None else lit
         vertex_colors = self.baked if vertex_colors is None else vertex_colors
         set_shading(shader, view_projection, color, lit, lighting, vertex_colors)

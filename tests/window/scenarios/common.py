@@ -55,6 +55,21 @@ def differing_share(a, b, empty):
     return (float(differ.sum()) / count if count else 0.0), count
 
 
+def block_mask(mask, block):
+    """Which ``block`` x ``block`` tiles of the bool image ``mask`` hold any True pixel: (h // block, w // block)."""
+    h, w = (mask.shape[0] // block) * block, (mask.shape[1] // block) * block
+    return mask[:h, :w].reshape(h // block, block, w // block, block).any(axis=(1, 3))
+
+
+def mask_mismatch(a, b, empty, block=8):
+    """Where two drawings cover different parts of the view, for wires and see-through surfaces whose pixels are not
+    comparable one by one: the share of ``block``-pixel tiles covered in one silhouette but not the other, over the
+    tiles covered in either. A preview drawn in the wrong place, or missing, or fighting its source, differs."""
+    ma, mb = block_mask(silhouette(a, empty), block), block_mask(silhouette(b, empty), block)
+    union = int((ma | mb).sum())
+    return (float((ma ^ mb).sum()) / union if union else 0.0), union
+
+
 def shot(w, name):
     """A screenshot of the 3D viewport after two redraws."""
     w.redraw(2)
@@ -79,10 +94,11 @@ def operate(w, operator, ob=None, **props):
     return made
 
 
-def oracle(w, name, empty, preview, applied, source=None):
+def oracle(w, name, empty, preview, applied, source=None, masks=False):
     """The preview oracle: a screenshot with ``preview(True)`` on (then ``preview(False)``) against one of the
     applied result, the object ``applied()`` makes, with ``source`` hidden; the applied object is removed again.
-    Records and returns the share of differing pixels over the union of both silhouettes."""
+    Records and returns the share of differing pixels over the union of both silhouettes (with ``masks``: of
+    differing tiles, `mask_mismatch`)."""
     preview(True)
     with_preview = shot(w, f"{name}_preview")
     preview(False)
@@ -93,6 +109,6 @@ def oracle(w, name, empty, preview, applied, source=None):
     bpy.data.objects.remove(made)
     if source is not None:
         source.hide_set(False)
-    share, union = differing_share(with_preview, result, empty)
+    share, union = (mask_mismatch if masks else differing_share)(with_preview, result, empty)
     w.results[f"{name}_vs_applied"], w.results[f"{name}_union_pixels"] = share, union
     return share

@@ -7,14 +7,15 @@ from common import clean_scene, differing_share, frame, operate, oracle, shot, s
 SETTLE = 0.3  # seconds between steps: the window draws in between
 
 
-def tessellation_oracle(w, ob, empty, name, **op):
+def tessellation_oracle(w, ob, empty, name, masks=False, **op):
     """The oracle for ``ob``'s tessellation preview against *Tessellate* with ``op``."""
 
     def preview(on):
         ob.tessera.tessellate.preview = on
         w.redraw()
 
-    return oracle(w, name, empty, preview, lambda: operate(w, bpy.ops.tessera.tessellate, ob, **op), source=ob)
+    return oracle(w, name, empty, preview, lambda: operate(w, bpy.ops.tessera.tessellate, ob, **op), source=ob,
+                  masks=masks)
 
 
 def run(w):
@@ -37,6 +38,14 @@ def run(w):
     s.level_mode = "ADAPTIVE"
     tessellation_oracle(w, ob, empty, "adaptive", method="PN", level_mode="ADAPTIVE", camera_source="VIEWPORT")
     s.level_mode = "UNIFORM"
+    yield SETTLE
+    # Wireframe shows the preview's wire and X-ray its see-through surface, as they show the applied mesh's
+    w.space.shading.type = "WIREFRAME"
+    tessellation_oracle(w, ob, empty, "wireframe", masks=True, method="PN", level=3)
+    w.space.shading.type = "SOLID"
+    w.space.shading.show_xray = True
+    tessellation_oracle(w, ob, empty, "xray", masks=True, method="PN", level=3)
+    w.space.shading.show_xray = False
     yield SETTLE
     with bpy.context.temp_override(**w.context(), active_object=ob, object=ob, selected_objects=[ob]):
         bpy.ops.tessera.tessellate(method="PN", level=3)
