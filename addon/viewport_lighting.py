@@ -1,12 +1,14 @@
 """How the 3D viewport lights and colours an object in Solid mode, for a preview drawn instead of it: the user's
-studio light (its four lights and ambient, in view space or turned with the world), the specular toggle, and the
-object's colour as the viewport's Color setting takes it (material, object, single colour). The GPU side is
+studio light (its four lights and ambient, in view space or turned with the world) or MatCap, the specular toggle,
+and the object's colour as the viewport's Color setting takes it (material, object, single colour). The GPU side is
 `gpu_shaders.offscreen.ViewLighting` and ``solid_light.glsl``."""
 
 import math
 
+import bpy
 import numpy as np
 
+from ..gpu_shaders import loader
 from ..gpu_shaders.offscreen import ViewLighting
 from .viewport import preview_style
 
@@ -34,6 +36,52 @@ def surface(shading, ob):
     return color, roughness, metallic
 
 
+_matcaps = {}  # MatCap name -> its (H, 2W, 4) float32 pixels (diffuse | specular), or None when unreadable
+
+
+def matcap_pixels(name):
+    """The MatCap ``name`` as Solid mode lights with it: its diffuse and specular passes side by side, (H, 2W, 4)
+    float32, row 0 at the bottom (read once from Blender's multilayer EXR; a few milliseconds). None when it cannot
+    be read (told once; previews then light with the studio lights)."""
+    if name not in _matcaps:
+        from ..kernels.common.errors import TesseraError
+        from ..kernels.common.image_io import read_channels
+
+        light = next((sl for sl in bpy.context.preferences.studio_lights
+                      if sl.type == "MATCAP" and sl.name == name), None)
+        _matcaps[name] = None
+        if light is not None:
+            try:
+                passes = read_channels(light.path, "MatCap", [f"{p}.{c}" for p in ("diffuse", "specular")
+                                                              for c in "RGB"])
+            except TesseraError as err:
+                print(f"Tessera: the MatCap {name!r} could not be read ({err}); previews light with the studio "
+                      "lights")
+            else:
+                h, w = passes[0].shape
+                pixels = np.ones((h, 2 * w, 4), np.float32)
+                pixels[:, :w, :3] = np.stack(passes[:3], axis=-1)
+                pixels[:, w:, :3] = np.stack(passes[3:], axis=-1)
+                _matcaps[name] = pixels
+    return _matcaps[name]
+
+
+def matcap_texture(name):
+    """The GPU texture of `matcap_pixels` ``name`` (uploaded once per GPU context), or None."""
+    pixels = matcap_pixels(name)
+    if pixels is None:
+        return None
+
+    def upload():
+        import gpu
+
+        h, w = pixels.shape[:2]
+        return gpu.types.GPUTexture((w, h), format="RGBA16F", data=gpu.types.Buffer("FLOAT", pixels.size,
+                                                                                   pixels.ravel()))
+
+    return loader.batch(("matcap", name), upload)
+
+
 def view_lighting(context, ob, view):
     """``(rgba, ViewLighting or None)`` for drawing ``ob`` in the current 3D view; view: (4, 4) world to view.
     None for Flat lighting (the colour as it is)."""
@@ -42,6 +90,16 @@ def view_lighting(context, ob, view):
     if shading.light == "FLAT":
         return color, None
     model_view = np.asarray(view, np.float64) @ np.array(ob.matrix_world)
+    rv3d = context.region_data
+    if shading.light == "MATCAP":
+        matcap = matcap_texture(shading.studio_light)
+        if matcap is not None:
+            light = next((sl for sl in context.preferences.studio_lights
+                          if sl.type == "MATCAP" and sl.name == shading.studio_light), None)
+            specular = bool(shading.show_specular_highlight and light is not None
+                            and light.has_specular_highlight_pass)
+            return color, ViewLighting(model_view=tuple(map(tuple, model_view)), lights=(), matcap=matcap,
+                                       specular=specular, orthographic=not rv3d.is_perspective)
     light = _studio_light(context, shading.studio_light)
     lights = []
     if light is not None:
@@ -57,7 +115,6 @@ def view_lighting(context, ob, view):
                 lights.append((tuple(direction), tuple(solid.diffuse_color), tuple(solid.specular_color),
                                float(solid.smooth)))
     ambient = tuple(light.light_ambient) if light is not None else (0.0, 0.0, 0.0)
-    rv3d = context.region_data
     # Solid mode remaps the material's roughness to its square root before it lights with it
     return color, ViewLighting(model_view=tuple(map(tuple, model_view)), lights=tuple(lights), ambient=ambient,
                                roughness=math.sqrt(max(float(roughness), 0.0)), metallic=float(metallic),

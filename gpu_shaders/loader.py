@@ -89,6 +89,15 @@ def batch(key, build):
     return _batches[key]
 
 
+def blank_texture():
+    """A 1x1 RGBA16F texture (black): bound to a sampler a draw does not read (every declared sampler is bound)."""
+    if "blank" not in _batches:
+        import gpu
+
+        _batches["blank"] = gpu.types.GPUTexture((1, 1), format="RGBA16F")
+    return _batches["blank"]
+
+
 def block(data):
     """A `gpu.types.GPUUniformBuf` holding ``data`` (float32, a multiple of 16 bytes), one per distinct content
     (never changed after it is made, so a draw never sees another draw's values)."""

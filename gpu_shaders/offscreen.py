@@ -15,8 +15,8 @@ from . import loader
 #: The view and shading constants every drawing shader shares, as the uniform buffer ``shading`` (std140, every member
 #: a whole vec4 or mat4): the push constants stay within the 128 bytes Vulkan and Metal guarantee. GLSL reads
 #: ``shading.view_projection``, ``shading.color``, ``shading.light_dir.xyz``, ``shading.lit_range`` (x, y: the check
-#: shade; z: studio lighting on; w: orthographic view), ``light_dir.w`` (1: the base colour is the vertex colour, in
-#: shaders made with ``vertex_color``) and, for studio lighting (`ViewLighting`), ``model_view`` and
+#: shade; z: 1 studio lighting, 2 MatCap lighting; w: orthographic view), ``light_dir.w`` (1: the base colour is the
+#: vertex colour, in shaders made with ``vertex_color``) and, for studio lighting (`ViewLighting`), ``model_view`` and
 #: ``normal_matrix`` (object to view space), ``material`` (roughness, metallic), ``ambient`` (rgb; a: specular on) and
 #: the four lights' ``light_direction``, ``light_diffuse`` (rgb; a: wrap) and ``light_specular``.
 VIEW_STRUCT = ("struct TesseraView {\n  mat4 view_projection;\n  vec4 color;\n  vec4 light_dir;\n  vec4 lit_range;\n"
@@ -31,7 +31,8 @@ class ViewLighting:
     the 3D view): model_view (4, 4) row-major, object to view space; lights: up to four ``(direction (3,) toward the
     light in view space, diffuse rgb, specular rgb, wrap)``; ambient rgb; roughness (as Solid mode takes it: the
     square root of the material's) and metallic of the object's surface; specular: the highlights are on;
-    orthographic: the view is."""
+    orthographic: the view is; matcap: a `gpu.types.GPUTexture` of the MatCap to light by instead of the lights (as
+    Solid mode's MatCap lighting does: its diffuse and specular passes side by side), or None."""
 
     model_view: tuple
     lights: tuple
@@ -40,6 +41,7 @@ class ViewLighting:
     metallic: float = 0.0
     specular: bool = True
     orthographic: bool = False
+    matcap: object = None
 
 
 HEADLIGHT = (0.3, -0.5, 0.81)
@@ -67,7 +69,7 @@ def view_block(view_projection, color=(1.0, 1.0, 1.0, 1.0), light_dir=HEADLIGHT,
         normal = np.eye(4)
         det = np.linalg.det(model_view[:3, :3])
         normal[:3, :3] = np.linalg.inv(model_view[:3, :3]).T if abs(det) > 1e-30 else model_view[:3, :3]
-        data[26:28] = (1.0, 1.0 if lighting.orthographic else 0.0)
+        data[26:28] = (2.0 if lighting.matcap is not None else 1.0, 1.0 if lighting.orthographic else 0.0)
         data[28:44] = model_view.astype(np.float32).T.ravel()
         data[44:60] = normal.astype(np.float32).T.ravel()
         data[60:62] = (lighting.roughness, lighting.metallic)
@@ -86,8 +88,8 @@ def shaded_create_info(name, *vertex_files, vertex_color=False):
     ``view_position`` varyings (the vertex stage writes all three), the ``shading`` uniform buffer (`add_view_block`)
     and ``flat_mesh_frag.glsl`` with ``solid_light.glsl``. The vertex stage is ``vertex_files`` joined in order.
     vertex_color: a fourth varying ``vertex_color`` (vec4, the vertex stage writes it) is the base colour where the
-    block says so (`view_block`'s ``vertex_colors``). The caller adds its vertex inputs, push constants and
-    samplers."""
+    block says so (`view_block`'s ``vertex_colors``). Sampler slot 4 is ``matcap`` (`set_shading` binds it). The
+    caller adds its vertex inputs, push constants and samplers (slots 0 to 3)."""
     import gpu
 
     iface = gpu.types.GPUStageInterfaceInfo(f"tessera_{name}_iface")
@@ -100,6 +102,7 @@ def shaded_create_info(name, *vertex_files, vertex_color=False):
     if vertex_color:
         info.define("TESSERA_VERTEX_COLOR")
     add_view_block(info)
+    info.sampler(4, "FLOAT_2D", "matcap")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
     info.vertex_source(loader.sources(*vertex_files))
@@ -115,6 +118,8 @@ def set_shading(shader, view_projection, color, lit, lighting=None, vertex_color
     shader.uniform_block("shading", view_block(view_projection, tuple(color), HEADLIGHT,
                                                (0.25, 0.75) if lit else (1.0, 0.0), lighting if lit else None,
                                                vertex_colors))
+    matcap = lighting.matcap if lit and lighting is not None else None
+    shader.uniform_sampler("matcap", matcap if matcap is not None else loader.blank_texture())
 
 
 def _describe_flat_mesh():

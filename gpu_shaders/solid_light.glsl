@@ -50,3 +50,18 @@ vec3 solid_light(vec3 base, float roughness, float metallic, vec3 N, vec3 I)
   diffuse *= diffuse_color * (1.0 - dot(specular_color, vec3(1.0 / 3.0)));
   return diffuse + specular;
 }
+
+/* Solid mode's MatCap lighting: the MatCap looked up by the view-space normal, turned so that the lookup follows the
+ * incident direction `I` in perspective views: its diffuse pass (the texture's left half) times the base colour, plus
+ * its specular pass (the right half) where the specular highlights are on (ambient.w). */
+vec3 matcap_light(vec3 base, vec3 N, vec3 I)
+{
+  float a = 1.0 / (1.0 + I.z);
+  float b = -I.x * I.y * a;
+  vec3 b1 = vec3(1.0 - I.x * I.x * a, b, -I.x);
+  vec3 b2 = vec3(b, 1.0 - I.y * I.y * a, -I.y);
+  vec2 uv = vec2(dot(b1, N), dot(b2, N)) * 0.496 + 0.5;
+  vec3 diffuse = textureLod(matcap, vec2(0.5 * uv.x, uv.y), 0.0).rgb;
+  vec3 specular = textureLod(matcap, vec2(0.5 + 0.5 * uv.x, uv.y), 0.0).rgb;
+  return diffuse * base + specular * shading.ambient.w;
+}

@@ -9,6 +9,7 @@ from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- 
 pytestmark = pytest.mark.window
 
 PREVIEWS = ("loop", "tubes", "terrain", "surface")
+LIGHTINGS = ("", "_matcap")  # Solid mode's studio lighting, its MatCap lighting
 
 
 @pytest.fixture(params=BACKENDS)
@@ -16,9 +17,11 @@ def previews(request, run_scenario):  # noqa: F811
     return run_scenario("previews", request.param)
 
 
-@pytest.mark.parametrize("name", PREVIEWS)
-def test_preview_looks_like_the_applied_result(previews, name):
+@pytest.mark.parametrize("lighting", LIGHTINGS)
+@pytest.mark.parametrize("preview", PREVIEWS)
+def test_preview_looks_like_the_applied_result(previews, preview, lighting):
     r, _, out = previews
+    name = preview + lighting
     assert r[f"{name}_union_pixels"] > 10_000, f"the {name} should fill part of the view"
     assert r[f"{name}_vs_applied"] <= PREVIEW_BAR, (
         f"{r[f'{name}_vs_applied']:.1%} of the pixels of the {name} preview differ from Blender's drawing of the "

@@ -31,9 +31,10 @@ def test_preview_looks_like_the_applied_result(tessellation):
     assert r["source_vs_applied"] > 2 * PREVIEW_BAR
 
 
-def test_adaptive_preview_looks_like_the_applied_result(tessellation):
+@pytest.mark.parametrize("name", ("adaptive", "matcap"))
+def test_adaptive_and_matcap_previews_look_like_the_applied_result(tessellation, name):
     r, _, out = tessellation
-    assert r["adaptive_vs_applied"] <= PREVIEW_BAR, f"the adaptive preview differs ({r['gpu']}; {out})"
+    assert r[f"{name}_vs_applied"] <= PREVIEW_BAR, f"the {name} preview differs ({r['gpu']}; {out})"
 
 
 @pytest.mark.parametrize("shading", ("wireframe", "xray"))

@@ -48,6 +48,19 @@ def height_image(size=129):
     return image
 
 
+def lit_both_ways(w, name, empty, preview, applied, source=None):
+    """The oracle in Solid mode's studio lighting (``name``), then in its MatCap lighting (``name_matcap``)."""
+    oracle(w, name, empty, preview, applied, source)
+    w.space.shading.light = "MATCAP"
+    w.results["matcap"] = w.space.shading.studio_light
+    preview(True)  # the first MatCap frame asks a timer to read the MatCap
+    yield SETTLE
+    preview(False)
+    oracle(w, f"{name}_matcap", empty, preview, applied, source)
+    w.space.shading.light = "STUDIO"
+    yield SETTLE
+
+
 def run(w):
     # Loop: a smooth Suzanne, two levels
     clean_scene(w)
@@ -57,10 +70,9 @@ def run(w):
     ob.tessera.loop.levels = 2
     empty = staged(w, ob, "loop")
     yield SETTLE
-    oracle(w, "loop", empty, setter(ob, "loop"),
-           lambda: operate(w, bpy.ops.tessera.loop_subdivide, ob, levels=2), source=ob)
+    yield from lit_both_ways(w, "loop", empty, setter(ob, "loop"),
+                             lambda: operate(w, bpy.ops.tessera.loop_subdivide, ob, levels=2), source=ob)
     hidden_pixels(w, ob, "loop", empty, "loop")
-    yield SETTLE
 
     # Tubes on a Bézier circle
     clean_scene(w)
@@ -70,11 +82,10 @@ def run(w):
     t.radius_source, t.radius, t.sides = "CONSTANT", 0.15, 16
     empty = staged(w, ob, "tubes", (0.9, 0.0, 0.5))
     yield SETTLE
-    oracle(w, "tubes", empty, setter(ob, "tubes"),
-           lambda: operate(w, bpy.ops.tessera.tubes, ob, radius_source="CONSTANT", radius=0.15, sides=16),
-           source=ob)
+    yield from lit_both_ways(
+        w, "tubes", empty, setter(ob, "tubes"),
+        lambda: operate(w, bpy.ops.tessera.tubes, ob, radius_source="CONSTANT", radius=0.15, sides=16), source=ob)
     hidden_pixels(w, ob, "tubes", empty, "tubes")
-    yield SETTLE
 
     # A terrain from an image, seen from above at an angle
     clean_scene(w)
@@ -83,9 +94,8 @@ def run(w):
     w.results["terrain_triangles"] = len(ob.data.polygons)
     empty = staged(w, ob, "terrain", (1.0, 0.0, 0.6))
     yield SETTLE
-    oracle(w, "terrain", empty, setter(ob, "terrain"), lambda: _copy_of(ob), source=ob)
+    yield from lit_both_ways(w, "terrain", empty, setter(ob, "terrain"), lambda: _copy_of(ob), source=ob)
     hidden_pixels(w, ob, "terrain", empty, "terrain")
-    yield SETTLE
 
     # A live parametric surface against the same surface made as a mesh
     clean_scene(w)
@@ -101,10 +111,9 @@ def run(w):
     def preview(on):
         live.hide_set(not on)
 
-    oracle(w, "surface", empty, preview,
-           lambda: operate(w, bpy.ops.tessera.parametric_surface_add, output="MESH", factor=live.tessera.surface.factor,
-                           surface=live.tessera.surface.surface))
-    yield SETTLE
+    s = live.tessera.surface
+    yield from lit_both_ways(w, "surface", empty, preview, lambda: operate(
+        w, bpy.ops.tessera.parametric_surface_add, output="MESH", factor=s.factor, surface=s.surface))
 
 
 def _copy_of(ob):

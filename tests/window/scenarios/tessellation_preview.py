@@ -35,6 +35,13 @@ def run(w):
     s.level = 3
     tessellation_oracle(w, ob, empty, "uniform", method="PN", level=3)
     yield SETTLE
+    w.space.shading.light = "MATCAP"
+    s.preview = True  # the first MatCap frame asks a timer to read the MatCap
+    yield SETTLE
+    s.preview = False
+    tessellation_oracle(w, ob, empty, "matcap", method="PN", level=3)
+    w.space.shading.light = "STUDIO"
+    yield SETTLE
     s.level_mode = "ADAPTIVE"
     tessellation_oracle(w, ob, empty, "adaptive", method="PN", level_mode="ADAPTIVE", camera_source="VIEWPORT")
     s.level_mode = "UNIFORM"
