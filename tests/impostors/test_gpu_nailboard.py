@@ -153,7 +153,7 @@ def test_the_viewport_draws_a_live_nailboard_without_waiting(clean_scene, gpu_re
     ball.tessera.nailboard.samples = 1
     eye = np.array([0.5, -6.0, 2.0])
     cam = camera.Camera(camera.look_at_view(eye, (0, 0, 0)), camera.perspective(0.6, 1.0, 0.5, 50.0), 160, 160)
-    context = SimpleNamespace(visible_objects=[ball])
+    context = SimpleNamespace(view_layer=bpy.context.view_layer, space_data=None)  # no 3D view: every visible object
     region = SimpleNamespace(height=160, width=160)
     t = time.perf_counter()
     first = offscreen.render(lambda: preview._draw(context, region, cam.view, cam.projection), size=(160, 160))
