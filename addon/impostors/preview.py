@@ -1,12 +1,17 @@
 """Live nailboards in the 3D viewport: objects with ``tessera.nailboard.enabled`` are drawn from their current
-board (`live.NailboardManager`), pre-warped for the eye every frame on the CPU (8 bytes a texel uploaded) and drawn
-by the GPU with per-texel depth. The draw callback never waits: a board is asked for through a timer (a draw
-callback may not save files or start processes), rendered by the worker process, and swapped in when done. The board
-is drawn instead of its object (`viewport.sync_source`), hidden with it. Nothing is drawn in background mode."""
+board (`live.NailboardManager`), pre-warped for the eye on the CPU (8 bytes a texel uploaded) and drawn by the GPU
+with per-texel depth. A pre-warp is made once per board and eye (`splat_for`): a redraw for the same view does none,
+and a moved eye's is made on a worker thread while the last one is drawn. The draw callback never waits: a board is
+asked for through a timer (a draw callback may not save files or start processes), rendered by the worker process,
+and swapped in when done. The board is drawn instead of its object (`viewport.sync_source`), hidden with it.
+Nothing is drawn in background mode."""
+
+from dataclasses import dataclass
 
 import bpy
 import numpy as np
 
+from ...kernels.common import workers
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.prewarp import fill_holes, forward_splat
@@ -93,6 +98,60 @@ def _finite(s):
     return True
 
 
+@dataclass
+class Prewarp:
+    """One object's pre-warp: ``splat`` made from ``images`` for the eye ``eye`` (bytes), and ``pending``: the
+    ``(images, eye, future)`` of one being made on a worker thread."""
+
+    images: object = None
+    eye: bytes = b""
+    splat: object = None
+    pending: tuple = None
+
+
+_prewarps = {}  # object session_uid -> Prewarp
+PREWARP_COUNT = [0]  # pre-warps started this session (the window tier counts them per redraw)
+
+
+def _prewarp(images, target):
+    return fill_holes(forward_splat(images.displacement, images.setup.frame, target, images.present), HOLE_GAP)
+
+
+def splat_for(ob, images, target):
+    """The pre-warp to draw ``images`` with for the eye ``target`` (3,): made now, once, for a new board; for a
+    moved eye, asked of a worker thread while the last eye's is returned (a timer redraws when it is done); for the
+    same board and eye, the one made before (no work)."""
+    p = _prewarps.setdefault(ob.session_uid, Prewarp())
+    eye = np.asarray(target, np.float64).tobytes()
+    if p.pending is not None and p.pending[2].done():
+        done_images, done_eye, future = p.pending
+        p.pending = None
+        if future.exception() is not None:
+            print(f"Tessera: a nailboard pre-warp failed: {future.exception()}")
+        elif done_images is images:
+            p.eye, p.splat = done_eye, future.result()
+    if p.images is images and p.eye == eye:
+        return p.splat
+    if p.images is not images:  # a new board: pre-warped now, once
+        PREWARP_COUNT[0] += 1
+        p.images, p.eye, p.splat = images, eye, _prewarp(images, target)
+        return p.splat
+    if p.pending is None or p.pending[0] is not images:
+        PREWARP_COUNT[0] += 1
+        p.pending = (images, eye, workers.submit(_prewarp, images, np.array(target, np.float64)))
+        if not bpy.app.timers.is_registered(_poll_prewarps):
+            bpy.app.timers.register(_poll_prewarps, first_interval=0.02)
+    return p.splat
+
+
+def _poll_prewarps():
+    """Redraw once a pre-warp made on a worker thread is done (the draw callback then picks it up)."""
+    pending = [p.pending for p in _prewarps.values() if p.pending is not None]
+    if any(future.done() for _, _, future in pending):
+        tag_view3d_redraw()
+    return 0.02 if pending else None
+
+
 def _draw(context, region, view, proj):
     from ...gpu_shaders.impostors.draw import BoardDrawData
 
@@ -107,13 +166,11 @@ def _draw(context, region, view, proj):
         images = live.images
         if images is None:
             continue
-        frame = images.setup.frame
         # relief mapping: pre-warped for this eye; a plain sprite: for the eye it was made for
-        target = eye if s.relief else live.board.eye
-        splat = fill_holes(forward_splat(images.displacement, frame, target, images.present), HOLE_GAP)
+        splat = splat_for(ob, images, eye if s.relief else live.board.eye)
         if live.draw is None:
-            live.draw = BoardDrawData(frame, images.colours, images.displacement, splat, images.normals)
-        else:
+            live.draw = BoardDrawData(images.setup.frame, images.colours, images.displacement, splat, images.normals)
+        elif live.draw.splat is not splat:
             live.draw.set_splat(splat)
         live.draw.draw(proj @ view)
 
@@ -125,6 +182,7 @@ def previewing(ob):
 
 def _forget(ob):
     """Settings of ``ob`` changed: its boards go, and a render still running for them is stopped (its folder too)."""
+    _prewarps.pop(getattr(ob, "session_uid", None), None)
     live = MANAGER.boards.pop(getattr(ob, "session_uid", None), None)
     if live is not None and live.pending is not None:
         live.pending.cancel()

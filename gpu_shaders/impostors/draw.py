@@ -54,6 +54,7 @@ class BoardDrawData:
     def set_splat(self, splat):
         """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel; its holes (NaN) as -1, an
         address no texel has (the shader tests for it: no NaN comparison on the GPU)."""
+        self.splat = splat
         self.offsets = image_texture(np.nan_to_num(np.asarray(splat.offsets, np.float32), nan=-1.0), "RG32F")
 
     def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
