@@ -162,6 +162,39 @@ def guarded(execute):
     return wrapper
 
 
+def each_selected(wanted):
+    """Make ``execute(self, context, tx)`` of an operator on the active object act on every selected object that
+    ``wanted(ob)`` accepts, as Blender's own object operators do: once per object (the active one first, then the
+    others in selection order), each run seeing that object as the active and only selected one, all in the one
+    `Transaction` of `guarded` (one object failing leaves nothing of the others). Use below ``@guarded``. With
+    nothing else selected it is the plain call."""
+
+    def decorate(execute):
+        @functools.wraps(execute)
+        def wrapper(self, context, tx):
+            active = context.active_object
+            targets = [active] if active is not None and wanted(active) else []
+            targets += [ob for ob in context.selected_objects if ob is not active and wanted(ob)]
+            if len(targets) <= 1:
+                return execute(self, context, tx)
+            results = []
+            for ob in targets:
+                with context.temp_override(active_object=ob, object=ob, selected_objects=[ob],
+                                           selected_editable_objects=[ob]):
+                    result = execute(self, bpy.context, tx)
+                if "CANCELLED" in result:
+                    return result
+                results.append(context.view_layer.objects.active)
+            for ob in results:  # every result selected, the last one active (as each run leaves its own)
+                if ob is not None:
+                    ob.select_set(True)
+            return {"FINISHED"}
+
+        return wrapper
+
+    return decorate
+
+
 def run_to_end(steps):
     """Run a generator of steps (see `guarded_step`) at once: its return value."""
     while True:

@@ -17,7 +17,7 @@ from ..addon.compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
 from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS, map_value_property
-from ..addon.guarded import check_numbers, guarded
+from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..kernels.common.errors import InvalidInputError, TesseraError
 from ..kernels.common.image_io import image_size
@@ -100,6 +100,7 @@ class TESSERA_OT_displacement_add(bpy.types.Operator):
         return True
 
     @guarded
+    @each_selected(lambda ob: ob.type == "MESH" and bool(ob.data.uv_layers))
     def execute(self, context, tx):
         ob = context.active_object
         channels = 1 if self.mode == "HEIGHT" else 3

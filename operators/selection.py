@@ -17,6 +17,11 @@ def select_only(context, objects):
         context.view_layer.objects.active = objects[-1]
 
 
+def is_mesh(ob):
+    """``ob`` is a mesh object (what the mesh operators act on, each selected one: `guarded.each_selected`)."""
+    return ob.type == "MESH"
+
+
 def mesh_poll(cls, context, verb):
     """Poll of an operator on the active mesh in Object Mode; says why not (``verb``: what the operator does)."""
     ob = context.active_object

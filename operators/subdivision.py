@@ -8,7 +8,7 @@ import bpy
 import numpy as np
 
 from ..addon import bridge
-from ..addon.guarded import check_editable, check_numbers, guarded
+from ..addon.guarded import check_editable, check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..addon.render_jobs import render_key
 from ..addon.subdivision.bake import read_bake, start_bake
@@ -21,7 +21,7 @@ from ..kernels.common.normals import face_unit_normals
 from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
-from .selection import mesh_poll, place_mesh, read_source
+from .selection import is_mesh, mesh_poll, place_mesh, read_source
 
 
 class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
@@ -42,6 +42,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
         return mesh_poll(cls, context, "subdivide")
 
     @guarded
+    @each_selected(is_mesh)
     def execute(self, context, tx):
         ob = context.active_object
         wm = context.window_manager

@@ -11,7 +11,7 @@ import numpy as np
 from ..addon import bridge, curve_bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.gpu_context import ensure_gpu_context
-from ..addon.guarded import check_numbers, guarded
+from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
@@ -126,6 +126,7 @@ class TESSERA_OT_parametric_surface_bake(bpy.types.Operator):
         return True
 
     @guarded
+    @each_selected(lambda ob: ob.tessera.surface.is_surface)
     def execute(self, context, tx):
         ob = context.active_object
         s = ob.tessera.surface
@@ -160,6 +161,7 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         draw_curve_options(self.layout, self)
 
     @guarded
+    @each_selected(lambda ob: ob.type == "CURVE")
     def execute(self, context, tx):
         ob = context.active_object
         settings = curve_sampling(self)
@@ -300,6 +302,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         draw_patch_options(self.layout, self)
 
     @guarded
+    @each_selected(lambda ob: ob.type == "SURFACE")
     def execute(self, context, tx):
         ob = context.active_object
         surfaces, rows = curve_bridge.read_surface_splines(ob.data, ob.name)

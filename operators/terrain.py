@@ -7,7 +7,7 @@ import time
 import bpy
 
 from ..addon.cameras import camera_for, object_camera
-from ..addon.guarded import check_numbers, guarded
+from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
@@ -183,6 +183,7 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
         return True
 
     @guarded
+    @each_selected(lambda ob: ob.type == "MESH" and ob.tessera.terrain.is_terrain)
     def execute(self, context, tx):
         ob = context.active_object
         check_numbers(ob.tessera.terrain)  # the settings the bake reads, as an operator's own are checked

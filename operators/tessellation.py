@@ -6,7 +6,7 @@ import numpy as np
 from ..addon import bridge
 from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
-from ..addon.guarded import check_numbers, guarded
+from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..addon.tessellation.settings import (
     TessellateOptions,
@@ -20,7 +20,7 @@ from ..kernels.common.budget import check_budget
 from ..kernels.common.errors import GPUContextError, GPUShaderError
 from ..kernels.tessellation.adaptive import adaptive_levels
 from ..kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
-from .selection import mesh_poll, place_mesh, read_source
+from .selection import is_mesh, mesh_poll, place_mesh, read_source
 
 
 def _world_positions(positions, matrix):
@@ -54,6 +54,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         draw_settings(self.layout, self)
 
     @guarded
+    @each_selected(is_mesh)
     def execute(self, context, tx):
         ob = context.active_object
         if self.use_object_settings:
