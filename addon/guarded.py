@@ -166,13 +166,16 @@ def each_selected(wanted):
     """Make ``execute(self, context, tx)`` of an operator on the active object act on every selected object that
     ``wanted(ob)`` accepts, as Blender's own object operators do: once per object (the active one first, then the
     others in selection order), each run seeing that object as the active and only selected one, all in the one
-    `Transaction` of `guarded` (one object failing leaves nothing of the others). Use below ``@guarded``. With
-    nothing else selected it is the plain call."""
+    `Transaction` of `guarded` (one object failing leaves nothing of the others). Use below ``@guarded``. An active
+    object that is not selected (a script that only set it active) is acted on alone, as is one with nothing else
+    selected: the plain call."""
 
     def decorate(execute):
         @functools.wraps(execute)
         def wrapper(self, context, tx):
             active = context.active_object
+            if active is not None and not active.select_get():
+                return execute(self, context, tx)
             targets = [active] if active is not None and wanted(active) else []
             targets += [ob for ob in context.selected_objects if ob is not active and wanted(ob)]
             if len(targets) <= 1:

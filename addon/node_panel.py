@@ -4,11 +4,12 @@ to the selected objects (the same groups are in Add Modifier > Tessera through t
 import bpy
 
 from . import node_groups, node_library  # noqa: F401 (node_library: every group registered)
-from .sidebar import Sidebar
+from .sidebar import Sidebar, panel_order
 
 
 class TESSERA_PT_node_groups(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_node_groups"
+    bl_order = panel_order(bl_idname)
     bl_label = "Node Groups"
     bl_options = {"DEFAULT_CLOSED"}
     object_types = frozenset({"MESH", "CURVES", "CURVE"})

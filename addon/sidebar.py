@@ -2,6 +2,32 @@
 subclasses it."""
 
 
+#: The order of Tessera's sidebar panels, top first: what an object *is* (a terrain, a live surface, a curve for
+#: tubes) before what can be done to any mesh; each panel's ``bl_order`` is its place here (`panel_order`).
+PANEL_ORDER = ("TESSERA_PT_gpu_notice", "TESSERA_PT_terrain", "TESSERA_PT_surfaces", "TESSERA_PT_tubes",
+               "TESSERA_PT_tessellation", "TESSERA_PT_displacement", "TESSERA_PT_subdivision", "TESSERA_PT_impostors",
+               "TESSERA_PT_node_groups", "TESSERA_PT_start")
+
+
+def panel_order(idname):
+    """``bl_order`` of the panel ``idname``: its place in `PANEL_ORDER`."""
+    return PANEL_ORDER.index(idname)
+
+
+def wrapped_label(layout, context, text, icon="NONE"):
+    """``text`` as labels wrapped to the region's width (a sidebar at Blender's default width shows about 35
+    characters), the icon on the first line only: no hint is clipped."""
+    import textwrap
+
+    region = getattr(context, "region", None)
+    scale = context.preferences.system.ui_scale if getattr(context, "preferences", None) else 1.0
+    width = max(20, int((region.width if region is not None else 300) / (7.0 * scale)) - 4)
+    col = layout.column(align=True)
+    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
+        col.label(text=line, icon=icon if i == 0 else "BLANK1" if icon != "NONE" else "NONE")
+    return col
+
+
 class Sidebar:
     """Where Tessera's panels live: View3D > Sidebar > Tessera. Shown for active objects of ``object_types``."""
 

@@ -1,25 +1,24 @@
 """Sidebar › Tessera › Start Here: the panel that keeps the Tessera tab in the sidebar when nothing Tessera works on
 is active, with the creators (Add › Tessera), what to select for the other tools, and a link to the manual."""
 
-import textwrap
-
 import bpy
 
 from .manifest import website
 from .menus import ADD_MENU, ICONS
-from .sidebar import Sidebar
+from .sidebar import Sidebar, panel_order, wrapped_label
 from .viewport import stopped_previews
 
 #: What to select for each of Tessera's tools (shown when nothing fitting is active).
 SELECT_HINTS = (
     ("MESH_DATA", "A mesh: Tessellate, Loop Subdivision, Displacement Map, Impostors"),
-    ("CURVE_DATA", "A curve, hair or wire mesh: Tubes"),
+    ("CURVE_DATA", "A curve, hair or wire mesh (edges only): Tubes"),
     ("SURFACE_DATA", "A NURBS surface: Object › Tessera › Tessellate Surface"),
 )
 
 
 class TESSERA_PT_start(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_start"
+    bl_order = panel_order(bl_idname)
     bl_label = "Start Here"
 
     @classmethod
@@ -35,10 +34,9 @@ class TESSERA_PT_start(Sidebar, bpy.types.Panel):
         col.operator_context = "INVOKE_REGION_WIN"
         for idname in ADD_MENU:
             col.operator(idname, icon=ICONS[idname])
-        col = layout.column(align=True)
-        col.label(text="Or select an object to work on:")
+        layout.label(text="Or select an object to work on:")
         for icon, text in SELECT_HINTS:
-            col.label(text=text, icon=icon)
+            wrapped_label(layout, context, text, icon)
         if website():
             layout.operator("wm.url_open", text="Manual", icon="HELP").url = website()
 
@@ -50,8 +48,8 @@ class TESSERA_PT_gpu_notice(bpy.types.Panel):
     bl_region_type = "UI"
     bl_category = "Tessera"
     bl_idname = "TESSERA_PT_gpu_notice"
+    bl_order = panel_order(bl_idname)
     bl_label = "Preview Stopped"
-    bl_order = 0
 
     @classmethod
     def poll(cls, context):
@@ -61,9 +59,8 @@ class TESSERA_PT_gpu_notice(bpy.types.Panel):
         col = self.layout.column(align=True)
         for topic, message in stopped_previews().items():
             col.label(text=f"The {topic} preview stopped drawing:", icon="ERROR")
-            for line in textwrap.wrap(message, 60):
-                col.label(text=line)
-        col.label(text="Operators still work: they compute on the CPU.")
+            wrapped_label(col, context, message)
+        wrapped_label(col, context, "Operators still work: they compute on the CPU.")
 
 
 classes = (TESSERA_PT_gpu_notice, TESSERA_PT_start)

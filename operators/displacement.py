@@ -14,7 +14,7 @@ import numpy as np
 
 from ..addon import bridge
 from ..addon.compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
-from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, texel
+from ..addon.displacement.brush_cursor import draw_ring, mouse_hit, stroke_ended, stroke_started, texel
 from ..addon.displacement.maps import StrokeSession, channels_for, map_state, sync_modifier
 from ..addon.displacement.settings import MODE_ITEMS, SPACE_ITEMS, map_value_property
 from ..addon.guarded import check_numbers, each_selected, guarded
@@ -246,6 +246,7 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
         self._last_write, self._write_seconds = 0.0, 0.0
         self._cursor = None
         self._draw = bpy.types.SpaceView3D.draw_handler_add(self._draw_cursor, (), "WINDOW", "POST_VIEW")
+        stroke_started()
         self.stroke.clear()
         self._sample(context, event, first=True)
         context.window_manager.modal_handler_add(self)
@@ -268,6 +269,7 @@ class TESSERA_OT_displacement_stroke(bpy.types.Operator):
 
     def _end(self, context):
         bpy.types.SpaceView3D.draw_handler_remove(self._draw, "WINDOW")
+        stroke_ended()
         context.area.tag_redraw()
 
     def _sample(self, context, event, first=False):

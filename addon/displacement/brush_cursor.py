@@ -108,23 +108,38 @@ def brush_ring_at(context, mouse):
         return None
 
 
+#: Strokes so far and whether one is running: the hover ring hides while the stroke draws its own, and a ring from
+#: before a stroke is never drawn again (Blender does not move gizmos while a modal operator runs).
+STROKES = {"count": 0, "running": False}
+
+
+def stroke_started():
+    STROKES["count"] += 1
+    STROKES["running"] = True
+
+
+def stroke_ended():
+    STROKES["running"] = False
+
+
 class TESSERA_GT_brush_cursor(bpy.types.Gizmo):
-    """Follows the mouse (``test_select`` is called on every move) and draws the brush ring; never selects."""
+    """Follows the mouse (``test_select`` is called on every move) and draws the brush ring; never selects. Only
+    one ring is ever drawn: none while a stroke draws its own, none left where a stroke began."""
 
     bl_idname = "TESSERA_GT_brush_cursor"
 
     def setup(self):
-        self.ring = None
+        self.ring, self.strokes = None, STROKES["count"]
 
     def test_select(self, context, location):
         ring = brush_ring_at(context, location)
-        if ring != self.ring:
-            self.ring = ring
+        if ring != self.ring or self.strokes != STROKES["count"]:
+            self.ring, self.strokes = ring, STROKES["count"]
             context.area.tag_redraw()
         return -1
 
     def draw(self, context):
-        if self.ring is not None:
+        if self.ring is not None and not STROKES["running"] and self.strokes == STROKES["count"]:
             draw_ring(self.ring, color=(1.0, 0.55, 0.1, 0.6))
 
 

@@ -24,6 +24,37 @@ def draw_brush_settings(layout, brush, channels=1):
     layout.prop(brush, "mirror_x")
 
 
+def map_channels(context):
+    """Channels of the active object's displacement map: 1 (height) or 3 (vector)."""
+    ob = context.active_object
+    return 3 if ob is not None and ob.type == "MESH" and ob.tessera.displacement.mode == "VECTOR" else 1
+
+
+def draw_brush_header(layout, brush):
+    """The tool header, as Sculpt Mode's: the brush, radius and strength each with its pen-pressure toggle, and the
+    other settings in a popover."""
+    layout.prop(brush, "kind", text="")
+    row = layout.row(align=True)
+    row.prop(brush, "radius")
+    row.prop(brush, "use_pressure_radius", text="", icon="STYLUS_PRESSURE")
+    row = layout.row(align=True)
+    row.prop(brush, "strength")
+    row.prop(brush, "use_pressure_strength", text="", icon="STYLUS_PRESSURE")
+    layout.popover("TESSERA_PT_brush_more", text="", icon="PREFERENCES")
+
+
+class TESSERA_PT_brush_more(bpy.types.Panel):
+    """The brush settings the header has no room for (a popover of the tool header)."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "HEADER"
+    bl_label = "Brush"
+    bl_idname = "TESSERA_PT_brush_more"
+
+    def draw(self, context):
+        draw_brush_settings(self.layout.column(), context.scene.tessera.brush, map_channels(context))
+
+
 class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
     bl_space_type = "VIEW_3D"
     bl_context_mode = "OBJECT"
@@ -41,12 +72,18 @@ class TESSERA_TL_displacement_brush(bpy.types.WorkSpaceTool):
     )
 
     def draw_settings(context, layout, tool):
-        draw_brush_settings(layout.column(), context.scene.tessera.brush)
+        brush = context.scene.tessera.brush
+        if getattr(context.region, "type", "") == "TOOL_HEADER":
+            draw_brush_header(layout, brush)
+        else:
+            draw_brush_settings(layout.column(), brush, map_channels(context))
 
 
 def register():
+    bpy.utils.register_class(TESSERA_PT_brush_more)
     bpy.utils.register_tool(TESSERA_TL_displacement_brush, separator=True)
 
 
 def unregister():
     bpy.utils.unregister_tool(TESSERA_TL_displacement_brush)
+    bpy.utils.unregister_class(TESSERA_PT_brush_more)

@@ -3,12 +3,13 @@
 import bpy
 
 from ..compat import UV_TANGENT_MESSAGE, has_uv_tangent_node
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .brush_tool import draw_brush_settings
 
 
 class TESSERA_PT_displacement(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_displacement"
+    bl_order = panel_order(bl_idname)
     bl_label = "Displacement Map"
 
     def draw(self, context):

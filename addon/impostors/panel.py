@@ -5,12 +5,13 @@ import bpy
 
 from ...kernels.common.errors import InvalidInputError
 from ..guarded import check_numbers
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .preview import MANAGER
 
 
 class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_impostors"
+    bl_order = panel_order(bl_idname)
     bl_label = "Impostors"
     bl_options = {"DEFAULT_CLOSED"}
 

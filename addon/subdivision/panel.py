@@ -3,13 +3,14 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .build import HCE_PROPERTY
 from .settings import copy_subdivision_settings, draw_subdivision_settings
 
 
 class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_subdivision"
+    bl_order = panel_order(bl_idname)
     bl_label = "Loop Subdivision"
     bl_options = {"DEFAULT_CLOSED"}
 

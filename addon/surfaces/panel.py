@@ -2,12 +2,13 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .settings import draw_surface_options
 
 
 class TESSERA_PT_surfaces(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_surfaces"
+    bl_order = panel_order(bl_idname)
     bl_label = "Parametric Surface"
     object_types = frozenset({"EMPTY"})
 

@@ -2,12 +2,13 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .settings import draw_terrain_settings
 
 
 class TESSERA_PT_terrain(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_terrain"
+    bl_order = panel_order(bl_idname)
     bl_label = "Terrain"
 
     @classmethod

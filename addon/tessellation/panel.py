@@ -2,12 +2,13 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .settings import draw_settings
 
 
 class TESSERA_PT_tessellation(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_tessellation"
+    bl_order = panel_order(bl_idname)
     bl_label = "Tessellate"
 
     def draw(self, context):

@@ -2,16 +2,27 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object
+from ..sidebar import Sidebar, active_object, panel_order
 from .settings import copy_tubes_settings, draw_tubes_settings
 from .sources import SOURCE_TYPES
 
 
 class TESSERA_PT_tubes(Sidebar, bpy.types.Panel):
     bl_idname = "TESSERA_PT_tubes"
+    bl_order = panel_order(bl_idname)
     bl_label = "Tubes"
     object_types = frozenset(SOURCE_TYPES)
 
+    @classmethod
+    def poll(cls, context):
+        """Curves and hair; of meshes, wire meshes (edges, no faces) or one whose tube preview is on: a mesh with
+        faces is not what tubes are made from (*Object › Tessera › Tubes* still takes its edges)."""
+        ob = active_object(context)
+        if ob is None or ob.type not in cls.object_types:
+            return False
+        if ob.type != "MESH" or ob.tessera.tubes.preview:
+            return True
+        return len(ob.data.edges) > 0 and len(ob.data.polygons) == 0
     def draw_header(self, context):
         self.layout.prop(active_object(context).tessera.tubes, "preview", text="")
 

@@ -44,7 +44,7 @@ class TubeOptions:
                                         default="radius")
     caps: bpy.props.EnumProperty(name="Caps", items=CAP_ITEMS, default="FLAT",
                                  description="How the ends of open tubes are closed")
-    sides_mode: bpy.props.EnumProperty(name="Sides", items=SIDES_ITEMS, default="FIXED",
+    sides_mode: bpy.props.EnumProperty(name="Sides From", items=SIDES_ITEMS, default="FIXED",
                                        description="A fixed number of sides, or fewer sides the smaller a tube looks")
     sides: bpy.props.IntProperty(name="Sides", default=8, min=3, max=1024, soft_max=64,
                                  description="Faces around every tube")

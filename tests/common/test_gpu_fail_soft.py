@@ -89,6 +89,8 @@ def test_operators_fall_back_to_numpy_with_a_warning(failing, bpy_module, clean_
     source = bpy.context.active_object
     results = []
     for evaluate_on in ("GPU", "CPU"):
+        for ob in bpy.context.selected_objects:  # the last result stays selected: Tessellate would take it too
+            ob.select_set(False)
         bpy.context.view_layer.objects.active = source
         source.select_set(True)
         capfd.readouterr()

@@ -91,7 +91,8 @@ def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, a
                                                                    bpy_module):
     """A tangent-space vector map on a wavy grid: the preview (MikkTSpace corner tangents in the control data,
     the frame built in the vertex shader) draws the surface the geometry-nodes group displaces, pixel for pixel
-    (linear method, level 1: the preview's vertices are the mesh's)."""
+    (linear method, level 1: the preview's vertices are the mesh's), shaded with the displaced surface's normals
+    as Blender shades the displaced mesh."""
     bpy = bpy_module
     preview = addon_module("addon.tessellation.preview")
     offscreen = addon_module("gpu_shaders.offscreen")
@@ -126,6 +127,8 @@ def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, a
     vp = cam.projection @ cam.view @ np.array(ob.matrix_world)
     disp = preview.displacement_for(ob)
     assert disp.mode == "TANGENT"
+    white = {"color": (1.0, 1.0, 1.0, 1.0), "lit": False}
+    gpu_flat = offscreen.render(lambda: entry.draw.draw(vp, displacement=disp, **white), size=(200, 200))
     gpu_img = offscreen.render(lambda: entry.draw.draw(vp, displacement=disp), size=(200, 200))
     plain = offscreen.render(lambda: entry.draw.draw(vp), size=(200, 200))
     rest, _ = bridge.read_mesh(ob.data)
@@ -133,8 +136,21 @@ def test_tangent_space_map_in_the_preview_matches_the_node_group(gpu_renderer, a
     moved, _ = bridge.read_mesh(ob.evaluated_get(dg).to_mesh())
     ob.evaluated_get(dg).to_mesh_clear()
     assert np.abs(moved.positions - rest.positions).max() > 0.05
-    cpu = offscreen.render_triangles(moved.positions, moved.triangles, vp, size=(200, 200),
-                                     normals=rest.corner_normals)
-    close = np.all(np.abs(cpu.astype(int) - gpu_img.astype(int)) <= 2, axis=-1)
-    assert close.mean() >= 0.995, close.mean()
+    cpu_flat = offscreen.render_triangles(moved.positions, moved.triangles, vp, size=(200, 200), **white)
+    close = np.all(np.abs(cpu_flat.astype(int) - gpu_flat.astype(int)) <= 2, axis=-1)
+    assert close.mean() >= 0.995, close.mean()  # the same surface, pixel for pixel
     assert np.mean(np.any(plain != gpu_img, axis=-1)) > 0.02
+
+    # Shading: the displaced mesh's own normals (Blender's), not the undisplaced surface's.
+    covered = cpu_flat[..., 0] > 127
+    displaced = offscreen.render_triangles(moved.positions, moved.triangles, vp, size=(200, 200),
+                                           normals=moved.corner_normals)
+    undisplaced = offscreen.render_triangles(moved.positions, moved.triangles, vp, size=(200, 200),
+                                             normals=rest.corner_normals)
+
+    def error(reference):
+        return float(np.abs(reference[covered, :3].astype(int) - gpu_img[covered, :3].astype(int)).mean())
+
+    assert covered.sum() > 5000
+    assert error(displaced) < 0.5 * error(undisplaced), (error(displaced), error(undisplaced))
+    assert error(displaced) < 6.0, error(displaced)

@@ -1,4 +1,4 @@
-"""Loop, tubes, terrain and live parametric surface previews in a real Blender window (scenario ``previews``), on
+"""Loop, tubes, terrain, displacement-map and live parametric surface previews in a real Blender window (scenario ``previews``), on
 OpenGL and Vulkan: each drawn instead of its source and lit as Solid mode lights Blender's own objects, so that it
 looks like its applied result drawn by Blender; hiding the source hides the preview."""
 
@@ -8,7 +8,7 @@ from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- 
 
 pytestmark = pytest.mark.window
 
-PREVIEWS = ("loop", "tubes", "terrain", "surface")
+PREVIEWS = ("loop", "tubes", "terrain", "displacement", "surface")
 LIGHTINGS = ("", "_matcap")  # Solid mode's studio lighting, its MatCap lighting
 
 

@@ -97,6 +97,41 @@ def run(w):
     yield from lit_both_ways(w, "terrain", empty, setter(ob, "terrain"), lambda: _copy_of(ob), source=ob)
     hidden_pixels(w, ob, "terrain", empty, "terrain")
 
+    # A displacement map on a grid: the tessellation preview sampling it (linear, level 1: the mesh's own vertices)
+    # against Blender drawing the grid its map's modifier displaces
+    clean_scene(w)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=64, y_subdivisions=64, size=4.0)
+    ob = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    operate(w, bpy.ops.tessera.displacement_add, ob, width=128, height=128)
+    v, u = (np.mgrid[0:128, 0:128] + 0.5) / 128
+    rgba = np.ones((128, 128, 4), np.float32)
+    rgba[..., :3] = (0.5 + 0.5 * np.sin(9.0 * u) * np.cos(7.0 * v))[..., None]
+    d = ob.tessera.displacement
+    d.image.pixels.foreach_set(rgba.ravel())
+    d.image.update()
+    d.mid_level, d.strength = 0.5, 0.6
+    t = ob.tessera.tessellate
+    t.method, t.level_mode, t.level = "LINEAR", "UNIFORM", 1
+    empty = staged(w, ob, "displacement", (1.0, 0.0, 0.6))
+    yield SETTLE
+
+    def displaced_preview(on):
+        t.preview = on
+
+    def displaced_mesh():  # the object itself, displaced by its map's modifier, drawn by Blender
+        copy = bpy.data.objects.new(f"{ob.name} displaced", ob.data)
+        copy.matrix_world = ob.matrix_world.copy()
+        bpy.context.collection.objects.link(copy)
+        copy.tessera.displacement.mode = d.mode
+        copy.tessera.displacement.uv_map = d.uv_map
+        copy.tessera.displacement.mid_level, copy.tessera.displacement.strength = d.mid_level, d.strength
+        copy.tessera.displacement.image = d.image
+        return copy
+
+    ob.hide_set(False)
+    yield from lit_both_ways(w, "displacement", empty, displaced_preview, displaced_mesh, source=ob)
+
     # A live parametric surface against the same surface made as a mesh
     clean_scene(w)
     live = operate(w, bpy.ops.tessera.parametric_surface_add, output="LIVE")

@@ -1,0 +1,51 @@
+"""The sidebar shows an object the panels of what it is, in the order of `sidebar.PANEL_ORDER`: a terrain its
+Terrain panel first, a curve its Tubes panel first, a plain mesh the mesh tools and no Tubes, a wire mesh Tubes."""
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+def shown(bpy, addon_module):
+    """The bl_labels of the Tessera panels the active object gets, top first."""
+    sidebar = addon_module("addon.sidebar")
+    panels = [getattr(bpy.types, idname) for idname in sidebar.PANEL_ORDER if hasattr(bpy.types, idname)]
+    visible = [p for p in panels if p.poll(bpy.context)]
+    assert [p.bl_order for p in visible] == sorted(p.bl_order for p in visible)
+    return [p.bl_label for p in sorted(visible, key=lambda p: p.bl_order)]
+
+
+def test_a_plain_mesh_gets_the_mesh_tools_and_no_tubes(clean_scene, bpy_module, addon_module):
+    bpy_module.ops.mesh.primitive_monkey_add()
+    labels = shown(bpy_module, addon_module)
+    assert labels[0] == "Tessellate" and "Tubes" not in labels and "Terrain" not in labels
+    assert {"Loop Subdivision", "Displacement Map", "Impostors"} <= set(labels)
+
+
+def test_a_wire_mesh_and_a_curve_get_tubes_first(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    mesh = bpy.data.meshes.new("Wire")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0)], [(0, 1), (1, 2)], [])
+    ob = bpy.data.objects.new("Wire", mesh)
+    bpy.context.collection.objects.link(ob)
+    bpy.context.view_layer.objects.active = ob
+    assert shown(bpy, addon_module)[0] == "Tubes"
+    bpy.ops.curve.primitive_bezier_curve_add()
+    assert shown(bpy, addon_module)[0] == "Tubes"
+
+
+def test_a_terrain_gets_its_terrain_panel_first(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    image = bpy.data.images.new("Hills", 33, 33, float_buffer=True)
+    image.pixels.foreach_set(np.random.default_rng(1).random(33 * 33 * 4).astype(np.float32))
+    assert bpy.ops.tessera.terrain_add(source="IMAGE", image_name=image.name) == {"FINISHED"}
+    labels = shown(bpy, addon_module)
+    assert labels[0] == "Terrain" and "Tubes" not in labels
+    bpy.data.images.remove(image)
+
+
+def test_nothing_fitting_gets_start_here_only(clean_scene, bpy_module, addon_module):
+    bpy = bpy_module
+    bpy.ops.object.camera_add()
+    assert shown(bpy, addon_module) == ["Start Here"]
