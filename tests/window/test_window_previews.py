@@ -1,6 +1,7 @@
-"""Loop, tubes, terrain, displacement-map and live parametric surface previews in a real Blender window (scenario ``previews``), on
-OpenGL and Vulkan: each drawn instead of its source and lit as Solid mode lights Blender's own objects, so that it
-looks like its applied result drawn by Blender; hiding the source hides the preview."""
+"""Loop, tubes, terrain, displacement-map and live parametric surface previews in a real Blender window (scenario
+``previews``), on OpenGL and Vulkan: each drawn instead of its source and lit as Solid mode lights Blender's own
+objects (studio lights and MatCap), so that it looks like its applied result drawn by Blender; hiding the source
+hides the preview."""
 
 import pytest
 from test_window_tessellation import PREVIEW_BAR
