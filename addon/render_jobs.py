@@ -8,7 +8,8 @@ scripts share `worker_device.py` (the user's Cycles device on the worker's side)
   (`close_all`), and folders that a Blender which crashed left behind are removed at the next enable
   (`remove_stale_folders`: only Tessera's kinds, only when their process is gone or they are old).
 - **Progress**: the worker prints ``TESSERA_PROGRESS k/n`` after each view and ``TESSERA_DEVICE ...`` once it knows
-  what it renders on; `RenderJob.progress` reads them from the log without blocking (the UI polls from a timer), and
+  what it renders on; `RenderJob.progress` reads them from the log without blocking (the UI polls from a timer;
+  `RenderJob.fraction` adds the share of the current view from its ``TESSERA_SAMPLES k/n`` lines), and
   `RenderJob.wait` follows them to the end where nothing can poll (``blender -b``, the ``bpy`` module), printing a
   line per step so scripts show progress.
 - **Device**: `render_device` gives the worker the Cycles device the user chose in the preferences (GPU where one is
@@ -36,8 +37,10 @@ KINDS = ("impostor", "board", "bake")
 ORPHAN_AGE_S = 60.0
 STALE_AGE_S = 24 * 3600.0
 _OWNER = "owner.pid"
-_PROGRESS = re.compile(rb"TESSERA_PROGRESS (\d+)/(\d+)")
 _DEVICE = re.compile(rb"TESSERA_DEVICE ([^\r\n]+)")
+#: A worker's progress lines: its step lines, and the samples of the render under way (`worker_device.report_samples`),
+#: so progress moves within a step.
+_STEPS = re.compile(rb"TESSERA_PROGRESS (\d+)/\d+|TESSERA_SAMPLES (\d+)/(\d+)")
 
 _open_jobs = {}  # folder -> RenderJob (or None while the job is being set up)
 
@@ -203,6 +206,7 @@ class RenderJob:
     def __init__(self, process, folder, total, log):
         self.process, self.folder, self.total, self.log = process, folder, int(total), log
         self._read, self._partial, self._done, self._device = 0, b"", 0, ""
+        self._within = 0.0  # the share of the current step done (its render's samples)
         _open_jobs[folder] = self
 
     def _log_bytes(self):
@@ -225,9 +229,11 @@ class RenderJob:
         text = self._partial + new
         cut = text.rfind(b"\n") + 1
         lines, self._partial = text[:cut], text[cut:]
-        done = _PROGRESS.findall(lines)
-        if done:
-            self._done = int(done[-1][0])
+        for step, sample, samples in _STEPS.findall(lines):
+            if step:
+                self._done, self._within = int(step), 0.0
+            elif int(samples) > 0:
+                self._within = min(int(sample) / int(samples), 1.0)
         found = _DEVICE.search(lines)
         if found and not self._device:
             self._device = found.group(1).decode("utf-8", "replace").strip()
@@ -236,6 +242,11 @@ class RenderJob:
         """Steps done so far (from the worker's log; never blocks): int."""
         self._scan()
         return self._done
+
+    def fraction(self):
+        """Steps done so far and the share of the current one its render has sampled (never blocks): float."""
+        self._scan()
+        return self._done + (self._within if self._done < self.total else 0.0)
 
     def device(self):
         """What the worker said it renders on, or "" before it says."""

@@ -27,3 +27,20 @@ def use_device(scene, device):
         except (KeyError, TypeError, AttributeError, RuntimeError) as err:
             print(f"Tessera: the GPU device could not be set up ({err}); rendering on the CPU", flush=True)
     print("TESSERA_DEVICE CPU", flush=True)
+
+
+def report_samples():
+    """Print a ``TESSERA_SAMPLES k/n`` line each time the render under way reaches a new sample (from Blender's
+    render statistics), so progress moves within a view (`render_jobs.RenderJob.fraction`)."""
+    import re
+
+    last = [None]
+    pattern = re.compile(r"Sample (\d+)/(\d+)")
+
+    def stats(text):
+        found = pattern.search(text)
+        if found and found.groups() != last[0]:
+            last[0] = found.groups()
+            print(f"TESSERA_SAMPLES {found.group(1)}/{found.group(2)}", flush=True)
+
+    bpy.app.handlers.render_stats.append(stats)

@@ -110,11 +110,13 @@ class TESSERA_OT_impostor_bake(bpy.types.Operator):
 
     def _status(self, context):
         job = self._job.job
-        done = job.progress()
+        done = job.fraction()
         context.window_manager.progress_update(done)
         device = job.device()
         on = f" on {device}" if device else ""
-        context.workspace.status_text_set(f"Baking impostor: view {done} of {job.total}{on} — Esc to cancel")
+        view = min(int(done) + 1, job.total)
+        context.workspace.status_text_set(f"Baking impostor: view {view} of {job.total} "
+                                          f"({100.0 * done / max(job.total, 1):.0f}%){on} — Esc to cancel")
 
     def _end(self, context):
         wm = context.window_manager

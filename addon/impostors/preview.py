@@ -100,8 +100,8 @@ def _finite(s):
 
 @dataclass
 class Prewarp:
-    """One object's pre-warp: ``splat`` made from ``images`` for the eye ``eye`` (bytes), and ``pending``: the
-    ``(images, eye, future)`` of one being made on a worker thread."""
+    """One object's pre-warp: ``splat`` (a `Splat` and its offset rows) made from ``images`` for the eye ``eye``
+    (bytes), and ``pending``: the ``(images, eye, future)`` of one being made on a worker thread."""
 
     images: object = None
     eye: bytes = b""
@@ -114,7 +114,11 @@ PREWARP_COUNT = [0]  # pre-warps started this session (the window tier counts th
 
 
 def _prewarp(images, target):
-    return fill_holes(forward_splat(images.displacement, images.setup.frame, target, images.present), HOLE_GAP)
+    """The pre-warp of ``images`` for the eye ``target`` and its offset rows, ready to upload: ``(Splat, rows)``."""
+    from ...gpu_shaders.impostors.draw import offset_rows
+
+    splat = fill_holes(forward_splat(images.displacement, images.setup.frame, target, images.present), HOLE_GAP)
+    return splat, offset_rows(splat)
 
 
 def splat_for(ob, images, target):
@@ -167,11 +171,11 @@ def _draw(context, region, view, proj):
         if images is None:
             continue
         # relief mapping: pre-warped for this eye; a plain sprite: for the eye it was made for
-        splat = splat_for(ob, images, eye if s.relief else live.board.eye)
+        splat, rows = splat_for(ob, images, eye if s.relief else live.board.eye)
         if live.draw is None:
             live.draw = BoardDrawData(images.setup.frame, images.colours, images.displacement, splat, images.normals)
         elif live.draw.splat is not splat:
-            live.draw.set_splat(splat)
+            live.draw.set_splat(splat, rows)
         live.draw.draw(proj @ view)
 
 

@@ -17,7 +17,7 @@ import bpy
 from mathutils import Matrix, Vector
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # addon/: the shared worker module
-from worker_device import use_device  # noqa: E402
+from worker_device import report_samples, use_device  # noqa: E402
 
 
 def setup(job):
@@ -78,6 +78,7 @@ def main(argv):
     with open(argv[0], encoding="utf-8") as f:
         job = json.load(f)
     scene = setup(job)
+    report_samples()
     for k, view in enumerate(job["views"], 1):
         render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"],
                     view.get("preview"))

@@ -36,6 +36,13 @@ def _describe():
     return info
 
 
+def offset_rows(splat):
+    """The offset map of a `Splat` as the GPU takes it: (H, W, 2) float32 source texel centres, holes (NaN) as -1,
+    an address no texel has (the shader tests for it: no NaN comparison on the GPU). Pure numpy: a worker thread
+    makes it with the pre-warp, so the draw only uploads."""
+    return np.nan_to_num(np.asarray(splat.offsets, np.float32), nan=-1.0)
+
+
 class BoardDrawData:
     """GPU resources of one nailboard: frame (`kernels.impostors.prewarp.ReliefFrame`); colours (H, W, 4),
     displacement (H, W) and normals (H, W, 3) of its source images; splat: the `Splat` of the current pre-warp."""
@@ -51,11 +58,11 @@ class BoardDrawData:
         self.normals = image_texture(n, "RGBA32F")
         self.set_splat(splat)
 
-    def set_splat(self, splat):
-        """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel; its holes (NaN) as -1, an
-        address no texel has (the shader tests for it: no NaN comparison on the GPU)."""
+    def set_splat(self, splat, rows=None):
+        """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel; rows: its `offset_rows` when
+        made already (on a worker thread)."""
         self.splat = splat
-        self.offsets = image_texture(np.nan_to_num(np.asarray(splat.offsets, np.float32), nan=-1.0), "RG32F")
+        self.offsets = image_texture(offset_rows(splat) if rows is None else rows, "RG32F")
 
     def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
         """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major."""

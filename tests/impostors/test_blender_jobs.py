@@ -4,6 +4,7 @@ once with a back-off, the redo panel reusing what did not change, bakes that sur
 linked data refused."""
 
 import os
+import re
 import subprocess
 import sys
 import time
@@ -268,3 +269,29 @@ def test_a_later_card_copies_the_material_of_its_kind_with_its_own_atlas(clean_s
         bpy.data.materials.remove(card.active_material)
     fresh = bake.card_material("fresh", bpy.data.images[f"{cards[1].name} colour"], 2, False, True)
     assert _graph(fresh)[0] == copied
+
+
+def test_progress_moves_within_a_view(clean_scene, bpy_module, addon_module, tmp_path):
+    """The status bar's share comes from the worker's step lines and, within a step, from its sample lines (a real
+    worker's log holds them)."""
+    bpy = bpy_module
+    bake = addon_module("addon.impostors.bake")
+    jobs = addon_module("addon.render_jobs")
+    aj = bake.start_atlas(_box(bpy), grid=1, tile=32, samples=8)
+    aj.job.process.wait(timeout=300)
+    real = aj.job._log_bytes()
+    aj.job.wait(lambda line: None, "Baking impostor views", timeout=300)
+    assert b"TESSERA_PROGRESS 1/1" in real and re.search(rb"TESSERA_SAMPLES [1-7]/8", real), real[-600:]
+    log = (tmp_path / "log")
+    log.write_bytes(b"TESSERA_DEVICE CPU\nTESSERA_SAMPLES 2/8\nTESSERA_SAMPLES 4/8\n")
+    job = jobs.RenderJob(None, str(tmp_path / "folder"), 2, str(log))
+    try:
+        assert job.fraction() == 0.5 and job.progress() == 0
+        with open(log, "ab") as f:
+            f.write(b"TESSERA_PROGRESS 1/2\nTESSERA_SAMPLES 6/8\nTESSERA_SAM")  # half a line: not read yet
+        assert job.fraction() == 1.75 and job.progress() == 1
+        with open(log, "ab") as f:
+            f.write(b"PLES 8/8\nTESSERA_PROGRESS 2/2\n")
+        assert job.fraction() == 2.0 and job.progress() == 2
+    finally:
+        jobs._open_jobs.pop(job.folder, None)

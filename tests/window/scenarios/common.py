@@ -14,13 +14,16 @@ THRESHOLD = 16
 
 def clean_scene(w):
     """No objects, no leftover meshes; Solid shading, overlays on except the text (it names the active object, which
-    the compared screenshots need not share)."""
+    the compared screenshots need not share) and the floor grid with its axes (Mesa's lavapipe draws Blender's grid
+    with blocks of garbage in perspective views, different from frame to frame)."""
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
     for mesh in list(bpy.data.meshes):
         bpy.data.meshes.remove(mesh)
     w.space.shading.type = "SOLID"
-    w.space.overlay.show_text = False
+    overlay = w.space.overlay
+    overlay.show_text = False
+    overlay.show_floor = overlay.show_axis_x = overlay.show_axis_y = False
 
 
 def frame(w, objects, view="FRONT"):
