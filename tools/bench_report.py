@@ -9,6 +9,7 @@ the run's date, machine and Blender in the block ``<!-- bench:machine -->``. Tex
 Usage:
     python tools/bench_report.py --run            # run every bench, then write the page (what `make bench` does)
     python tools/bench_report.py --run tubes      # run some, then write the page from whatever out/bench holds
+                                                  # (a bench not run here keeps its block as it is)
     python tools/bench_report.py                  # write the page from out/bench as it is
 """
 
@@ -138,15 +139,21 @@ def machine_block():
     return "*Measured " + "; ".join(parts) + ".*\n"
 
 
-def write_page():
+def write_page(machine_too=True):
+    """Fill the page's blocks from out/bench; the machine block only with ``machine_too`` (a run of every bench:
+    after a partial run the page's other tables still come from the machine it names)."""
     text = PAGE.read_text(encoding="utf-8")
 
     def fill(match):
         name = match.group(2)
         if name == "machine":
+            if not machine_too:
+                return match.group(0)
             body = machine_block()
         else:
             path = OUT / f"{name}.jsonl"
+            if not path.exists() and match.group(3).strip():
+                return match.group(0)  # not run here: the block keeps the tables of the run that wrote it
             rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()] \
                 if path.exists() else []
             body = tables(rows) if rows else f"*(bench/{name}.py has not been run: `make bench`)*\n"
@@ -169,7 +176,8 @@ def main():
         if unknown:
             raise SystemExit(f"bench_report: no bench called {sorted(unknown)}")
         failed = run(args.run or benches())
-    write_page()
+    # the machine line names where the page's tables were measured: only when out/bench holds every bench's rows
+    write_page(machine_too=all((OUT / f"{name}.jsonl").exists() for name in benches()))
     if args.run is not None and failed:
         raise SystemExit(f"bench_report: these benches failed (their rows say how): {failed}")
 

@@ -35,7 +35,8 @@ from .worker import world_box
 @dataclass
 class LiveBoard:
     """One object's state: images and board (what it is drawn from, or None), the transform they were made with,
-    the running job, the eyes of the last frames (for the velocity), and the GPU draw data (set by the viewport)."""
+    the running job and the eyes of the last frames (for the velocity). The viewport keeps what it draws itself
+    (`preview.Prewarp`)."""
 
     images: object = None
     board: Board = None
@@ -43,7 +44,6 @@ class LiveBoard:
     pending: object = None
     pending_board: Board = None
     eyes: list = field(default_factory=list)
-    draw: object = None
     previewing: bool = False  # drawn from the pending job's preview until its full render is there
     resampling: tuple = None  # (future of the resampled images, the images and Board it resamples, its resolution)
     keep: Board = None  # a board whose resampling failed: drawn as it is
@@ -101,7 +101,7 @@ class NailboardManager:
                 live.retry_at = time.monotonic() + min(RETRY_MAX_S, RETRY_S * 2 ** (live.failures - 1))
                 print(f"Tessera: the nailboard of {ob.name!r} could not be rendered: {err}")
             else:
-                live.images, live.board, live.draw = images, live.pending_board, None
+                live.images, live.board = images, live.pending_board
                 live.failed, live.failures = "", 0
                 self.cache[(ob.session_uid, live.matrix, live.board.eye.tobytes())] = (live.images, live.board)
                 while len(self.cache) > self.cache_size:
@@ -109,14 +109,14 @@ class NailboardManager:
         elif live.pending is not None and not live.previewing:
             early = getattr(live.pending, "preview", lambda: None)()
             if early is not None:
-                live.images, live.board, live.draw, live.previewing = early, live.pending_board, None, True
+                live.images, live.board, live.previewing = early, live.pending_board, True
                 self.previews += 1
         moved = live.matrix != matrix
         if moved:
             if live.pending is not None:
                 live.pending.cancel()
                 live.pending, live.previewing = None, False
-            live.images, live.board, live.draw, live.matrix = None, None, None, matrix
+            live.images, live.board, live.matrix = None, None, matrix
         verdict = None if live.board is None else check(live.board, eye, fov, res_screen, self.k, self.relief_factor)
         stale = verdict is None or verdict.regenerate
         if stale and live.pending is None:
@@ -124,7 +124,7 @@ class NailboardManager:
                 self.reasons.append(verdict)
             hit = self._cached(ob, matrix, eye, res_screen, fov)
             if hit is not None:
-                live.images, live.board, live.draw = hit[0], hit[1], None
+                live.images, live.board = hit[0], hit[1]
                 self.cache_hits += 1
             elif time.monotonic() >= live.retry_at:
                 self._ask(ob, live, eye, res_screen, fov)
@@ -142,7 +142,7 @@ class NailboardManager:
                 print(f"Tessera: resampling a nailboard failed, it is drawn as rendered: {future.exception()}")
                 live.keep = board
             elif live.images is source and live.board is board:  # nothing newer came in the meantime
-                live.images, live.draw = future.result(), None
+                live.images = future.result()
                 live.board = Board(board.eye, board.lo, board.hi, resolution)
                 self.resamples += 1
             return

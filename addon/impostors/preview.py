@@ -1,10 +1,10 @@
 """Live nailboards in the 3D viewport: objects with ``tessera.nailboard.enabled`` are drawn from their current
 board (`live.NailboardManager`), pre-warped for the eye on the CPU (8 bytes a texel uploaded) and drawn by the GPU
-with per-texel depth. A pre-warp is made once per board and eye (`splat_for`): a redraw for the same view does none,
-and a moved eye's is made on a worker thread while the last one is drawn. The draw callback never waits: a board is
-asked for through a timer (a draw callback may not save files or start processes), rendered by the worker process,
-and swapped in when done. The board is drawn instead of its object (`viewport.sync_source`), hidden with it.
-Nothing is drawn in background mode."""
+with per-texel depth. A pre-warp is made once per board and eye, on a worker thread, while the last one is drawn
+(`splat_for`): a redraw for the same view makes none, and the main thread never makes one. The draw callback never
+waits: a board is asked for through a timer (a draw callback may not save files or start processes), rendered by the
+worker process, and swapped in when done. The board is drawn instead of its object (`viewport.sync_source`), hidden
+with it. Nothing is drawn in background mode."""
 
 from dataclasses import dataclass
 
@@ -100,12 +100,13 @@ def _finite(s):
 
 @dataclass
 class Prewarp:
-    """One object's pre-warp: ``splat`` (a `Splat` and its offset rows) made from ``images`` for the eye ``eye``
-    (bytes), and ``pending``: the ``(images, eye, future)`` of one being made on a worker thread."""
+    """What the viewport draws one object from: ``shown``, the ``(images, eye, (Splat, offset rows))`` drawn now, its
+    GPU ``draw`` data (`BoardDrawData`) made from ``draw_images``, and ``pending``: the ``(images, eye, future)`` of a
+    pre-warp being made on a worker thread."""
 
-    images: object = None
-    eye: bytes = b""
-    splat: object = None
+    shown: tuple = None
+    draw: object = None
+    draw_images: object = None
     pending: tuple = None
 
 
@@ -122,9 +123,10 @@ def _prewarp(images, target):
 
 
 def splat_for(ob, images, target):
-    """The pre-warp to draw ``images`` with for the eye ``target`` (3,): made now, once, for a new board; for a
-    moved eye, asked of a worker thread while the last eye's is returned (a timer redraws when it is done); for the
-    same board and eye, the one made before (no work)."""
+    """What to draw ``ob`` from when its current board is ``images`` and the eye ``target`` (3,): ``(images, eye,
+    (Splat, rows))``, or None before any is ready. For the same board and eye, the one made before (no work); for a
+    new board or a moved eye, the last one made while a worker thread pre-warps the new (a timer redraws when it is
+    done): the main thread never pre-warps."""
     p = _prewarps.setdefault(ob.session_uid, Prewarp())
     eye = np.asarray(target, np.float64).tobytes()
     if p.pending is not None and p.pending[2].done():
@@ -132,20 +134,16 @@ def splat_for(ob, images, target):
         p.pending = None
         if future.exception() is not None:
             print(f"Tessera: a nailboard pre-warp failed: {future.exception()}")
-        elif done_images is images:
-            p.eye, p.splat = done_eye, future.result()
-    if p.images is images and p.eye == eye:
-        return p.splat
-    if p.images is not images:  # a new board: pre-warped now, once
-        PREWARP_COUNT[0] += 1
-        p.images, p.eye, p.splat = images, eye, _prewarp(images, target)
-        return p.splat
-    if p.pending is None or p.pending[0] is not images:
+        else:
+            p.shown = (done_images, done_eye, future.result())
+    if p.shown is not None and p.shown[0] is images and p.shown[1] == eye:
+        return p.shown
+    if p.pending is None:  # one at a time: one for an earlier eye or board is shown when done, then this one asked
         PREWARP_COUNT[0] += 1
         p.pending = (images, eye, workers.submit(_prewarp, images, np.array(target, np.float64)))
         if not bpy.app.timers.is_registered(_poll_prewarps):
             bpy.app.timers.register(_poll_prewarps, first_interval=0.02)
-    return p.splat
+    return p.shown
 
 
 def _poll_prewarps():
@@ -171,12 +169,18 @@ def _draw(context, region, view, proj):
         if images is None:
             continue
         # relief mapping: pre-warped for this eye; a plain sprite: for the eye it was made for
-        splat, rows = splat_for(ob, images, eye if s.relief else live.board.eye)
-        if live.draw is None:
-            live.draw = BoardDrawData(images.setup.frame, images.colours, images.displacement, splat, images.normals)
-        elif live.draw.splat is not splat:
-            live.draw.set_splat(splat, rows)
-        live.draw.draw(proj @ view)
+        shown = splat_for(ob, images, eye if s.relief else live.board.eye)
+        if shown is None:
+            continue
+        shown_images, _, (splat, rows) = shown
+        p = _prewarps[ob.session_uid]
+        if p.draw is None or p.draw_images is not shown_images:
+            p.draw = BoardDrawData(shown_images.setup.frame, shown_images.colours, shown_images.displacement, splat,
+                                   shown_images.normals, rows)
+            p.draw_images = shown_images
+        elif p.draw.splat is not splat:
+            p.draw.set_splat(splat, rows)
+        p.draw.draw(proj @ view)
 
 
 def previewing(ob):

@@ -47,7 +47,7 @@ class BoardDrawData:
     """GPU resources of one nailboard: frame (`kernels.impostors.prewarp.ReliefFrame`); colours (H, W, 4),
     displacement (H, W) and normals (H, W, 3) of its source images; splat: the `Splat` of the current pre-warp."""
 
-    def __init__(self, frame, colours, displacement, splat, normals=None):
+    def __init__(self, frame, colours, displacement, splat, normals=None, rows=None):
         h, w = np.asarray(displacement).shape
         self.frame, self.size = frame, (w, h)
         self.colours = image_texture(colours, "RGBA32F")
@@ -56,7 +56,7 @@ class BoardDrawData:
         if normals is not None:
             n[..., :3] = normals
         self.normals = image_texture(n, "RGBA32F")
-        self.set_splat(splat)
+        self.set_splat(splat, rows)
 
     def set_splat(self, splat, rows=None):
         """Upload a new offset map (a new pre-warp for a moved eye): 8 bytes a texel; rows: its `offset_rows` when

@@ -162,8 +162,15 @@ def test_the_viewport_draws_a_live_nailboard_without_waiting(clean_scene, gpu_re
     preview._start_queued()  # what the timer does outside the draw callback
     live = preview.MANAGER.boards[ball.session_uid]
     live.pending.job.result(timeout=240)
-    second = offscreen.render(lambda: preview._draw(context, region, cam.view, cam.projection), size=(160, 160))
+    draw = lambda: preview._draw(context, region, cam.view, cam.projection)  # noqa: E731
+    swapped = offscreen.render(draw, size=(160, 160))  # the board swapped in; its pre-warp asked of a worker thread
     assert live.images is not None and live.pending is None
+    assert swapped[..., :3].max() == 0 and preview.PREWARP_COUNT[0] >= 1
+    preview._prewarps[ball.session_uid].pending[2].result(timeout=60)
+    second = offscreen.render(draw, size=(160, 160))
+    count = preview.PREWARP_COUNT[0]
+    again = offscreen.render(draw, size=(160, 160))
+    assert preview.PREWARP_COUNT[0] == count and np.array_equal(again, second)  # the same view: no new pre-warp
     drawn = second[..., :3].max(axis=-1) > 10
     assert drawn.sum() > 1000 and (second[..., 0][drawn] >= second[..., 2][drawn]).all()
     preview.MANAGER.boards.clear()
