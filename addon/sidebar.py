@@ -20,12 +20,22 @@ def wrapped_label(layout, context, text, icon="NONE"):
     import textwrap
 
     region = getattr(context, "region", None)
-    scale = context.preferences.system.ui_scale if getattr(context, "preferences", None) else 1.0
+    scale = (context.preferences.system.ui_scale if getattr(context, "preferences", None) else 0.0) or 1.0
     width = max(20, int((region.width if region is not None else 300) / (7.0 * scale)) - 4)
     col = layout.column(align=True)
     for i, line in enumerate(textwrap.wrap(text, width) or [""]):
         col.label(text=line, icon=icon if i == 0 else "BLANK1" if icon != "NONE" else "NONE")
     return col
+
+
+def preview_notice(layout, context, on, how):
+    """Under a preview switched ``on`` where the viewport shades in Material Preview or Rendered: the preview is drawn
+    as in Solid mode there, its object is left out of the viewport's render while it is on, and F12 renders the
+    object as it is; ``how`` (a phrase) says how to get the result into a render."""
+    shading = getattr(getattr(getattr(context, "space_data", None), "shading", None), "type", "SOLID")
+    if on and shading in {"MATERIAL", "RENDERED"}:
+        wrapped_label(layout.box(), context, "Live Preview is drawn as in Solid mode; renders show the object without "
+                      f"it. To render the result, {how}.", icon="INFO")
 
 
 class Sidebar:

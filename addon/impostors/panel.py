@@ -5,7 +5,7 @@ import bpy
 
 from ...kernels.common.errors import InvalidInputError
 from ..guarded import check_numbers
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .preview import MANAGER
 
 
@@ -18,6 +18,7 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
     def draw(self, context):
         s = active_object(context).tessera.nailboard
         layout = self.layout
+        preview_notice(layout, context, s.enabled, "bake an impostor card (Bake Impostor)")
         layout.use_property_split = True
         layout.use_property_decorate = False
         layout.prop(s, "enabled", text="Live Nailboard")

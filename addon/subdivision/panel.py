@@ -3,7 +3,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .build import HCE_PROPERTY
 from .settings import copy_subdivision_settings, draw_subdivision_settings
 
@@ -21,6 +21,7 @@ class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
         layout = self.layout
         ob = active_object(context)
         settings = ob.tessera.loop
+        preview_notice(layout, context, settings.preview, "apply it (Loop Subdivide)")
         draw_subdivision_settings(layout, settings)
         me = ob.data
         col = layout.column(align=True)

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .settings import draw_surface_options
 
 
@@ -22,6 +22,7 @@ class TESSERA_PT_surfaces(Sidebar, bpy.types.Panel):
     def draw(self, context):
         s = active_object(context).tessera.surface
         layout = self.layout
+        preview_notice(layout, context, s.is_surface, "bake it into a mesh (Bake Surface)")
         draw_surface_options(layout, s)
         col = layout.column()
         col.use_property_split = True

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .settings import draw_terrain_settings
 
 
@@ -20,6 +20,8 @@ class TESSERA_PT_terrain(Sidebar, bpy.types.Panel):
         self.layout.prop(active_object(context).tessera.terrain, "preview", text="")
 
     def draw(self, context):
+        preview_notice(self.layout, context, active_object(context).tessera.terrain.preview,
+                       "bake it for the camera (Bake Terrain for Camera) or add the Tessera Terrain node group")
         draw_terrain_settings(self.layout, active_object(context).tessera.terrain)
         row = self.layout.row()
         row.scale_y = 1.4

@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .settings import draw_settings
 
 
@@ -14,6 +14,8 @@ class TESSERA_PT_tessellation(Sidebar, bpy.types.Panel):
     def draw(self, context):
         settings = active_object(context).tessera.tessellate
         self.layout.prop(settings, "preview", icon="HIDE_OFF")
+        preview_notice(self.layout, context, settings.preview, "apply it (Tessellate) or add the Tessera PN "
+                       "Triangles or Phong node group")
         draw_settings(self.layout, settings)
         row = self.layout.row()
         row.scale_y = 1.4

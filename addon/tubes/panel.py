@@ -2,7 +2,7 @@
 
 import bpy
 
-from ..sidebar import Sidebar, active_object, panel_order
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .settings import copy_tubes_settings, draw_tubes_settings
 from .sources import SOURCE_TYPES
 
@@ -28,6 +28,8 @@ class TESSERA_PT_tubes(Sidebar, bpy.types.Panel):
 
     def draw(self, context):
         settings = active_object(context).tessera.tubes
+        preview_notice(self.layout, context, settings.preview, "make the mesh (Make Tube Mesh) or add the Tessera "
+                       "Tubes node group")
         draw_tubes_settings(self.layout, settings)
         row = self.layout.row()
         row.scale_y = 1.4

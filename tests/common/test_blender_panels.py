@@ -49,3 +49,34 @@ def test_nothing_fitting_gets_start_here_only(clean_scene, bpy_module, addon_mod
     bpy = bpy_module
     bpy.ops.object.camera_add()
     assert shown(bpy, addon_module) == ["Start Here"]
+
+
+def test_material_preview_and_rendered_say_how_to_render_the_result(clean_scene, bpy_module, addon_module):
+    """In Material Preview and Rendered shading a preview that is on says it is drawn as in Solid mode, and how to
+    get its result into a render; in Solid mode, or with the preview off, nothing is said."""
+    from types import SimpleNamespace
+
+    sidebar = addon_module("addon.sidebar")
+
+    class Layout:
+        def __init__(self):
+            self.labels = []
+
+        def box(self):
+            return self
+
+        def column(self, align=False):
+            return self
+
+        def label(self, text="", icon="NONE"):
+            self.labels.append(text)
+
+    def said(shading, on):
+        layout = Layout()
+        context = SimpleNamespace(space_data=SimpleNamespace(shading=SimpleNamespace(type=shading)),
+                                  region=SimpleNamespace(width=320), preferences=bpy_module.context.preferences)
+        sidebar.preview_notice(layout, context, on, "apply it (Tessellate)")
+        return " ".join(layout.labels)
+
+    assert "apply it (Tessellate)" in said("MATERIAL", True) and "Solid" in said("RENDERED", True)
+    assert said("SOLID", True) == "" and said("RENDERED", False) == ""
