@@ -4,7 +4,8 @@ GLSL follows Blender's cross-compilation rules: no ``#version``, ``layout`` or r
 the files; inputs, outputs and uniforms are declared in the create-info. Nothing is compiled at import:
 `shader` compiles on first use (which needs a GPU context, see `addon.gpu_context`). GLSL files are named by
 their path under ``gpu_shaders/`` (``"tubes/tube_vert.glsl"``). `batch` keeps the refinement-pattern batches the
-previews draw instanced; `clear` forgets shaders and batches together.
+previews draw instanced (`pattern_batch`: as triangles, or as their edges for a wire); `clear` forgets shaders and
+batches together.
 
 Every shader is compiled here and nowhere else (`_compile`). A shader that fails is remembered per backend (OpenGL,
 Vulkan, Metal) for the session and raised as a `GPUShaderError` naming the backend and the shader, with the start
@@ -13,6 +14,8 @@ of the driver's log, every time it is asked for, without compiling it again: a p
 """
 
 from pathlib import Path
+
+import numpy as np
 
 from ..kernels.common.errors import GPUShaderError
 
@@ -87,6 +90,25 @@ def batch(key, build):
     if key not in _batches:
         _batches[key] = build()
     return _batches[key]
+
+
+def pattern_batch(key, shader, make, wireframe=False):
+    """The `batch` of a refinement pattern drawn instanced, cached under ``key`` and ``wireframe``: ``make()`` gives
+    ``(vertex attributes {name: (V, k) array}, triangles (T, 3) int32)``; drawn as its triangles, or with
+    ``wireframe`` as each of its edges once (lines)."""
+
+    def build():
+        from gpu_extras.batch import batch_for_shader
+
+        from ..kernels.common.topology import triangle_edges
+
+        attributes, triangles = make()
+        if wireframe:
+            return batch_for_shader(shader, "LINES", attributes,
+                                    indices=triangle_edges(np.asarray(triangles, np.int32))[0])
+        return batch_for_shader(shader, "TRIS", attributes, indices=np.asarray(triangles, np.int32))
+
+    return batch((*key, "wire" if wireframe else "tris"), build)
 
 
 def blank_texture():

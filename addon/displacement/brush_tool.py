@@ -51,6 +51,11 @@ class TESSERA_PT_brush_more(bpy.types.Panel):
     bl_label = "Brush"
     bl_idname = "TESSERA_PT_brush_more"
 
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.type == "MESH" and ob.tessera.displacement.image is not None
+
     def draw(self, context):
         draw_brush_settings(self.layout.column(), context.scene.tessera.brush, map_channels(context))
 

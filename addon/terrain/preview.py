@@ -67,7 +67,7 @@ def _draw(context, region, view, proj):
         if entry is None:
             continue
         update_view(ob, entry, view, proj, region.width, region.height)
-        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ np.array(ob.matrix_world))
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ np.array(ob.matrix_world), wire=True)
 
 
 PREVIEW = Preview(_draw, topic=TOPIC, on_settings=settings_changed, replaces=previewing)

@@ -49,8 +49,8 @@ def _draw(context, region, view, proj):
             cam = Camera(view @ model, proj, region.width, region.height)
             entry.draw.set_sides(lod_sides(entry.draw.lines, kernel_settings(s), cam))
             entry.view = key
-        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ model, region.width, clamp=s.aa_clamp,
-                       max_radius=s.max_radius)
+        draw_as_object(context, ob, view, entry.draw.draw, proj @ view @ model, region.width, wire=True,
+                       clamp=s.aa_clamp, max_radius=s.max_radius)
 
 
 PREVIEW = Preview(_draw, data_types=(bpy.types.Curve, bpy.types.Mesh, bpy.types.Curves), topic=TOPIC)

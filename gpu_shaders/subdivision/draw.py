@@ -5,6 +5,7 @@ Attribute shows the applied result's colours), or drawn as they are (the check s
 
 import numpy as np
 
+from ...kernels.common.topology import triangle_edges
 from .. import loader
 from ..offscreen import set_shading, shaded_create_info
 
@@ -32,11 +33,6 @@ class LoopDrawData:
         self.triangles = np.ascontiguousarray(triangles, np.int32)
         self._batch = self._wire = None
 
-    def _edges(self):
-        """Every edge of the triangles once: (E, 2) int32."""
-        pairs = np.sort(self.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-        return np.unique(pairs, axis=0).astype(np.int32)
-
     def draw(self, view_projection, color=CLAY, lit=None, lighting=None, vertex_colors=None, wireframe=False):
         """Draw into the bound framebuffer; view_projection: (4, 4) row-major, object space to clip. lit: shade
         (default: only without baked colours, which carry their own light); lighting: an `offscreen.ViewLighting`
@@ -51,7 +47,8 @@ class LoopDrawData:
         if wireframe:
             if self._wire is None:
                 self._wire = batch_for_shader(shader, "LINES", {"pos": self.positions, "nor": self.normals,
-                                                                "col": self.colours}, indices=self._edges())
+                                                                "col": self.colours},
+                                              indices=triangle_edges(self.triangles)[0])
             set_shading(shader, view_projection, color, False)
             self._wire.draw(shader)
             return

@@ -64,16 +64,11 @@ def pattern_bytes(factor):
 
 
 def _pattern_batch(shader, factor, wireframe=False):
-    from gpu_extras.batch import batch_for_shader
-
-    def build():
+    def make():
         uv, tris = domain_pattern(factor)
-        if wireframe:
-            edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
-            return batch_for_shader(shader, "LINES", {"uv": uv}, indices=np.unique(edges, axis=0).astype(np.int32))
-        return batch_for_shader(shader, "TRIS", {"uv": uv}, indices=tris)
+        return {"uv": uv}, tris
 
-    return loader.batch(("surfaces", factor, wireframe), build)
+    return loader.pattern_batch(("surfaces", factor), shader, make, wireframe)
 
 
 class SurfaceDrawData:

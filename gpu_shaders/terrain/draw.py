@@ -33,12 +33,10 @@ def _describe():
     return info
 
 
-def _pattern_batch(shader, key):
-    """The tile pattern of class ``key`` (cached)."""
-    from gpu_extras.batch import batch_for_shader
-
-    return loader.batch(("terrain", key), lambda: batch_for_shader(shader, "TRIS", {"code": pattern_codes(*key)},
-                                                                   indices=pattern(*key)))
+def _pattern_batch(shader, key, wireframe=False):
+    """The tile pattern of class ``key`` (cached), its triangles or its edges."""
+    return loader.pattern_batch(("terrain", key), shader, lambda: ({"code": pattern_codes(*key)}, pattern(*key)),
+                                wireframe)
 
 
 class TerrainDrawData:
@@ -74,9 +72,10 @@ class TerrainDrawData:
             self.buckets[key] = (rgba_texture(rows.reshape(-1, 4)), len(tiles))
             self.tile_bytes += rows.nbytes
 
-    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, lighting=None):
+    def draw(self, view_projection, color=(0.8, 0.8, 0.8, 1.0), lit=True, lighting=None, wireframe=False):
         """Draw into the bound framebuffer. view_projection: (4, 4) row-major, terrain-local space to clip;
-        lighting: an `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
+        lighting: an `offscreen.ViewLighting` to light as the viewport does, or None for the check shade;
+        wireframe: the edges of the tiles' triangles instead."""
         shader = loader.shader("terrain_preview", _describe)
         set_shading(shader, view_projection, color, lit, lighting)
         hm = self.hm
@@ -89,4 +88,4 @@ class TerrainDrawData:
             shader.uniform_float("edge_counts", tuple(float(c) for c in key[:4]))
             shader.uniform_float("inner_count", float(key[4]))
             shader.uniform_sampler("tiles", texture)
-            _pattern_batch(shader, key).draw_instanced(shader, instance_start=0, instance_count=count)
+            _pattern_batch(shader, key, wireframe).draw_instanced(shader, instance_start=0, instance_count=count)

@@ -7,7 +7,6 @@ Each class's pattern is drawn instanced; ``patch_eval.glsl`` places its vertices
 is the compute path: the same ``evaluate`` for every welded vertex of a CPU refinement, read back as arrays.
 """
 
-import numpy as np
 
 from ...kernels.tessellation import patch_instances as pi
 from .. import loader
@@ -55,16 +54,12 @@ def _describe_compute():
 
 def _pattern_batch(shader, key, wireframe=False):
     """The pattern of class ``key`` as triangles, or as its unique edges for a wireframe (cached)."""
-    from gpu_extras.batch import batch_for_shader
 
-    def build():
+    def make():
         codes, tris = pi.pattern(*key)
-        if wireframe:
-            edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
-            return batch_for_shader(shader, "LINES", {"code": codes}, indices=np.unique(edges, axis=0).astype(np.int32))
-        return batch_for_shader(shader, "TRIS", {"code": codes}, indices=tris)
+        return {"code": codes}, tris
 
-    return loader.batch(("tessellation", key, wireframe), build)
+    return loader.pattern_batch(("tessellation", key), shader, make, wireframe)
 
 
 def _set_surface(shader, method, pn_quadratic, fractional, control):

@@ -66,19 +66,19 @@ def section_order(lines):
     return np.insert(idx, where, extra)
 
 
-def pattern_batch(shader, n):
-    """Instanced ring pattern with ``n`` sides: 64 x n vertices (ij), 63 x n quads as triangles (cached)."""
-    from gpu_extras.batch import batch_for_shader
+def pattern_batch(shader, n, wireframe=False):
+    """Instanced ring pattern with ``n`` sides: 64 x n vertices (ij), 63 x n quads as triangles, or their edges
+    (cached)."""
 
-    def build():
+    def make():
         k, j = np.meshgrid(np.arange(SECTIONS_PER_PATCH), np.arange(n), indexing="ij")
         ij = np.stack((k, j), axis=-1).reshape(-1, 2).astype(np.float32)
         a = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + np.arange(n)[None, :]).ravel()
         a1 = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + (np.arange(n)[None, :] + 1) % n).ravel()
         tris = np.concatenate((np.stack((a, a1, a1 + n), 1), np.stack((a, a1 + n, a + n), 1))).astype(np.int32)
-        return batch_for_shader(shader, "TRIS", {"ij": ij}, indices=tris)
+        return {"ij": ij}, tris
 
-    return loader.batch(("tubes", n), build)
+    return loader.pattern_batch(("tubes", n), shader, make, wireframe)
 
 
 class TubeDrawData:
@@ -106,9 +106,10 @@ class TubeDrawData:
             self.patch_bytes += rows.nbytes
 
     def draw(self, view_projection, viewport_width, color=(0.8, 0.8, 0.8, 1.0), lit=True, clamp=False,
-             max_radius=0.0, lighting=None):
+             max_radius=0.0, lighting=None, wireframe=False):
         """Draw into the bound framebuffer. view_projection: (4, 4) row-major, object space to clip; lighting: an
-        `offscreen.ViewLighting` to light as the viewport does, or None for the check shade."""
+        `offscreen.ViewLighting` to light as the viewport does, or None for the check shade; wireframe: the edges
+        of the tubes' triangles instead."""
         shader = loader.shader("tube_preview", _describe)
         vp = np.asarray(view_projection, np.float64)
         set_shading(shader, vp, color, lit, lighting)
@@ -120,4 +121,4 @@ class TubeDrawData:
         for n, (texture, count) in self.buckets.items():
             shader.uniform_float("sides", float(n))
             shader.uniform_sampler("patches", texture)
-            pattern_batch(shader, n).draw_instanced(shader, instance_start=0, instance_count=count)
+            pattern_batch(shader, n, wireframe).draw_instanced(shader, instance_start=0, instance_count=count)
