@@ -281,6 +281,8 @@ def test_progress_moves_within_a_view(clean_scene, bpy_module, addon_module, tmp
     aj.job.process.wait(timeout=300)
     real = aj.job._log_bytes()
     aj.job.wait(lambda line: None, "Baking impostor views", timeout=300)
+    bake.read_atlas(aj)  # reading the views removes the job's folder
+    assert aj.job.folder not in jobs.open_folders()
     assert b"TESSERA_PROGRESS 1/1" in real and re.search(rb"TESSERA_SAMPLES [1-7]/8", real), real[-600:]
     log = (tmp_path / "log")
     log.write_bytes(b"TESSERA_DEVICE CPU\nTESSERA_SAMPLES 2/8\nTESSERA_SAMPLES 4/8\n")
