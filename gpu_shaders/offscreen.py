@@ -99,14 +99,14 @@ def shaded_create_info(name, *vertex_files, vertex_color=False):
     if vertex_color:
         iface.smooth("VEC4", "vertex_color")
     info = gpu.types.GPUShaderCreateInfo()
-    if vertex_color:
-        info.define("TESSERA_VERTEX_COLOR")
     add_view_block(info)
     info.sampler(4, "FLOAT_2D", "matcap")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
     info.vertex_source(loader.sources(*vertex_files))
-    info.fragment_source(loader.sources("solid_light.glsl", "flat_mesh_frag.glsl"))
+    # a define in the source, not the create-info: the same text on every supported Blender
+    prelude = "#define TESSERA_VERTEX_COLOR\n" if vertex_color else ""
+    info.fragment_source(prelude + loader.sources("solid_light.glsl", "flat_mesh_frag.glsl"))
     return info
 
 
