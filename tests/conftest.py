@@ -15,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -176,3 +177,39 @@ def built_zips(bpy_module, tmp_root):
                           timeout=900)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return sorted(out.glob("tessera-*.zip"))
+
+
+class Recorder:
+    """A stand-in for `bpy.types.UILayout` that records the label of every property row (a heading prefixes the
+    rows under it, and a box makes a section of its own, as Blender shows them) and accepts every other call."""
+
+    def __init__(self, rows, heading=""):
+        self.rows, self.heading = rows, heading
+        self.boxes = 0
+
+    def prop(self, data, name, text=None, **_):
+        label = text if text is not None else data.bl_rna.properties[name].name
+        if label:
+            self.rows.append(f"{self.heading}{label}")
+
+    def _child(self, heading=""):
+        return Recorder(self.rows, f"{self.heading}{heading}: " if heading else self.heading)
+
+    def column(self, align=False, heading="", **_):
+        return self._child(heading)
+
+    def row(self, align=False, heading="", **_):
+        return self._child(heading)
+
+    def box(self):
+        self.boxes += 1
+        return Recorder(self.rows, f"{self.heading}box {self.boxes}: ")
+
+    def split(self, **_):
+        return self._child()
+
+    def operator(self, *args, **kwargs):
+        return SimpleNamespace()
+
+    def __getattr__(self, name):  # label, separator, template_*, menu, popover ...: nothing to record
+        return lambda *args, **kwargs: self._child()

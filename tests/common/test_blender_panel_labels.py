@@ -5,44 +5,9 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import Recorder
 
 pytestmark = pytest.mark.blender
-
-
-class Recorder:
-    """A stand-in for `bpy.types.UILayout` that records the label of every property row (a heading prefixes the
-    rows under it, and a box makes a section of its own, as Blender shows them) and accepts every other call."""
-
-    def __init__(self, rows, heading=""):
-        self.rows, self.heading = rows, heading
-        self.boxes = 0
-
-    def prop(self, data, name, text=None, **_):
-        label = text if text is not None else data.bl_rna.properties[name].name
-        if label:
-            self.rows.append(f"{self.heading}{label}")
-
-    def _child(self, heading=""):
-        return Recorder(self.rows, f"{self.heading}{heading}: " if heading else self.heading)
-
-    def column(self, align=False, heading="", **_):
-        return self._child(heading)
-
-    def row(self, align=False, heading="", **_):
-        return self._child(heading)
-
-    def box(self):
-        self.boxes += 1
-        return Recorder(self.rows, f"{self.heading}box {self.boxes}: ")
-
-    def split(self, **_):
-        return self._child()
-
-    def operator(self, *args, **kwargs):
-        return SimpleNamespace()
-
-    def __getattr__(self, name):  # label, separator, template_*, menu, popover ...: nothing to record
-        return lambda *args, **kwargs: self._child()
 
 
 def _drawn(bpy, addon_module):
