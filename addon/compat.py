@@ -18,6 +18,8 @@ ask for it, and the version is compared only where the difference cannot be seen
 - geometry-node modes (Set Curve Normal, Resample Curve, Merge by Distance, ...): a node property until 4.5, a
   menu input socket from 5.0 (`set_node_mode`); Curve to Mesh scales the profile by the curve radius by itself in
   4.2 and through its Scale input from 4.5 (builders link the radius where the node has that input);
+- a worker's render reports its samples through the ``render_stats`` handler from 5.2; on 4.2 the handler crashed
+  the worker's background render (`RENDER_STATS_IN_WORKERS`: before, progress moves per view only);
 - the memory layout behind RNA items (face offsets, attribute values) is the same in all of them; `mesh_memory`
   checks it at run time instead of assuming it. The face offsets are closed by the corner count in all of them
   (`FACE_OFFSETS_CLOSED`).
@@ -26,6 +28,10 @@ ask for it, and the version is compared only where the difference cannot be seen
 import math
 
 import bpy
+
+#: A worker's background render may report its samples through ``bpy.app.handlers.render_stats`` (5.2; on 4.2 the
+#: handler crashed the worker, exit -11, as the first statistics came in).
+RENDER_STATS_IN_WORKERS = bpy.app.version >= (5, 2, 0)
 
 #: 5.0+ stores custom normals as a float vector attribute (what is written is what is read back).
 FLOAT_CUSTOM_NORMALS = bpy.app.version >= (5, 0, 0)

@@ -23,6 +23,7 @@ from ...kernels.common.tolerances import ALPHA_FLOOR
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.resample import resample_board
 from .. import render_jobs
+from ..compat import RENDER_STATS_IN_WORKERS
 from ..render_jobs import job_folder, remove_folder, render_device, stop_process, track
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
@@ -65,7 +66,8 @@ def write_job(ob, folder, resolution, samples, scale, clip, views, device=None):
            "world": None if scene.world is None else scene.world.name,
            "matrices": {o.name: [list(row) for row in o.matrix_world] for o in (ob, *lights)},
            "resolution": int(resolution), "samples": int(samples), "scale": float(scale), "clip": float(clip),
-           "views": views, "device": device if device is not None else render_device()}
+           "views": views, "device": device if device is not None else render_device(),
+           "report_samples": RENDER_STATS_IN_WORKERS}
     path = os.path.join(folder, "job.json")
     with open(path, "w", encoding="utf-8") as f:
         json.dump(job, f)

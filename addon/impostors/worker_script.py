@@ -3,10 +3,11 @@ orthographic cameras into multilayer EXRs with their Combined, Depth and Normal 
 
 Argument after ``--``: a job file written by `worker.write_job` (JSON): the blend file holding the object, the
 lights and the world (and only what they depend on), their names, every object's world matrix, resolution,
-samples, orthographic scale, clip end and the views (location, forward, up, out), rendered one after the other (one
+samples, orthographic scale, clip end, the views (location, forward, up, out), rendered one after the other (one
 for a live board, a grid of them for an impostor atlas); a view may ask for a quick preview render first (progressive
-delivery: the viewport draws it until the full render is there). The objects are placed in a scene of their own at the
-matrices given, unparented and unconstrained, so the render sees them where the viewport does.
+delivery: the viewport draws it until the full render is there), and whether to report the render's samples (where the
+Blender allows it: `compat.RENDER_STATS_IN_WORKERS`). The objects are placed in a scene of their own at the matrices
+given, unparented and unconstrained, so the render sees them where the viewport does.
 """
 
 import json
@@ -78,7 +79,8 @@ def main(argv):
     with open(argv[0], encoding="utf-8") as f:
         job = json.load(f)
     scene = setup(job)
-    report_samples()
+    if job.get("report_samples"):
+        report_samples()
     for k, view in enumerate(job["views"], 1):
         render_view(scene, view["location"], view["forward"], view["up"], job["scale"], job["clip"], view["out"],
                     view.get("preview"))

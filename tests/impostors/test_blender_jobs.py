@@ -283,7 +283,9 @@ def test_progress_moves_within_a_view(clean_scene, bpy_module, addon_module, tmp
     aj.job.wait(lambda line: None, "Baking impostor views", timeout=300)
     bake.read_atlas(aj)  # reading the views removes the job's folder
     assert aj.job.folder not in jobs.open_folders()
-    assert b"TESSERA_PROGRESS 1/1" in real and re.search(rb"TESSERA_SAMPLES [1-7]/8", real), real[-600:]
+    assert b"TESSERA_PROGRESS 1/1" in real, real[-600:]
+    if addon_module("addon.compat").RENDER_STATS_IN_WORKERS:
+        assert re.search(rb"TESSERA_SAMPLES [1-7]/8", real), real[-600:]
     log = (tmp_path / "log")
     log.write_bytes(b"TESSERA_DEVICE CPU\nTESSERA_SAMPLES 2/8\nTESSERA_SAMPLES 4/8\n")
     job = jobs.RenderJob(None, str(tmp_path / "folder"), 2, str(log))
