@@ -216,6 +216,8 @@ def test_linked_data_is_refused_by_name(clean_scene, bpy_module, tmp_path):
 
 def test_the_ui_path_of_the_impostor_bake_makes_the_card_of_the_script_path(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
+    for image in [i for i in bpy.data.images if i.name.startswith("Cube impostor")]:  # an earlier test's cards
+        bpy.data.images.remove(image)
     box = _box(bpy)
     op = UiOperator(bpy, "tessera.impostor_bake", grid=2, tile=16, samples=2, dilation=2)
     op._begin(bpy.context)
