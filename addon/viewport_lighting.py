@@ -36,20 +36,22 @@ def surface(shading, ob):
     return color, roughness, metallic
 
 
-_matcaps = {}  # MatCap name -> its (H, 2W, 4) float32 pixels (diffuse | specular), or None when unreadable
+_matcaps = {}  # MatCap name -> (its (H, 2W, 4) float32 pixels (diffuse | specular), it has a specular pass), or
+#                (None, False) when unreadable
 
 
 def matcap_pixels(name):
-    """The MatCap ``name`` as Solid mode lights with it: its diffuse and specular passes side by side, (H, 2W, 4)
-    float32, row 0 at the bottom (read once from Blender's multilayer EXR; a few milliseconds). None when it cannot
-    be read (told once; previews then light with the studio lights)."""
+    """The MatCap ``name`` as Solid mode lights with it: ``(pixels, specular)``, its diffuse and specular passes side
+    by side, (H, 2W, 4) float32, row 0 at the bottom (read once from Blender's multilayer EXR; a few milliseconds),
+    and whether Blender counts its specular pass. Pixels None when it cannot be read (told once; previews then
+    light with the studio lights)."""
     if name not in _matcaps:
         from ..kernels.common.errors import TesseraError
         from ..kernels.common.image_io import read_channels
 
         light = next((sl for sl in bpy.context.preferences.studio_lights
                       if sl.type == "MATCAP" and sl.name == name), None)
-        _matcaps[name] = None
+        _matcaps[name] = (None, False)
         if light is not None:
             try:
                 passes = read_channels(light.path, "MatCap", [f"{p}.{c}" for p in ("diffuse", "specular")
@@ -62,13 +64,13 @@ def matcap_pixels(name):
                 pixels = np.ones((h, 2 * w, 4), np.float32)
                 pixels[:, :w, :3] = np.stack(passes[:3], axis=-1)
                 pixels[:, w:, :3] = np.stack(passes[3:], axis=-1)
-                _matcaps[name] = pixels
+                _matcaps[name] = (pixels, bool(light.has_specular_highlight_pass))
     return _matcaps[name]
 
 
 def matcap_texture(name):
     """The GPU texture of `matcap_pixels` ``name`` (uploaded once per GPU context), or None."""
-    pixels = matcap_pixels(name)
+    pixels = matcap_pixels(name)[0]
     if pixels is None:
         return None
 
@@ -94,10 +96,7 @@ def view_lighting(context, ob, view):
     if shading.light == "MATCAP":
         matcap = matcap_texture(shading.studio_light)
         if matcap is not None:
-            light = next((sl for sl in context.preferences.studio_lights
-                          if sl.type == "MATCAP" and sl.name == shading.studio_light), None)
-            specular = bool(shading.show_specular_highlight and light is not None
-                            and light.has_specular_highlight_pass)
+            specular = shading.show_specular_highlight and matcap_pixels(shading.studio_light)[1]
             return color, ViewLighting(model_view=tuple(map(tuple, model_view)), lights=(), matcap=matcap,
                                        specular=specular, orthographic=not rv3d.is_perspective)
     light = _studio_light(context, shading.studio_light)

@@ -2,14 +2,12 @@
 ring under the cursor and nowhere else (none left where a stroke began), a dragged stroke paints the map."""
 
 import pytest
-from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- fixtures
+from window_tier import assert_no_traceback, run_scenario, scenario_fixture, window_blender  # noqa: F401 -- fixtures
 
 pytestmark = pytest.mark.window
 
 
-@pytest.fixture(params=BACKENDS)
-def brush(request, run_scenario):  # noqa: F811
-    return run_scenario("brush", request.param)
+brush = scenario_fixture("brush")
 
 
 def test_the_tool_is_picked_and_a_stroke_paints(brush):
@@ -28,5 +26,4 @@ def test_one_ring_under_the_cursor_and_none_where_the_stroke_began(brush):
 
 
 def test_no_traceback(brush):
-    _, log, _ = brush
-    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
+    assert_no_traceback(brush[1])

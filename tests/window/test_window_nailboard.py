@@ -5,14 +5,12 @@ asserted.)"""
 
 import pytest
 from test_window_tessellation import MASK_BAR
-from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- fixtures
+from window_tier import assert_no_traceback, run_scenario, scenario_fixture, window_blender  # noqa: F401 -- fixtures
 
 pytestmark = pytest.mark.window
 
 
-@pytest.fixture(params=BACKENDS)
-def nailboard(request, run_scenario):  # noqa: F811
-    return run_scenario("nailboard", request.param)
+nailboard = scenario_fixture("nailboard")
 
 
 def test_the_board_arrives_and_is_drawn_where_the_object_is(nailboard):
@@ -34,5 +32,4 @@ def test_a_redraw_of_the_same_view_makes_no_prewarp(nailboard):
 
 
 def test_no_traceback(nailboard):
-    _, log, _ = nailboard
-    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
+    assert_no_traceback(nailboard[1])

@@ -5,7 +5,7 @@ hides the preview."""
 
 import pytest
 from test_window_tessellation import PREVIEW_BAR
-from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- fixtures
+from window_tier import assert_no_traceback, run_scenario, scenario_fixture, window_blender  # noqa: F401 -- fixtures
 
 pytestmark = pytest.mark.window
 
@@ -13,9 +13,7 @@ PREVIEWS = ("loop", "tubes", "terrain", "displacement", "surface")
 LIGHTINGS = ("", "_matcap")  # Solid mode's studio lighting, its MatCap lighting
 
 
-@pytest.fixture(params=BACKENDS)
-def previews(request, run_scenario):  # noqa: F811
-    return run_scenario("previews", request.param)
+previews = scenario_fixture("previews")
 
 
 @pytest.mark.parametrize("lighting", LIGHTINGS)
@@ -36,5 +34,4 @@ def test_hiding_the_source_hides_its_preview(previews, name):
 
 
 def test_no_traceback(previews):
-    _, log, _ = previews
-    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
+    assert_no_traceback(previews[1])

@@ -6,7 +6,7 @@ import re
 
 import pytest
 from conftest import ROOT
-from window_tier import BACKENDS, run_scenario, window_blender  # noqa: F401 -- fixtures
+from window_tier import assert_no_traceback, run_scenario, scenario_fixture, window_blender  # noqa: F401 -- fixtures
 
 pytestmark = pytest.mark.window
 
@@ -16,9 +16,7 @@ PREVIEW_BAR = 0.05
 MASK_BAR = 0.10
 
 
-@pytest.fixture(params=BACKENDS)
-def tessellation(request, run_scenario):  # noqa: F811
-    return run_scenario("tessellation_preview", request.param)
+tessellation = scenario_fixture("tessellation_preview", "tessellation")
 
 
 def test_preview_looks_like_the_applied_result(tessellation):
@@ -68,7 +66,7 @@ def test_no_traceback_in_the_session(tessellation):
     edit = log[log.find("@@ edit mode starts"):log.find("@@ edit mode ends")]
     assert "@@ edit mode ends" in log, "the Edit Mode step did not run"
     assert "Traceback" not in edit, f"Edit Mode with the preview on printed:\n{edit[-3000:]}"
-    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
+    assert_no_traceback(log)
 
 
 def test_brush_icon_exists_in_the_packaged_blender(window_blender):  # noqa: F811

@@ -61,3 +61,19 @@ def run_scenario(window_blender, tmp_root):
         return results, log, out
 
     return run
+
+
+def scenario_fixture(scenario, name=None):
+    """A fixture (named ``name``, default the scenario's) that runs ``scenario`` once per backend of `BACKENDS`:
+    (results, log, the output folder). Assign it in a test module: ``brush = scenario_fixture("brush")``."""
+
+    @pytest.fixture(params=BACKENDS, name=name or scenario)
+    def fixture(request, run_scenario):
+        return run_scenario(scenario, request.param)
+
+    return fixture
+
+
+def assert_no_traceback(log):
+    """The scenario's Blender printed no traceback."""
+    assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"

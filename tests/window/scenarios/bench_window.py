@@ -6,21 +6,11 @@ one redraw. Writes its rows into ``results["rows"]``."""
 import time
 
 import bpy
-from common import clean_scene, frame, operate
+from common import REDRAWS, clean_scene, frame, operate, region_ms
 from mathutils import Euler
-from previews import _copy_of, height_image
+from previews import _copy_of, height_image, setter
 
-REDRAWS = 20
 HOLD_TIMEOUT_S = 180.0
-
-
-def region_ms(w, iterations=REDRAWS):
-    """Milliseconds of main-thread time per redraw of the 3D viewport region."""
-    with bpy.context.temp_override(**w.context()):
-        bpy.ops.wm.redraw_timer(type="DRAW", iterations=2)  # warm: uploads and level selections happen here
-        start = time.perf_counter()
-        bpy.ops.wm.redraw_timer(type="DRAW", iterations=iterations)
-    return 1000.0 * (time.perf_counter() - start) / iterations
 
 
 def triangles(ob):
@@ -41,10 +31,6 @@ def cost(w, name, source, preview, applied):
     bpy.data.objects.remove(made)
     source.hide_set(False)
     return row
-
-
-def setter(ob, group, name="preview"):
-    return lambda on: setattr(getattr(ob.tessera, group), name, on)
 
 
 def hold(w, started, done):
@@ -139,7 +125,7 @@ def run(w):
     steps = []
     for _ in range(10):  # orbit in steps, as a drag does; each step's redraw on the main thread
         orbit()
-        steps.append(region_ms(w, 1))
+        steps.append(region_ms(w, 1, warm=False))
         yield 0.02
     rows.append({"case": "live board, orbiting (10 steps of 3°)", "longest_hold_ms": round(max(steps), 1),
                  "redraw_ms": round(region_ms(w), 1), "beyond_redraw_ms": round(max(max(steps) - redraw, 0.0), 1)})

@@ -6,10 +6,13 @@ more than 16/255; the share of differing pixels is taken over the union of both 
 where its screenshot differs from the empty scene's.
 """
 
+import time
+
 import bpy
 import numpy as np
 
 THRESHOLD = 16
+REDRAWS = 20  # redraws a timing averages over
 
 
 def clean_scene(w):
@@ -115,3 +118,14 @@ def oracle(w, name, empty, preview, applied, source=None, masks=False):
     share, union = (mask_mismatch if masks else differing_share)(with_preview, result, empty)
     w.results[f"{name}_vs_applied"], w.results[f"{name}_union_pixels"] = share, union
     return share
+
+
+def region_ms(w, iterations=REDRAWS, warm=True):
+    """Milliseconds of main-thread time per redraw of the 3D viewport region; ``warm``: after two redraws that are
+    not counted (uploads and level selections happen there), else counting the first redraw of what changed."""
+    with bpy.context.temp_override(**w.context()):
+        if warm:
+            bpy.ops.wm.redraw_timer(type="DRAW", iterations=2)
+        start = time.perf_counter()
+        bpy.ops.wm.redraw_timer(type="DRAW", iterations=iterations)
+    return 1000.0 * (time.perf_counter() - start) / iterations

@@ -6,19 +6,11 @@ thread with the view unchanged and just after the view moved (the moved eye's pr
 import time
 
 import bpy
-from common import clean_scene, frame, mask_mismatch, shot, silhouette
+from common import clean_scene, frame, mask_mismatch, region_ms, shot, silhouette
 from mathutils import Euler
 
 SETTLE = 0.3
 FIRST_BOARD_S = 120.0
-
-
-def redraw_ms(w, iterations):
-    """Milliseconds of main-thread time per redraw of the window (Blender's own redraw timer)."""
-    start = time.perf_counter()
-    with bpy.context.temp_override(**w.context()):
-        bpy.ops.wm.redraw_timer(type="DRAW_WIN", iterations=iterations)
-    return 1000.0 * (time.perf_counter() - start) / iterations
 
 
 def run(w):
@@ -38,7 +30,7 @@ def run(w):
     empty = shot(w, "empty")
     ob.hide_set(False)
     source = shot(w, "object")
-    r["redraw_ms_object"] = redraw_ms(w, 10)  # the baseline: Blender drawing the object itself
+    r["redraw_ms_object"] = region_ms(w, 10)  # the baseline: Blender drawing the object itself
     yield SETTLE
 
     s = ob.tessera.nailboard
@@ -60,7 +52,7 @@ def run(w):
     r["board_vs_object_tiles"], r["board_union_tiles"] = mask_mismatch(board, source, empty)
 
     count = preview.PREWARP_COUNT[0]
-    r["redraw_ms_same_view"] = redraw_ms(w, 10)
+    r["redraw_ms_same_view"] = region_ms(w, 10)
     r["prewarps_per_redraw_same_view"] = (preview.PREWARP_COUNT[0] - count) / 10
 
     ob.hide_set(True)
@@ -71,7 +63,7 @@ def run(w):
     moved = []
     for _ in range(5):  # orbit a little, as a drag would: each redraw's main-thread time
         rv3d.view_rotation.rotate(Euler((0.0, 0.0, 0.01)))
-        moved.append(redraw_ms(w, 1))
+        moved.append(region_ms(w, 1, warm=False))
         yield 0.05
     r["redraw_ms_moved"] = max(moved)
     r["prewarps_while_orbiting"] = preview.PREWARP_COUNT[0] - count
