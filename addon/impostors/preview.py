@@ -197,4 +197,10 @@ def _forget(ob):
 
 
 PREVIEW = Preview(_draw, topic=TOPIC, on_settings=_forget, replaces=previewing)
-register, unregister = PREVIEW.register, PREVIEW.unregister
+register = PREVIEW.register
+
+
+def unregister():
+    """Undo `register`; the boards' GPU data goes with it (its GPU context may not outlive the add-on)."""
+    PREVIEW.unregister()
+    _prewarps.clear()
