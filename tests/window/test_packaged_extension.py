@@ -1,0 +1,93 @@
+"""The built zip in the packaged Blender (Debian's 5.2.x on the system Python 3.14, as every Linux distribution builds
+it), installed as a user installs it from a terminal: ``blender --command extension install-file -e``, one tool run
+through ``blender --command tessera``, then ``blender --command extension remove``; nothing of it is left."""
+
+import json
+import re
+import shutil
+import subprocess
+
+import pytest
+from conftest import ROOT
+from window_tier import window_blender  # noqa: F401 -- fixture
+
+pytestmark = pytest.mark.window
+
+#: Runs inside the chroot (tools/packaged_run.sh): each step's output and exit code into /tessera-out.
+STEPS = r"""
+set -u
+out=/tessera-out
+ext=/tmp/blender-user/extensions
+step() { name=$1; shift; "$@" >"$out/$name.log" 2>&1; echo $? >"$out/$name.rc"; }
+step install blender --command extension install-file -r user_default -e "$out/$ZIP"
+ls "$ext/.local/lib/"python3*/site-packages >"$out/site_installed.txt" 2>&1
+step tessellate blender --command tessera tessellate --level 2 -o "$out/cube.ply" --json "$out/summary.json"
+step opencl blender --background --python-expr "
+import importlib, json, sys
+rt = importlib.import_module('bl_ext.user_default.tessera.kernels.common.opencl_runtime').get_runtime()
+import pyopencl
+print('RESULT' + json.dumps({'device': rt is not None and rt.device.name, 'pyopencl': pyopencl.__file__,
+                             'python': '%d.%d' % sys.version_info[:2]}))"
+step remove blender --command extension remove user_default.tessera
+find "$ext" -mindepth 1 -not -path "*/.cache*" -not -name __pycache__ -not -path "*/__pycache__/*" \
+  >"$out/left.txt" 2>&1
+"""
+BUNDLED = ("pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile")
+
+
+@pytest.fixture(scope="module")
+def packaged_install(window_blender, built_zips, tmp_root):  # noqa: F811 -- fixture
+    out = tmp_root / "packaged_install"
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
+    linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
+    shutil.copy2(linux, out / linux.name)
+    (out / "steps.sh").write_text(STEPS)
+    done = subprocess.run(["bash", str(ROOT / "tools" / "packaged_run.sh"), str(out), "600", "--",
+                           "env", f"ZIP={linux.name}", "bash", "/tessera-out/steps.sh"],
+                          capture_output=True, text=True, timeout=700)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    return out
+
+
+def _step(out, name):
+    log = (out / f"{name}.log").read_text(errors="replace")
+    return int((out / f"{name}.rc").read_text()), log
+
+
+def test_install_file_enables_it(packaged_install):
+    rc, log = _step(packaged_install, "install")
+    assert rc == 0 and 'Installed "tessera"' in log, log[-2000:]
+    assert "isn't compatible" not in log
+    listing = (packaged_install / "site_installed.txt").read_text().split()
+    site = {entry.split(".")[0].split("-")[0] for entry in listing}
+    for name in BUNDLED:  # the wheels for this Python, from the zip
+        assert name in site, f"{name} was not installed from the zip's wheels: {sorted(site)}"
+
+
+def test_a_tool_runs_from_the_command_line(packaged_install):
+    rc, log = _step(packaged_install, "tessellate")
+    assert rc == 0, log[-2000:]
+    assert "Traceback" not in log
+    summary = json.loads((packaged_install / "summary.json").read_text())
+    assert summary["ok"] and summary["results"][0]["faces"] == 12 * 6  # the start-up cube, level 2: 6 per triangle
+    head = (packaged_install / "cube.ply").read_bytes()[:400].decode("ascii", "replace")
+    assert re.search(r"element face 72\b", head), head
+
+
+def test_the_bundled_pyopencl_finds_a_device(packaged_install):
+    rc, log = _step(packaged_install, "opencl")
+    lines = [line for line in log.splitlines() if line.startswith("RESULT")]
+    assert rc == 0 and lines, log[-2000:]
+    report = json.loads(lines[-1][len("RESULT"):])
+    assert report["python"] == "3.14"
+    assert "/extensions/.local/" in report["pyopencl"]  # the zip's wheel, not the distribution's package
+    assert report["device"], "the bundled pyopencl found no OpenCL device (PoCL)"
+
+
+def test_remove_leaves_nothing(packaged_install):
+    rc, log = _step(packaged_install, "remove")
+    assert rc == 0 and 'Removed "tessera"' in log, log[-2000:]
+    left = [line for line in (packaged_install / "left.txt").read_text().splitlines()
+            if any(part in line for part in ("tessera",) + BUNDLED)]
+    assert left == [], left
