@@ -99,3 +99,27 @@ def blender_on_path(folder):
     shim.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{cli}" "$@"\n')
     shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
     return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
+
+
+def installed_blender(built_zips, home):
+    """``run(*args, timeout=600)``: ``blender ARGS`` in a process (cwd ``home``), with Tessera installed from the built
+    zip into a user folder of its own (`blender_on_path`): CompletedProcess. ``run.start(*args)`` starts one (Popen);
+    ``run.env`` is its environment."""
+    import subprocess
+
+    env = dict(blender_on_path(home), BLENDER_USER_RESOURCES=str(home / "user"))
+    env.pop("PYTHONPATH", None)
+    linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
+
+    def run(*args, timeout=600):
+        return subprocess.run(["blender", *map(str, args)], env=env, capture_output=True, text=True, timeout=timeout,
+                              cwd=home)
+
+    def start(*args):
+        return subprocess.Popen(["blender", *map(str, args)], env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, cwd=home)
+
+    done = run("--command", "extension", "install-file", "-r", "user_default", "-e", linux)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    run.start, run.env = start, env
+    return run

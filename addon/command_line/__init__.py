@@ -10,11 +10,12 @@ module: ``execute(["tessellate", "scene.blend", "--level", "4", "-o", "out.glb"]
 import os
 import signal
 import sys
+import time
 
 import bpy
 
 from ...kernels.common.errors import TesseraError
-from . import files, join, plan, verbs
+from . import files, join, plan, stopping, verbs
 
 COMMAND = "tessera"
 _handles = []
@@ -42,9 +43,12 @@ def _join(argv):
     p.add_argument("--name", default=None, help="the joined object's name (default: the output's name)")
     p.add_argument("--json", nargs="?", const="-", metavar="FILE", help="print a JSON summary as the last line")
     args = p.parse_args(argv)
-    summary = verbs.Summary("join")
+    files.check_output(args.out)
+    for path in args.inputs:
+        files.check_input(path, {".blend", *files.IMPORTERS})
+    verbs.probe_outputs(args)
+    summary, outputs, t0 = verbs.Summary("join"), files.Outputs(), time.perf_counter()
     try:
-        files.check_output(args.out)
         objects = join.read_meshes(args.inputs)
         if not objects:
             raise verbs.Usage("The files hold no mesh object to join")
@@ -55,10 +59,12 @@ def _join(argv):
         v, f = len(ob.data.vertices), len(ob.data.polygons)
         summary.results.append({"source": ", ".join(args.inputs), "objects": [ob.name], "vertices": v, "faces": f})
         verbs._say(f"joined {len(objects)} meshes: {v:,} vertices, {f:,} faces")
-        summary.outputs += files.write(args.out, [ob])
-        summary.ok = True
+        outputs.write(args.out, [ob])
+        verbs.finish(args, summary, outputs, t0)
     finally:
-        verbs._summary_out(args, summary)
+        outputs.discard()
+        if not summary.ok:
+            verbs._summary_out(args, summary)
     return verbs.EXIT_OK
 
 
@@ -101,8 +107,8 @@ def execute(argv):
         print(_USAGE, end="", flush=True)
         return verbs.EXIT_OK if argv else verbs.EXIT_USAGE
     verb, rest = argv[0], argv[1:]
-    verbs.stopping.clear()
-    previous = signal.signal(signal.SIGTERM, verbs.stop) if _main_thread() else None
+    stopping.requested.clear()
+    previous = signal.signal(signal.SIGTERM, stopping.handler) if _main_thread() else None
     try:
         if verb == "plan":
             return _plan(rest)
@@ -117,7 +123,10 @@ def execute(argv):
     except verbs.Usage as err:
         print(f"{err}\n(blender -c {COMMAND} {verb} --help lists the options)", file=sys.stderr, flush=True)
         return verbs.EXIT_USAGE
-    except (files.FileProblem, verbs.Stopped, KeyboardInterrupt, TesseraError) as err:
+    except files.FileProblem as err:  # an input that cannot be used
+        print(f"tessera: {err}", file=sys.stderr, flush=True)
+        return verbs.EXIT_USAGE
+    except (files.WriteFailed, stopping.Stopped, KeyboardInterrupt, TesseraError) as err:
         print(f"tessera: {err}", file=sys.stderr, flush=True)
         return verbs.EXIT_FAILED
     except RuntimeError as err:  # an importer or exporter refused

@@ -1,20 +1,25 @@
 """Files in and out of the command line: scenes and meshes read through Blender's importers, results written through
-Blender's exporters under a temporary name and renamed when complete, so a task that is killed never leaves a half
-file under the name asked for.
+Blender's exporters under a temporary name, checked whole (`written`) and renamed when every output of the run is,
+so a task that fails, is stopped or is killed never leaves a half file under the name asked for.
 
 Output names may hold ``{object}`` (one file per source object) and ``{frame}`` or ``#``s (one per frame, the ``#``s
 giving the zero-padded width, as Blender's render output does).
 """
 
+import errno
 import glob
 import os
 import re
 import shutil
 import socket
+import sys
+from contextlib import contextmanager
+from dataclasses import dataclass
 
 import bpy
 
 from .. import render_jobs
+from . import stopping, written
 
 #: Importers by file extension: (operator path, keyword arguments).
 IMPORTERS = {
@@ -58,6 +63,10 @@ class FileProblem(Exception):
     """A file argument that cannot be used (exit code 2): the message says why."""
 
 
+class WriteFailed(Exception):
+    """An output that could not be written whole (exit code 1): one sentence naming the path and the cause."""
+
+
 def extension(path):
     return os.path.splitext(path)[1].lower()
 
@@ -82,16 +91,37 @@ def _operator(path):
     return getattr(getattr(bpy.ops, module), name)
 
 
+#: How the files Blender saves begin: uncompressed, zstd (Blender 3.0+), gzip (before).
+_BLEND_MAGIC = (b"BLENDER", b"\x28\xb5\x2f\xfd", b"\x1f\x8b")
+
+
+def check_input(path, readable):
+    """Raise `FileProblem` unless ``path`` is a file this process can read, of an extension in ``readable``; a .blend
+    must begin as Blender's files do."""
+    path = os.path.abspath(path)
+    if os.path.isdir(path):
+        raise FileProblem(f"{path}: is a folder; give a file")
+    if not os.path.exists(path):
+        raise FileProblem(f"{path}: no such file")
+    ext = extension(path)
+    if ext not in readable:
+        raise FileProblem(f"{path}: cannot read {ext or 'a file without an extension'}; give "
+                          f"{', '.join(sorted(readable))}")
+    try:
+        with open(path, "rb") as f:
+            head = f.read(7)
+    except OSError as err:
+        raise FileProblem(f"{path}: cannot be read: {os_cause(err)}") from None
+    if ext == ".blend" and not head.startswith(_BLEND_MAGIC):
+        raise FileProblem(f"{path}: is not a Blender file (it does not begin as a .blend does)")
+
+
 def read_inputs(paths):
     """Open the scene and import the meshes named by ``paths``: a .blend is opened (at most one, first); other files
     are imported into it, or into an empty scene when no .blend is given. Returns the objects the imports added."""
     paths = [os.path.abspath(p) for p in paths]
     for p in paths:
-        if not os.path.isfile(p):
-            raise FileProblem(f"{p}: no such file")
-        if extension(p) != ".blend" and extension(p) not in IMPORTERS:
-            raise FileProblem(f"{p}: cannot read {extension(p) or 'a file without an extension'}; give a .blend or "
-                              f"one of {', '.join(sorted(IMPORTERS))}")
+        check_input(p, {".blend", *IMPORTERS})
     blends = [p for p in paths if extension(p) == ".blend"]
     if len(blends) > 1:
         raise FileProblem(f"Give one .blend at most (the scene); got {len(blends)}")
@@ -153,47 +183,288 @@ def _partial(path):
     return os.path.join(folder, f".{stem}.tessera-partial-{_host()}-{os.getpid()}{ext}")
 
 
-def write(path, objects):
-    """Write ``objects`` to ``path`` (format by extension; a .blend holds the whole scene, the objects in it) through
-    `write_with`. Returns the paths written."""
-    ext = extension(path)
-    if ext == ".blend":
-        return write_with(path, lambda p: bpy.ops.wm.save_as_mainfile(filepath=p, copy=True, check_existing=False))
-    return write_with(path, lambda p: _export(p, objects, ext))
+#: What an operating-system error means for a file being written, in the user's words.
+_CAUSES = {errno.ENOSPC: "no space left on the device", errno.EDQUOT: "the disk quota is used up",
+           errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
+           errno.EPERM: "permission denied", errno.EISDIR: "it is a folder; give a file name",
+           errno.ENOTDIR: "a folder in its path is a file", errno.ENAMETOOLONG: "the name is too long",
+           errno.EIO: "the device reported an input/output error"}
+_ERRNO_TEXT = re.compile(r"\[Errno (\d+)\]")
 
 
-def write_with(path, writer):
-    """Call ``writer(temporary path)`` to write the file, then rename it to ``path``: the file at ``path`` is complete
-    or absent. Formats that name files beside them (`_SIDECARS`) are written under their final names in a folder of
-    their own, then moved, the main file last. Returns the paths written."""
+def failed(path, cause):
+    """The `WriteFailed` of ``path``: "PATH: not written: CAUSE"."""
+    return WriteFailed(f"{path}: not written: {cause}")
+
+
+def os_cause(err):
+    """The cause of an `OSError` in the user's words."""
+    return _CAUSES.get(err.errno) or (err.strerror or str(err)).lower()
+
+
+def _writable(folder):
+    """None when files can be made in the existing folder ``folder``, else why not."""
+    if os.access(folder, os.W_OK):
+        return None
+    try:
+        if os.statvfs(folder).f_flag & os.ST_RDONLY:
+            return _CAUSES[errno.EROFS]
+    except (OSError, AttributeError):
+        pass
+    return _CAUSES[errno.EACCES]
+
+
+def probe_output(path):
+    """Raise `WriteFailed` when ``path`` cannot be written: it is a folder, a folder on its way is a file, or its
+    folder (or the nearest one that exists) is read-only or not ours. Checked before any work, and again at the
+    write."""
     path = os.path.abspath(path)
+    if os.path.isdir(path):
+        raise failed(path, _CAUSES[errno.EISDIR])
     folder = os.path.dirname(path)
-    os.makedirs(folder, exist_ok=True)
+    while not os.path.lexists(folder) and os.path.dirname(folder) != folder:
+        folder = os.path.dirname(folder)
+    if not os.path.isdir(folder):
+        raise failed(path, f"{folder} is a file, not a folder")
+    why = _writable(folder)
+    if why:
+        raise failed(path, f"{why} ({folder})")
+
+
+@dataclass
+class Pending:
+    """A file written whole under a partial name: `commit` gives it its final name(s), `discard` removes it.
+    ``moves``: [(partial path, final path)], the main file last; ``partial``: what to remove (a file or folder)."""
+
+    moves: list
+    partial: str
+
+    @property
+    def paths(self):
+        return [final for _, final in self.moves]
+
+    def commit(self):
+        for src, dst in self.moves:
+            os.replace(src, dst)
+        self.discard()
+        return self.paths
+
+    def discard(self):
+        if os.path.isdir(self.partial):
+            shutil.rmtree(self.partial, ignore_errors=True)
+        elif os.path.lexists(self.partial):
+            os.remove(self.partial)
+
+
+class Outputs:
+    """The files of one run: each written and checked under a partial name (`write`, `write_with`), all given their
+    final names together at the end (`commit`), or all removed (`discard`): a run writes every output or none."""
+
+    def __init__(self):
+        self.pending = []
+
+    def write(self, path, objects):
+        """Write ``objects`` to ``path`` (format by extension; a .blend holds the whole scene): the final paths."""
+        ext = extension(path)
+        if ext == ".blend":
+            return self.write_with(path, lambda p: bpy.ops.wm.save_as_mainfile(filepath=p, copy=True,
+                                                                              check_existing=False))
+        _check_space(path, objects, ext)
+        return self.write_with(path, lambda p: _export(p, objects, ext), _expected(objects, ext))
+
+    def write_with(self, path, writer, expected=None):
+        """Call ``writer(partial path)`` to write ``path`` (`write_with`): the final paths."""
+        pending = write_with(path, writer, expected)
+        self.pending.append(pending)
+        return pending.paths
+
+    def commit(self):
+        done = []
+        while self.pending:
+            done += self.pending.pop(0).commit()
+        return done
+
+    def discard(self):
+        while self.pending:
+            self.pending.pop().discard()
+
+
+#: Formats whose exporter may end the process when the disk fills (Alembic's library aborts): refused unless the
+#: free space is this many times the size `written.least_size` gives.
+_ABORTS_WHEN_FULL = {".abc": 1.25}
+
+
+def _check_space(path, objects, ext):
+    """Refuse, before the exporter runs, an output that cannot fit: the file system has less free space than the least
+    its meshes take (`written.least_size`; more for formats whose exporter aborts on a full disk)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    while not os.path.isdir(folder) and os.path.dirname(folder) != folder:
+        folder = os.path.dirname(folder)
+    free = written.free_bytes(folder)
+    if free is None:
+        return
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    need = 0
+    for ob in objects:
+        if ob.type == "MESH":
+            me = ob.evaluated_get(depsgraph).data
+            need += written.least_size(ext, len(me.vertices), len(me.loops), len(me.polygons))
+    need *= _ABORTS_WHEN_FULL.get(ext, 1.0)
+    if need > free:
+        raise failed(os.path.abspath(path), f"{_CAUSES[errno.ENOSPC]} (it needs at least {_megabytes(need)}; "
+                                            f"{_megabytes(free)} free)")
+
+
+def _megabytes(n):
+    return f"{n / 1e6:.1f} MB" if n >= 1e5 else f"{n / 1e3:.0f} kB"
+
+
+def _expected(objects, ext):
+    """What an OBJ of ``objects`` holds ({"vertices", "faces"}), when every one is a mesh; else None."""
+    if ext != ".obj" or not objects or any(ob.type != "MESH" for ob in objects):
+        return None
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    meshes = [ob.evaluated_get(depsgraph).data for ob in objects]
+    return {"vertices": sum(len(m.vertices) for m in meshes), "faces": sum(len(m.polygons) for m in meshes)}
+
+
+def write_with(path, writer, expected=None):
+    """Call ``writer(temporary path)`` to write ``path``, check the file whole (`written.check_written`), and return
+    the `Pending` that renames it: the file at ``path`` is complete or absent. Formats that name files beside them
+    (`_SIDECARS`) are written under their final names in a folder of their own, moved at the commit, the main file
+    last. Every failure is a `WriteFailed` naming the path and the cause; a stop (SIGTERM) while the writer runs is
+    held until it returns."""
+    path = os.path.abspath(path)
+    probe_output(path)
+    folder = os.path.dirname(path)
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as err:
+        raise failed(path, os_cause(err)) from None
     remove_stale_partials(folder)
     ext = extension(path)
-    if ext in _SIDECARS:
-        partial = _partial(path)[: -len(ext)]
-        os.makedirs(partial, exist_ok=True)
-        try:
-            writer(os.path.join(partial, os.path.basename(path)))
-            written = []
-            names = sorted(os.listdir(partial), key=lambda n: n == os.path.basename(path))  # the main file last
-            for name in names:
-                os.replace(os.path.join(partial, name), os.path.join(folder, name))
-                written.append(os.path.join(folder, name))
-            return written
-        finally:
-            shutil.rmtree(partial, ignore_errors=True)
-    partial = _partial(path)
+    sidecars = ext in _SIDECARS
+    partial = _partial(path)[: -len(ext)] if sidecars else _partial(path)
+    main = os.path.join(partial, os.path.basename(path)) if sidecars else partial
+    pending = Pending([], partial)
     try:
-        writer(partial)
-        if not os.path.isfile(partial):
-            raise FileProblem(f"{path}: the exporter wrote nothing")
-        os.replace(partial, path)
+        if sidecars:
+            os.makedirs(partial, exist_ok=True)
+        _run_writer(path, writer, main)
+        if not os.path.isfile(main):
+            raise failed(path, "the exporter wrote nothing")
+        try:
+            written.check_written(main, expected)
+        except written.ShortWrite as err:
+            raise failed(path, _CAUSES[errno.ENOSPC] if written.disk_full(folder) else str(err)) from None
+        except OSError as err:
+            raise failed(path, os_cause(err)) from None
+        if sidecars:
+            names = sorted(os.listdir(partial), key=lambda n: n == os.path.basename(path))  # the main file last
+            pending.moves = [(os.path.join(partial, n), os.path.join(folder, n)) for n in names]
+        else:
+            pending.moves = [(partial, path)]
+        return pending
+    except BaseException:
+        pending.discard()
+        raise
+
+
+def _run_writer(path, writer, target):
+    """``writer(target)`` with its output held back: on failure one sentence (`WriteFailed`), not the exporter's
+    traceback; on success what it printed is passed on."""
+    with stopping.deferred(), _captured_output() as captured:
+        try:
+            writer(target)
+            error = None
+        except OSError as err:
+            error = os_cause(err)
+        except RuntimeError as err:  # the exporter's report, or its Python exception
+            error = str(err)
+    if error is None:
+        cause = _os_error_said(captured.text)
+        if cause is None:
+            captured.replay()
+            return
+        raise failed(path, cause)  # the exporter printed an operating-system error but reported nothing (USD)
+    if stopping.requested:
+        raise stopping.Stopped(stopping.message())
+    found = _ERRNO_TEXT.findall(error + captured.text)
+    if found:
+        cause = _CAUSES.get(int(found[-1])) or os.strerror(int(found[-1])).lower()
+    elif written.disk_full(os.path.dirname(path)):
+        cause = _CAUSES[errno.ENOSPC]
+    else:
+        lines = [ln.strip() for ln in error.splitlines() if ln.strip() and not ln.startswith((" ", "Traceback"))]
+        cause = (lines[-1] if lines else "the exporter failed").removeprefix("Error: ")
+    raise failed(path, cause)
+
+
+#: Operating-system errors an exporter may print while reporting success: a write that failed.
+_PRINTED = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO)
+
+
+def _os_error_said(text):
+    """The cause, when ``text`` (what an exporter printed) names a failed write (`_PRINTED`): else None."""
+    for number in _PRINTED:
+        if os.strerror(number) in text:
+            return _CAUSES[number]
+    return None
+
+
+class _Captured:
+    """What a writer printed: ``streams`` {fd: text}."""
+
+    def __init__(self):
+        self.streams = {}
+
+    @property
+    def text(self):
+        return "".join(self.streams.values())
+
+    def replay(self):
+        for fd, stream in ((1, sys.stdout), (2, sys.stderr)):
+            if self.streams.get(fd):
+                stream.write(self.streams[fd])
+                stream.flush()
+
+
+def _flush_all():
+    """Flush Python's and C's buffered output (Blender prints its reports and log with C's stdio)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):  # no C library to call (Windows): Python's flush is all
+        pass
+
+
+@contextmanager
+def _captured_output():
+    """File descriptors 1 and 2 into memory (memfds, never the disk that may be full) while the block runs: Blender
+    prints an operator's failure (an exporter's traceback) on them."""
+    captured = _Captured()
+    try:
+        held = {fd: os.memfd_create(f"tessera-{fd}") for fd in (1, 2)}
+    except (AttributeError, OSError):  # not Linux: nothing is held back
+        yield captured
+        return
+    _flush_all()
+    saved = {fd: os.dup(fd) for fd in held}
+    for fd, memfd in held.items():
+        os.dup2(memfd, fd)
+    try:
+        yield captured
     finally:
-        if os.path.exists(partial):
-            os.remove(partial)
-    return [path]
+        _flush_all()
+        for fd, memfd in held.items():
+            os.dup2(saved[fd], fd)
+            os.close(saved[fd])
+            os.lseek(memfd, 0, os.SEEK_SET)
+            with os.fdopen(memfd, "rb") as f:
+                captured.streams[fd] = f.read().decode("utf-8", "replace")
 
 
 def _export(path, objects, ext):

@@ -29,8 +29,7 @@ def read_meshes(paths):
     found = []
     for path in paths:
         path = os.path.abspath(path)
-        if not os.path.isfile(path):
-            raise files.FileProblem(f"{path}: no such file")
+        files.check_input(path, {".blend", *files.IMPORTERS})
         if files.extension(path) == ".blend":
             found += _read_blend(path)
         else:

@@ -21,7 +21,9 @@ from dataclasses import asdict, dataclass, field
 
 import bpy
 
-from . import files
+from ...kernels.common.errors import InvalidInputError
+from ...kernels.terrain.lod import block_tiles
+from . import files, stopping
 from .options import add_options, chosen, settable
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -62,19 +64,6 @@ _NOT_OPTIONS = {"output", "camera_source", "filepath", "tile_files", "source", "
 
 class Usage(Exception):
     """Bad arguments (exit code 2)."""
-
-
-class Stopped(Exception):
-    """The process was asked to stop (SIGTERM, as farm managers send): unwind, removing partial files."""
-
-
-#: Set when a stop was asked for (an operator that the signal interrupted reports a failure; this tells them apart).
-stopping = set()
-
-
-def stop(signum, frame):
-    stopping.add(signum)
-    raise Stopped(f"stopped by signal {signum}; nothing was written")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -156,8 +145,8 @@ def _run_operator(verb, kwargs, source, summary, edits=None):
     try:
         getattr(getattr(bpy.ops, module), name)(**kwargs)
     except RuntimeError as err:  # the operator's report: what to change
-        if stopping:
-            raise Stopped(f"stopped by signal {min(stopping)}; nothing was written") from err
+        if stopping.requested:
+            raise stopping.Stopped(stopping.message()) from err
         message = str(err).strip()
         message = message[len("Error: "):] if message.startswith("Error: ") else message
         summary.failures.append({"source": source, "error": message})
@@ -235,8 +224,9 @@ def _check_outputs(verb, args, per_object_count):
                     "write one file per object")
 
 
-def _write(verb, pattern, groups, summary, frame=None):
-    """Write the results: ``groups`` is [(source name, objects)]; one file, or one per source with {object}."""
+def _write(verb, pattern, groups, outputs, frame=None):
+    """Write the results into ``outputs`` (`files.Outputs`): ``groups`` is [(source name, objects)]; one file, or one
+    per source with {object}."""
     if "{object}" in pattern:
         jobs = [(files.output_name(pattern, src, frame), objs) for src, objs in groups]
     else:
@@ -244,15 +234,12 @@ def _write(verb, pattern, groups, summary, frame=None):
     for path, objects in jobs:
         if verb.name == "impostors" and files.extension(path) == ".glb":
             files.select_only(objects)
-            written = files.write_with(path, lambda p: bpy.ops.tessera.impostor_export(filepath=p))
+            outputs.write_with(path, lambda p: bpy.ops.tessera.impostor_export(filepath=p))
         else:
-            written = files.write(path, objects)
-        summary.outputs += written
-        for w in written:
-            _say(f"wrote {w}")
+            outputs.write(path, objects)
 
 
-def run_object_verb(verb, args, summary):
+def run_object_verb(verb, args, summary, outputs):
     kwargs = dict(chosen(args, operator_settings(verb)), **verb.fixed)
     files.read_inputs(args.inputs)
     _scene_settings(args)
@@ -267,11 +254,11 @@ def run_object_verb(verb, args, summary):
             groups.append((ob.name, made))
     if summary.failures:
         return EXIT_FAILED
-    _write(verb, args.out, groups, summary, args.frame)
+    _write(verb, args.out, groups, outputs, args.frame)
     return EXIT_OK
 
 
-def run_terrain(verb, args, summary):
+def run_terrain(verb, args, summary, outputs):
     kwargs = chosen(args, operator_settings(verb))
     blends = [p for p in args.inputs if files.extension(p) == ".blend"]
     maps = [os.path.abspath(p) for p in args.inputs if files.extension(p) != ".blend"]
@@ -279,7 +266,14 @@ def run_terrain(verb, args, summary):
     _check_outputs(verb, args, 1)
     if not maps:
         raise Usage("Give a height map (PNG, TIFF/GeoTIFF, EXR, .r16/.r32/.raw)")
+    if "block" in kwargs:  # checked before anything is read
+        try:
+            block_tiles(kwargs["block"], (1, 1))
+        except InvalidInputError as err:
+            raise Usage(f"--block: {err}") from None
     for m in maps:
+        if os.path.isdir(m):
+            raise Usage(f"{m}: is a folder; give a height map file")
         if not os.path.isfile(m):
             raise Usage(f"{m}: no such file")
     if any(os.path.dirname(m) != os.path.dirname(maps[0]) for m in maps[1:]):
@@ -308,8 +302,15 @@ def run_terrain(verb, args, summary):
             if _run_operator(_TERRAIN_BAKE, bake, source, summary, edits=[terrain]) is None:
                 return EXIT_FAILED
         summary.results[-1]["frame"] = frame
-        _write(verb, args.out, [(source, [terrain])], summary, frame)
+        _write(verb, args.out, [(source, [terrain])], outputs, frame)
     return EXIT_OK
+
+
+def probe_outputs(args):
+    """Refuse, before any work, an output or ``--json`` file that cannot be written (`files.probe_output`)."""
+    files.probe_output(files.output_name(args.out, "object", 1))
+    if args.json not in (None, "-"):
+        files.probe_output(args.json)
 
 
 def run(verb_name, argv):
@@ -318,23 +319,55 @@ def run(verb_name, argv):
     summary = Summary(verb.name)
     t0 = time.perf_counter()
     args = parser_for(verb).parse_args(argv)  # Usage on bad arguments; SystemExit(0) for --help
+    probe_outputs(args)
+    outputs = files.Outputs()
     try:
-        code = (run_terrain if verb.name == "terrain" else run_object_verb)(verb, args, summary)
+        code = (run_terrain if verb.name == "terrain" else run_object_verb)(verb, args, summary, outputs)
+        if code == EXIT_OK:
+            finish(args, summary, outputs, t0)
     except files.FileProblem as err:
         raise Usage(str(err)) from err
     finally:
-        summary.seconds = round(time.perf_counter() - t0, 3)
-        summary.ok = not summary.failures and bool(summary.outputs)
-        _summary_out(args, summary)
+        outputs.discard()  # what was not committed
+        if not summary.ok:
+            summary.seconds = round(time.perf_counter() - t0, 3)
+            _summary_out(args, summary)
     return code
 
 
+def finish(args, summary, outputs, t0):
+    """Give the run's outputs their final names, the ``--json`` summary file first (when it cannot be written, no
+    output is); then print the summary when it goes to the standard output."""
+    summary.outputs = [p for pending in outputs.pending for p in pending.paths]
+    summary.ok = not summary.failures and bool(summary.outputs)
+    summary.seconds = round(time.perf_counter() - t0, 3)
+    try:
+        if args.json not in (None, "-"):
+            text = json.dumps(asdict(summary)) + "\n"
+            files.write_with(args.json, lambda p: _write_text(p, text)).commit()
+    except BaseException:
+        summary.ok = False
+        raise
+    for path in outputs.commit():
+        _say(f"wrote {path}")
+    if args.json == "-":
+        print(json.dumps(asdict(summary)), flush=True)
+
+
+def _write_text(path, text):
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
 def _summary_out(args, summary):
+    """Print or write the summary of a run that failed (best effort: a summary that cannot be written is said)."""
     if not args.json:
         return
     text = json.dumps(asdict(summary))
     if args.json == "-":
         print(text, flush=True)
-    else:
-        with open(args.json, "w", encoding="utf-8") as f:
-            f.write(text + "\n")
+        return
+    try:
+        files.write_with(args.json, lambda p: _write_text(p, text + "\n")).commit()
+    except (files.WriteFailed, OSError) as err:
+        _say(f"the summary was not written either: {err}")

@@ -90,6 +90,12 @@ def test_help_lists_every_verb_and_every_setting_with_its_tooltip(cli, bpy_modul
     (["terrain", "-o", "x.obj", "missing.png"], "missing.png: no such file"),
     (["terrain", "-o", "x.obj", "a.png", "--frames", "3-1"], "the last frame comes before the first"),
     (["terrain", "-o", "x.obj", "--block", "0,0,2"], "give 4 values"),
+    # the block is checked before the map is looked for
+    (["terrain", "-o", "x.obj", "missing.png", "--block", "5,0,2,2"], "Block 5, 0 of a 2 x 2 split does not exist"),
+    (["tessellate", os.sep, "-o", "x.obj"], ": is a folder; give a file"),
+    (["join", "missing.blend", "-o", "x.obj"], "missing.blend: no such file"),
+    (["join", os.sep, "-o", "x.obj"], ": is a folder; give a file"),
+    (["plan", "tessellate", "missing.blend", "-o", "x.obj"], "missing.blend: no such file"),
     (["plan", "terrain", "a.png", "-o", "t.blend", "--blocks", "0x2"], "invalid blocks_arg value"),
     (["tessellate", "-o", "x.obj", "--no-such-setting"], "unrecognized arguments: --no-such-setting"),
 ])
@@ -170,6 +176,52 @@ def test_one_file_per_object_and_a_failure_writes_nothing(cli, scene, tmp_path, 
     assert info["failures"] == [{"source": "Empty mesh", "error": "Mesh 'Empty mesh' has no faces to work on"}]
     assert "Empty mesh: FAILED: Mesh 'Empty mesh' has no faces to work on" in captured.err
     assert not out.exists() and info["outputs"] == []
+
+
+def test_join_refuses_a_file_that_is_not_a_blend(cli, scene, tmp_path, capsys):
+    fake = tmp_path / "notes.blend"
+    fake.write_text("not a scene")
+    assert cli.execute(["join", str(fake), "-o", str(tmp_path / "x.obj")]) == 2
+    err = capsys.readouterr().err
+    assert "notes.blend: is not a Blender file" in err and "Traceback" not in err
+    assert os.listdir(tmp_path) == ["notes.blend"]
+
+
+@pytest.mark.parametrize("case", ["parent is a file", "name is a folder", "json parent is a file"])
+def test_an_output_that_cannot_be_written_exits_1_before_any_work(cli, scene, tmp_path, capsys, case):
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "cube.ply").mkdir()
+    out, summary, says = str(tmp_path / "out.ply"), None, ""
+    if case == "parent is a file":
+        out, says = str(tmp_path / "afile" / "out.ply"), f"not written: {tmp_path / 'afile'} is a file, not a folder"
+    elif case == "name is a folder":
+        out, says = str(tmp_path / "cube.ply"), "cube.ply: not written: it is a folder; give a file name"
+    else:
+        summary, says = str(tmp_path / "afile" / "s.json"), "s.json: not written:"
+    argv = ["tessellate", "--objects", "Cube", "--level", "2", "-o", out] + (["--json", summary] if summary else [])
+    assert cli.execute(argv) == 1
+    err = capsys.readouterr().err
+    assert says in err and "Traceback" not in err
+    assert "tessellate 1/1" not in err  # refused before the work
+    assert sorted(os.listdir(tmp_path)) == ["afile", "cube.ply"] and os.listdir(tmp_path / "cube.ply") == []
+
+
+def test_the_json_summary_is_written_before_the_outputs_are_named(cli, scene, tmp_path, capsys, monkeypatch):
+    """When the summary cannot be written (checked at the start, it failed at the end), no output is named."""
+    files = cli.files
+    real = files.write_with
+
+    def refuse_json(path, writer, expected=None):
+        if path.endswith(".json"):
+            raise files.failed(path, "no space left on the device")
+        return real(path, writer, expected)
+
+    monkeypatch.setattr(files, "write_with", refuse_json)
+    code = cli.execute(["tessellate", "--objects", "Cube", "--level", "2", "-o", str(tmp_path / "cube.ply"),
+                        "--json", str(tmp_path / "s.json")])
+    err = capsys.readouterr().err
+    assert code == 1 and "s.json: not written: no space left on the device" in err
+    assert os.listdir(tmp_path) == []  # neither the output nor a partial file
 
 
 def test_names_with_wildcards_and_commas_are_taken_literally(cli, scene, tmp_path):

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from blender_helpers import blender_on_path
+from blender_helpers import installed_blender
 from tessera.tools.geotiff_files import write_geotiff
 
 pytestmark = pytest.mark.blender
@@ -30,23 +30,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def blender(built_zips, tmp_path_factory):
     """``run(*args)``: ``blender ARGS`` in a process, with Tessera installed from the built zip: CompletedProcess."""
-    home = tmp_path_factory.mktemp("cli_home")
-    env = dict(blender_on_path(home), BLENDER_USER_RESOURCES=str(home / "user"))
-    env.pop("PYTHONPATH", None)
-    linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
-
-    def run(*args, timeout=600):
-        return subprocess.run(["blender", *map(str, args)], env=env, capture_output=True, text=True, timeout=timeout,
-                              cwd=home)
-
-    def start(*args):
-        return subprocess.Popen(["blender", *map(str, args)], env=env, stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True, cwd=home)
-
-    done = run("--command", "extension", "install-file", "-r", "user_default", "-e", linux)
-    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
-    run.start = start
-    return run
+    return installed_blender(built_zips, tmp_path_factory.mktemp("cli_home"))
 
 
 def _blend(path, body):
