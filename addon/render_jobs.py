@@ -57,7 +57,18 @@ def job_folder(kind):
 
 
 def stop_process(process, timeout=10.0):
-    """Kill a worker process still running and wait for it: whether it has ended."""
+    """Stop a worker process still running and wait for it: whether it has ended. A leashed worker (`start_worker`)
+    is let go by closing its leash's pipe (the leash kills it and removes its folder), then killed if it lingers."""
+    leash = getattr(process, "stdin", None)
+    if leash is not None and not leash.closed:
+        try:
+            leash.close()
+        except OSError:
+            pass
+        try:
+            process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            pass
     if process.poll() is None:
         process.kill()
         try:
@@ -137,22 +148,68 @@ def worker_command(script, job_file):
     return [sys.executable, str(script), "--", str(job_file)]
 
 
+#: The leash every worker runs on (`worker_leash.py`): it never outlives the Blender that started it.
+LEASH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "worker_leash.py")
+
+
+def _python():
+    """The Python this Blender runs (its own, or the system's in a distribution's build), when it is a Python
+    program; else None."""
+    exe = sys.executable or ""
+    return exe if os.path.basename(exe).lower().startswith("python") and os.path.isfile(exe) else None
+
+
 def start_worker(script, job_file, log_path):
     """Start worker ``script`` on ``job_file``, its output going to ``log_path`` (a file, not a pipe: a chatty
     worker never stalls), below the viewport's priority ([Clua et al.]'s "low-priority thread": nice 10 on POSIX, below
-    normal on Windows). Returns the `subprocess.Popen`. The priority is lowered after the start rather than in the
-    child before it, so Python can spawn without copying this (large) process's page tables (no ``preexec_fn``)."""
+    normal on Windows), on a leash (`worker_leash.py`): when this process ends, however it ends, the worker is killed
+    and its job folder (the job file's) removed. Returns the `subprocess.Popen` (of the leash; its ``stdin`` is the
+    leash's pipe, which `stop_process` closes)."""
+    command = worker_command(script, job_file)
+    python = _python()
     kwargs = {}
     if os.name == "nt":
         kwargs["creationflags"] = subprocess.BELOW_NORMAL_PRIORITY_CLASS
     with open(log_path, "wb") as log:
-        process = subprocess.Popen(worker_command(script, job_file), stdout=log, stderr=subprocess.STDOUT, **kwargs)
+        if python is not None:
+            folder = os.path.dirname(os.path.abspath(job_file))
+            folder = folder if folder in _open_jobs else ""  # only a job's own folder is ever removed by the leash
+            process = subprocess.Popen([python, "-I", LEASH, folder, "--", *command], stdin=subprocess.PIPE,
+                                       stdout=log, stderr=subprocess.STDOUT, **kwargs)
+        else:
+            process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, **kwargs)
     if hasattr(os, "setpriority"):
         try:
             os.setpriority(os.PRIO_PROCESS, process.pid, 10)
         except OSError:  # it has finished already, or the system does not let us: it runs at normal priority
             pass
     return process
+
+
+#: What a signal that ended a worker means, in the user's words.
+_SIGNALS = {"SIGKILL": "it was killed (SIGKILL; most often the system ran out of memory)",
+            "SIGSEGV": "it crashed (SIGSEGV)", "SIGABRT": "it aborted (SIGABRT)", "SIGBUS": "it crashed (SIGBUS)",
+            "SIGTERM": "it was stopped (SIGTERM)", "SIGINT": "it was interrupted (SIGINT)"}
+_ERROR_LINE = re.compile(r"error|exception|failed|out of memory|cannot|could not", re.IGNORECASE)
+
+
+def failure(what, code, log):
+    """One sentence for a worker that ended with exit ``code`` (negative: the signal) and ``log`` (bytes): why it
+    ended, and the last line of its log that says what went wrong (not Blender's start-up lines)."""
+    import signal
+
+    if code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+        reason = _SIGNALS.get(name, f"it was ended by {name}")
+    else:
+        reason = f"it exited with code {code}"
+    lines = [ln.strip() for ln in log.decode("utf-8", "replace").splitlines() if ln.strip()]
+    said = [ln for ln in lines if _ERROR_LINE.search(ln) and not ln.startswith("Traceback")]
+    detail = said[-1] if said else ""
+    return f"{what} failed: the render process ended early ({reason})" + (f": {detail[:300]}" if detail else "")
 
 
 def render_device(context=None):
@@ -264,7 +321,7 @@ class RenderJob:
         """Raise `TesseraError` with the end of the worker's log when it failed (``what``: "Baking the impostor")."""
         code = self.process.poll()
         if code is not None and code != 0:
-            raise TesseraError(f"{what} failed (exit {code}): {self.tail()}")
+            raise TesseraError(failure(what, code, self._log_bytes()))
 
     def wait(self, report=None, what="Rendering", timeout=None):
         """Follow the job to its end where nothing polls it (background mode, the ``bpy`` module): ``report(line)``

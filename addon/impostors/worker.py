@@ -125,8 +125,11 @@ class BoardJob:
     def _read(self):
         try:
             if self.process.returncode != 0 or not os.path.isfile(self.out):
-                tail = Path(self.folder, "worker.log").read_text(errors="replace")[-600:]
-                raise TesseraError(f"Rendering the board failed (exit {self.process.returncode}): {tail}")
+                log = Path(self.folder, "worker.log").read_bytes()
+                if self.process.returncode == 0:  # it ended as if done, without the board
+                    raise TesseraError(f"Rendering the board failed: the render process wrote no board: "
+                                       f"{log[-300:].decode('utf-8', 'replace').strip()}")
+                raise TesseraError(render_jobs.failure("Rendering the board", self.process.returncode, log))
             if self._preview is not None:
                 futures.wait([self._preview])  # the preview's reading is done with the folder too
             return self._read_images(self.out)

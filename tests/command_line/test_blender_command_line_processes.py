@@ -221,3 +221,42 @@ def test_a_killed_task_leaves_no_output_and_the_next_task_clears_its_partial_fil
     assert sorted(os.listdir(out)) == partial  # only the hidden partial folder
     _ok(blender("-c", "tessera", "loop", heavy, "--levels", "1", "-o", out / "other.ply"))
     assert sorted(os.listdir(out)) == ["other.ply"]
+
+
+def _processes_naming(text):
+    """The ids of the running processes whose command line holds ``text``."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if text.encode() in f.read():
+                    found.append(int(pid))
+        except OSError:
+            pass
+    return found
+
+
+def test_a_killed_task_takes_its_render_worker_and_job_folder_with_it(blender, bpy_module, tmp_path):
+    """SIGKILL of an impostors task (a farm's pre-emption): within 5 s no worker renders on and no job folder stays."""
+    _blend(tmp_path / "prop.blend", "bpy.ops.mesh.primitive_monkey_add()")
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    proc = subprocess.Popen(["blender", "-c", "tessera", "impostors", str(tmp_path / "prop.blend"), "--grid", "16",
+                             "--tile", "256", "--samples", "512", "-o", str(tmp_path / "prop.blend.out.blend")],
+                            env=dict(blender.env, TMPDIR=str(temp)), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, cwd=tmp_path)
+    deadline, workers, folders = time.monotonic() + 120, [], []
+    while time.monotonic() < deadline and not workers:
+        folders = [temp / n for n in os.listdir(temp) if n.startswith("tessera-impostor-")]
+        workers = [p for f in folders for p in _processes_naming(f"{f}/job.json") if p != proc.pid]
+        time.sleep(0.05)
+    assert workers, "the task started no render worker"
+    time.sleep(1.0)  # rendering
+    proc.kill()
+    proc.wait(timeout=30)
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline and (any(_processes_naming(f"{f}/job.json") for f in folders)
+                                           or any(f.exists() for f in folders)):
+        time.sleep(0.05)
+    assert not any(_processes_naming(f"{f}/job.json") for f in folders), "a render worker outlived its task"
+    assert not any(f.exists() for f in folders), "the job folder outlived its task"

@@ -301,3 +301,48 @@ def test_progress_moves_within_a_view(clean_scene, bpy_module, addon_module, tmp
         assert job.fraction() == 2.0 and job.progress() == 2
     finally:
         jobs._open_jobs.pop(job.folder, None)
+
+
+def _leashed(render_jobs, tmp_path, body):
+    """A worker running the Python ``body`` on a leash, in a job folder: (process, folder)."""
+    folder = render_jobs.job_folder("bake")
+    script = tmp_path / "worker.py"
+    script.write_text(body)
+    job = os.path.join(folder, "job.json")
+    with open(job, "w") as f:
+        f.write("{}")
+    return render_jobs.start_worker(script, job, os.path.join(folder, "worker.log")), folder
+
+
+def test_a_worker_that_dies_is_told_by_its_reason_not_its_start_up_lines(addon_module, tmp_path):
+    render_jobs = addon_module("addon.render_jobs")
+    process, folder = _leashed(render_jobs, tmp_path, "import os, signal, sys\n"
+                               "print('Blender 5.2 (hash 1234) started', flush=True)\n"
+                               "print('Read prefs: userpref.blend', flush=True)\n"
+                               "os.kill(os.getpid(), signal.SIGSEGV)\n")
+    assert process.wait(timeout=60) == -11  # the leash ends as its worker did
+    job = render_jobs.RenderJob(process, folder, 1, os.path.join(folder, "worker.log"))
+    with pytest.raises(Exception) as err:
+        job.check("Baking the lighting")
+    job.close()
+    assert str(err.value) == "Baking the lighting failed: the render process ended early (it crashed (SIGSEGV))"
+    said = render_jobs.failure("Rendering", -9, b"Blender 5.2 started\nFra:1 Mem:12M | Error: CUDA device lost\n"
+                                                b"Blender quit\n")
+    assert said == ("Rendering failed: the render process ended early (it was killed (SIGKILL; most often the system "
+                    "ran out of memory)): Fra:1 Mem:12M | Error: CUDA device lost")
+    assert render_jobs.failure("Rendering", 3, b"Read blend\n").endswith("(it exited with code 3)")
+
+
+def test_closing_a_workers_leash_ends_it_and_removes_its_folder(addon_module, tmp_path):
+    render_jobs = addon_module("addon.render_jobs")
+    process, folder = _leashed(render_jobs, tmp_path, "import time\ntime.sleep(600)\n")
+    time.sleep(0.5)
+    worker = [int(p) for p in os.listdir("/proc") if p.isdigit()
+              and str(tmp_path / "worker.py").encode() in open(f"/proc/{p}/cmdline", "rb").read()
+              and int(p) != process.pid]
+    assert worker, "the worker did not start"
+    assert render_jobs.stop_process(process, timeout=10)
+    assert not os.path.exists(folder)  # removed by the leash
+    render_jobs.remove_folder(folder)
+    for pid in worker:
+        assert not os.path.exists(f"/proc/{pid}") or "Z" in open(f"/proc/{pid}/stat").read().split()[2]
