@@ -231,6 +231,8 @@ def _mesh_digest(digest, ob, depsgraph=None):
     source = ob.evaluated_get(depsgraph) if depsgraph is not None else ob
     try:
         mesh = source.to_mesh() if depsgraph is not None else ob.data
+        if mesh is None:  # nothing to render (an empty curve)
+            return
         pos = np.empty(len(mesh.vertices) * 3, np.float32)
         mesh.vertices.foreach_get("co", pos)
         digest.update(pos.tobytes())

@@ -7,9 +7,11 @@ import bpy
 
 def use_device(scene, device):
     """Render on the Cycles device the user chose (``device``: `addon.render_jobs.render_device`), else the CPU; says
-    which in a ``TESSERA_DEVICE`` line."""
+    which in a ``TESSERA_DEVICE`` line (and, when a GPU was asked for, why it is the CPU)."""
     scene.cycles.device = "CPU"
+    why = ""
     if device and device.get("gpu"):
+        why = f", because no GPU was found (Cycles sees no {device.get('type')} device)"
         try:
             prefs = bpy.context.preferences.addons["cycles"].preferences
             prefs.compute_device_type = device["type"]
@@ -25,8 +27,8 @@ def use_device(scene, device):
                 print(f"TESSERA_DEVICE GPU ({device['type']}): {', '.join(used)}", flush=True)
                 return
         except (KeyError, TypeError, AttributeError, RuntimeError) as err:
-            print(f"Tessera: the GPU device could not be set up ({err}); rendering on the CPU", flush=True)
-    print("TESSERA_DEVICE CPU", flush=True)
+            why = f", because the GPU could not be set up ({err})"
+    print(f"TESSERA_DEVICE CPU{why}", flush=True)
 
 
 def report_samples():

@@ -22,7 +22,7 @@ from ..guarded import run_to_end
 from ..node_groups import Graph
 from ..render_jobs import RenderJob, job_folder, remove_folder
 from .export import PROPERTY
-from .worker import start_worker, world_box, write_job
+from .worker import check_renderable, start_worker, world_box, write_job
 
 #: Memory per atlas texel: the colour, normal and depth atlases as assembled (float32 RGBA, RGB, float64), their three
 #: RGBA float images in Blender and the packed copies of those images.
@@ -79,6 +79,7 @@ class AtlasJob:
 def start_atlas(ob, grid=8, tile=128, samples=16, hemi=False, device=None):
     """Start rendering ``ob`` (world space) from every view of the atlas in a worker process: an `AtlasJob`, at once.
     device: the Cycles device (`render_jobs.render_device`; default: the user's)."""
+    check_renderable(ob)
     lo, hi = world_box(ob)
     centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
     if not size > 0:

@@ -70,6 +70,15 @@ RESAMPLE_AT = 4
 RESAMPLE_TO = 2
 
 
+def _failed(live, ob, err):
+    """Record that ``ob``'s board could not be made (`LiveBoard.failed`, shown in its panel), say so once, and wait
+    longer before each new try."""
+    live.failures += 1
+    live.failed = str(err).strip().splitlines()[0][:300] if str(err).strip() else "the render failed"
+    live.retry_at = time.monotonic() + min(RETRY_MAX_S, RETRY_S * 2 ** (live.failures - 1))
+    print(f"Tessera: the nailboard of {ob.name!r} could not be rendered: {err}")
+
+
 class NailboardManager:
     """Boards of every nailboard object, by ``session_uid``. request(ob, eye, res_screen, fov) -> a job;
     resample(images, resolution) -> the images at that resolution (`worker.resample_images`), or None: never."""
@@ -96,10 +105,7 @@ class NailboardManager:
             try:
                 images = job.result()
             except TesseraError as err:  # told once; asked for again after the back-off
-                live.failures += 1
-                live.failed = str(err).strip().splitlines()[0][:300] if str(err).strip() else "the render failed"
-                live.retry_at = time.monotonic() + min(RETRY_MAX_S, RETRY_S * 2 ** (live.failures - 1))
-                print(f"Tessera: the nailboard of {ob.name!r} could not be rendered: {err}")
+                _failed(live, ob, err)
             else:
                 live.images, live.board = images, live.pending_board
                 live.failed, live.failures = "", 0
@@ -171,8 +177,12 @@ class NailboardManager:
         target = eye
         if self.lead and len(live.eyes) >= 2:  # velocity prediction, `lead` frames ahead
             target = eye + self.lead * (live.eyes[-1] - live.eyes[-2])
+        try:
+            job = self.request(ob, target, res_screen, fov)
+        except TesseraError as err:  # refused before it started (nothing to render): told once, asked again later
+            _failed(live, ob, err)
+            return
         lo, hi = world_box(ob)
-        job = self.request(ob, target, res_screen, fov)
         live.pending = job
         live.pending_board = Board(np.asarray(target, np.float64), lo, hi, job.setup.resolution)
         self.regenerations += 1

@@ -29,6 +29,7 @@ class DeferredJob:
     """A board asked for from a draw callback: started by a timer, then the worker's `BoardJob`."""
 
     def __init__(self, ob, eye, res_screen, fov, samples, progressive=True):
+        worker.check_renderable(ob)  # refused here (told once by the manager), not in the worker
         self.setup = board_setup(*worker.world_box(ob), eye, res_screen, fov)
         self.args, self.name, self.job = (eye, res_screen, fov, samples, progressive), ob.name, None
         _queue.append(self)

@@ -159,6 +159,31 @@ def resample_images(images, resolution):
     return BoardImages(setup, colours, displacement, normals, present)
 
 
+def check_renderable(ob, depsgraph=None):
+    """Raise `TesseraError` when ``ob`` would render nothing or garbage: no faces once evaluated (an empty curve, a
+    mesh of loose points), or vertices that are not numbers (NaN or infinite), which would fill the images with
+    non-finite pixels."""
+    source = ob.evaluated_get(depsgraph or bpy.context.evaluated_depsgraph_get())
+    try:
+        mesh = source.to_mesh()
+        faces = 0 if mesh is None else len(mesh.polygons)
+        bad = 0
+        if faces:
+            pos = np.empty(len(mesh.vertices) * 3, np.float32)
+            mesh.vertices.foreach_get("co", pos)
+            bad = int((~np.isfinite(pos.reshape(-1, 3))).any(axis=1).sum())
+    finally:
+        source.to_mesh_clear()
+    if not faces:
+        raise TesseraError(f"{ob.name!r} has no faces to render (an empty curve or loose points render nothing): "
+                           "give it geometry, or pick another object")
+    if bad:
+        raise TesseraError(f"{ob.name!r} has {bad:,} vertices that are not numbers (NaN or infinite): fix or delete "
+                           "them, then try again")
+    if not np.isfinite(np.array(ob.matrix_world)).all():
+        raise TesseraError(f"{ob.name!r} has a transform that is not made of numbers: reset it (Alt+G, Alt+R, Alt+S)")
+
+
 def world_box(ob):
     """The world-space axis-aligned box around ``ob``'s bounding box: ``(lo, hi)``, each (3,) float64."""
     from mathutils import Vector
@@ -183,6 +208,7 @@ def request_board(ob, eye, res_screen, fov, samples=8, rounding="CEIL", setup=No
     `PROGRESSIVE_MIN_SAMPLES` samples, the worker first renders the board with `preview_samples` and writes it
     (`BoardJob.preview`), then renders it in full."""
     if setup is None:
+        check_renderable(ob)
         setup = board_setup(*world_box(ob), eye, res_screen, fov, rounding)
     folder = job_folder("board")
     out = os.path.join(folder, "board.exr")

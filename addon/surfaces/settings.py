@@ -48,7 +48,7 @@ def _annotations():
     out = {
         "surface": bpy.props.EnumProperty(name="Surface", items=SURFACE_ITEMS, default="TORUS",
                                           description="Which surface to make"),
-        "factor": bpy.props.IntProperty(name="Factor", default=32, min=1, max=MAX_FACTOR,
+        "factor": bpy.props.IntProperty(name="Factor", default=32, min=1, soft_min=2, max=MAX_FACTOR,
                                         description="Quads along each side of the surface's grid (2 × Factor² "
                                                     "triangles)"),
     }

@@ -127,6 +127,9 @@ def surface_mesh(surface, factor):
     keep = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 0] != welded[:, 2])
     corner_uv = uv[tris[keep]]
     welded = welded[keep]
+    if not len(welded):
+        raise InvalidInputError(f"At Factor {factor} every triangle of the surface folds onto its seams, leaving "
+                                "nothing to mesh: use a Factor of 2 or more")
     if closure.flip:
         welded, corner_uv = welded[:, ::-1], corner_uv[:, ::-1]
     return DomainMesh(positions.astype(np.float32), np.ascontiguousarray(welded, np.int32),

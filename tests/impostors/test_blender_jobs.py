@@ -59,6 +59,51 @@ def test_an_atlas_job_returns_at_once_reports_progress_and_device_and_leaves_no_
     assert not os.path.exists(aj.job.folder) and aj.job.folder not in jobs.open_folders()
 
 
+def test_a_gpu_asked_for_where_there_is_none_says_why_it_rendered_on_the_cpu(clean_scene, bpy_module, addon_module):
+    bake = addon_module("addon.impostors.bake")
+    aj = bake.start_atlas(_box(bpy_module), grid=1, tile=8, samples=1,
+                          device={"type": "CUDA", "devices": [], "gpu": True})
+    aj.job.wait(lambda line: None, "Baking impostor views", timeout=300)
+    bake.read_atlas(aj)
+    assert aj.job.device() == "CPU, because no GPU was found (Cycles sees no CUDA device)"
+
+
+@pytest.mark.parametrize("case", ["empty curve", "loose points", "NaN vertex"])
+def test_an_object_that_renders_nothing_or_garbage_is_refused_before_a_worker_starts(clean_scene, bpy_module,
+                                                                                     addon_module, case):
+    bpy = bpy_module
+    if case == "empty curve":
+        ob = bpy.data.objects.new("Thing", bpy.data.curves.new("Thing", "CURVE"))
+        says = "'Thing' has no faces to render"
+    else:
+        me = bpy.data.meshes.new("Thing")
+        nan = float("nan")
+        if case == "loose points":
+            me.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])
+            says = "'Thing' has no faces to render"
+        else:
+            me.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0), (nan, 0, 1)], [], [(0, 1, 2), (1, 2, 3)])
+            says = "'Thing' has 1 vertices that are not numbers (NaN or infinite)"
+        ob = bpy.data.objects.new("Thing", me)
+    bpy.context.scene.collection.objects.link(ob)
+    bpy.ops.object.select_all(action="DESELECT")
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    before = _tessera_folders()
+    objects = set(bpy.data.objects)
+    with pytest.raises(RuntimeError) as err:
+        bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=1)
+    assert says in str(err.value) and "Tessera failed" not in str(err.value)
+    assert set(bpy.data.objects) == objects and _tessera_folders() == before
+    # the live board of it: refused once, told in its panel, asked again only after a back-off
+    live = addon_module("addon.impostors.live")
+    preview = addon_module("addon.impostors.preview")
+    manager = live.NailboardManager(preview._request)
+    board = manager.update(ob, (0.0, -8.0, 1.0), 400, 0.8)
+    assert says in board.failed and board.pending is None and board.retry_at > time.monotonic()
+    assert manager.update(ob, (0.0, -8.0, 1.0), 400, 0.8).failures == 1  # not asked again at once
+
+
 def test_cancel_stops_the_worker_and_leaves_nothing(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
     bake = addon_module("addon.impostors.bake")

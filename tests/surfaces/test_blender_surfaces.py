@@ -65,6 +65,19 @@ def test_a_bad_parameter_adds_nothing(clean_scene, bpy_module):
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
 
 
+@pytest.mark.parametrize("surface", ["SPHERE", "TORUS", "KLEIN", "MOBIUS"])
+def test_a_factor_that_leaves_no_triangle_is_refused_with_what_to_change(clean_scene, bpy_module, surface):
+    """Factor 1 (0 is clamped to it): every triangle folds onto a seam; refused, nothing added, no internal error."""
+    bpy = bpy_module
+    before = (len(bpy.data.objects), len(bpy.data.meshes))
+    for factor in (0, 1):
+        with pytest.raises(RuntimeError) as err:
+            bpy.ops.tessera.parametric_surface_add(surface=surface, factor=factor)
+        assert "use a Factor of 2 or more" in str(err.value) and "Tessera failed" not in str(err.value)
+    assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+    assert bpy.ops.tessera.parametric_surface_add(surface=surface, factor=2) == {"FINISHED"}
+
+
 def bezier_object(bpy, co, hl, hr, cyclic=False, radius=None):
     data = bpy.data.curves.new("Bez", "CURVE")
     data.dimensions = "3D"
