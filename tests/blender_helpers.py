@@ -101,15 +101,69 @@ def blender_on_path(folder):
     return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
 
 
-def installed_blender(built_zips, home):
+def packaged_blender_root():
+    """The chroot with Debian's packaged Blender (tools/window_setup.sh makes it once per machine), when the command
+    line's tests are to run it: as root, with unshare and chroot, unless TESSERA_CLI_BLENDER=standin (`make test-all`
+    runs the stand-in on each ``bpy`` version). None where the stand-in runs."""
+    import os
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    if os.environ.get("TESSERA_CLI_BLENDER") == "standin" or os.geteuid() != 0:
+        return None
+    if shutil.which("unshare") is None or shutil.which("chroot") is None:
+        return None
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run(["bash", str(root / "tools" / "window_setup.sh")], capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.fail(f"the packaged Blender could not be set up: {done.stderr.strip()[-2000:]}", pytrace=False)
+    return Path(done.stdout.strip().splitlines()[-1])
+
+
+def packaged_blender_on_path(folder, binds, passed=("BLENDER_USER_RESOURCES", "TMPDIR")):
+    """A ``blender`` command in ``folder``/bin that runs Debian's packaged Blender (tools/packaged_run.sh) in the
+    caller's folder, with the folders ``binds`` (and what is mounted below them) at their own paths and the
+    variables ``passed`` passed in; a signal sent to it reaches Blender itself. The environment with it first on
+    PATH (a copy of os.environ)."""
+    import os
+    import shlex
+    import stat
+    from pathlib import Path
+
+    bin_dir = Path(folder) / "bin"
+    bin_dir.mkdir(exist_ok=True)
+    run = Path(__file__).resolve().parents[1] / "tools" / "packaged_run.sh"
+    out = Path(folder) / "packaged_out"
+    out.mkdir(exist_ok=True)
+    bind_args = " ".join(f"--bind {shlex.quote(str(b))}" for b in binds)
+    env_args = " ".join(f'${{{name}:+--env {name}="${name}"}}' for name in passed)
+    shim = bin_dir / "blender"
+    shim.write_text(f'#!/bin/bash\nexec bash {shlex.quote(str(run))} {bind_args} {env_args} --cd "$PWD" '
+                    f'{shlex.quote(str(out))} 0 -- blender "$@"\n')
+    shim.chmod(shim.stat().st_mode | stat.S_IEXEC)
+    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
+
+
+def cli_blender_on_path(folder, binds):
+    """``blender`` on PATH for the command line's tests: the packaged Blender where it runs here
+    (`packaged_blender_root`), else the stand-in (`blender_on_path`). (environment, whether it is the packaged)."""
+    if packaged_blender_root() is not None:
+        return packaged_blender_on_path(folder, binds), True
+    return blender_on_path(folder), False
+
+
+def installed_blender(built_zips, home, binds=()):
     """``run(*args, timeout=600)``: ``blender ARGS`` in a process (cwd ``home``), with Tessera installed from the built
-    zip into a user folder of its own (`blender_on_path`): CompletedProcess. ``run.start(*args)`` starts one (Popen);
-    ``run.env`` is its environment."""
+    zip into a user folder of its own (`cli_blender_on_path`; ``binds``: the folders its files are in, besides
+    ``home`` and the zip's): CompletedProcess. ``run.start(*args)`` starts one (Popen); ``run.env`` is its
+    environment; ``run.packaged`` whether it is Debian's packaged Blender."""
     import subprocess
 
-    env = dict(blender_on_path(home), BLENDER_USER_RESOURCES=str(home / "user"))
-    env.pop("PYTHONPATH", None)
     linux = next(z for z in built_zips if z.name.endswith("linux_x64.zip"))
+    env, packaged = cli_blender_on_path(home, [home, linux.parent, *binds])
+    env = dict(env, BLENDER_USER_RESOURCES=str(home / "user"))
+    env.pop("PYTHONPATH", None)
 
     def run(*args, timeout=600):
         return subprocess.run(["blender", *map(str, args)], env=env, capture_output=True, text=True, timeout=timeout,
@@ -121,5 +175,5 @@ def installed_blender(built_zips, home):
 
     done = run("--command", "extension", "install-file", "-r", "user_default", "-e", linux)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
-    run.start, run.env = start, env
+    run.start, run.env, run.packaged = start, env, packaged
     return run

@@ -3,7 +3,9 @@
 # (.venv-4.2, ...; tools/setup.sh VERSION). The extension zips are built once and the packaging test installs
 # that same linux zip in every Blender. The kernels' output digests (tools/kernel_digest.py) must agree across
 # every environment (NumPy 1.26 on Python 3.11, NumPy 2 on 3.13). A Blender whose Python is missing fails. The
-# window tier (Debian's packaged Blender in a real window) runs once, in `make test`, not per bpy version.
+# window tier (Debian's packaged Blender in a real window) runs once, in `make test`, not per bpy version; here the
+# command line's process tests run the stand-in of each bpy version (TESSERA_CLI_BLENDER=standin), where `make test`
+# runs them with the packaged Blender.
 #
 #   tools/matrix.sh            every version
 #   tools/matrix.sh 4.2 5.2    some of them
@@ -28,7 +30,7 @@ for v in "${versions[@]}"; do
     status[$v]="no environment"; seconds[$v]=0; failed=1; continue
   fi
   echo "matrix: Blender $v"
-  TESSERA_ZIP_DIR="$PWD/$out/dist" ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider -m "not window" >"$out/test-$v.log" 2>&1
+  TESSERA_CLI_BLENDER=standin TESSERA_ZIP_DIR="$PWD/$out/dist" ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider -m "not window" >"$out/test-$v.log" 2>&1
   rc=$?
   seconds[$v]=$(( $(date +%s) - start ))
   summary=$(tail -n 1 "$out/test-$v.log")

@@ -78,6 +78,23 @@ def check_output(path, allowed=None):
     if ext not in known:
         raise FileProblem(f"{path}: cannot write {ext or 'a file without an extension'}; use one of "
                           f"{', '.join(sorted(known))}")
+    if ext in EXPORTERS and not available(EXPORTERS[ext][0]):
+        raise FileProblem(f"{path}: this Blender was built without the {ext} exporter (distributions' builds may "
+                          f"leave out USD or Alembic); use one of {', '.join(sorted(writable(known)))}")
+
+
+def available(op_path):
+    """Whether this Blender has the importer or exporter ``op_path`` ("wm.usd_export"; its core add-on enabled)."""
+    try:
+        _operator(op_path).get_rna_type()
+    except (AttributeError, KeyError, RuntimeError, ModuleNotFoundError):
+        return False
+    return True
+
+
+def writable(formats):
+    """The extensions of ``formats`` this Blender can write."""
+    return [ext for ext in formats if ext not in EXPORTERS or available(EXPORTERS[ext][0])]
 
 
 def _operator(path):
@@ -114,6 +131,9 @@ def check_input(path, readable):
         raise FileProblem(f"{path}: cannot be read: {os_cause(err)}") from None
     if ext == ".blend" and not head.startswith(_BLEND_MAGIC):
         raise FileProblem(f"{path}: is not a Blender file (it does not begin as a .blend does)")
+    if ext in IMPORTERS and not available(IMPORTERS[ext][0]):
+        raise FileProblem(f"{path}: this Blender was built without the {ext} importer (distributions' builds may "
+                          "leave out USD or Alembic); export it as .glb, .obj or .ply and give that")
 
 
 def read_inputs(paths):

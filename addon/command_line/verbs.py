@@ -319,6 +319,10 @@ def run(verb_name, argv):
     summary = Summary(verb.name)
     t0 = time.perf_counter()
     args = parser_for(verb).parse_args(argv)  # Usage on bad arguments; SystemExit(0) for --help
+    try:
+        files.check_output(args.out, verb.outputs or None)  # a format this Blender writes: before any work
+    except files.FileProblem as err:
+        raise Usage(str(err)) from err
     probe_outputs(args)
     outputs = files.Outputs()
     try:

@@ -1,12 +1,13 @@
 """``blender -c tessera`` as separate processes, as a farm runs it (tier: blender): the built extension installed in a
-user folder of its own, ``blender`` on PATH (`blender_cli.py`, the ``bpy`` module standing in for the executable these
-machines do not have, with Blender's registry of add-on commands).
+user folder of its own, ``blender`` on PATH: Debian's packaged Blender where it runs here (`make test` as root), the
+``bpy`` module standing in for the executable elsewhere and under `make test-all` (`blender_cli.py`, with Blender's
+registry of add-on commands).
 
 - a terrain split by ``plan`` into 4 blocks (two frames of a camera path) and into 16 blocks, every task its own
   process, joined: exactly the mesh one process makes (positions bit for bit, the same triangles);
 - impostors planned per object: the same atlases as one process baking both;
 - a task stopped (SIGTERM, as farm managers send) or killed (SIGKILL) leaves no output file, and the next task in that
-  folder removes what the killed one left.
+  folder removes what the killed one left; a killed task's render worker and job folder go with it.
 """
 
 import json
@@ -30,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def blender(built_zips, tmp_path_factory):
     """``run(*args)``: ``blender ARGS`` in a process, with Tessera installed from the built zip: CompletedProcess."""
-    return installed_blender(built_zips, tmp_path_factory.mktemp("cli_home"))
+    return installed_blender(built_zips, tmp_path_factory.mktemp("cli_home"), [tmp_path_factory.getbasetemp()])
 
 
 def _blend(path, body):

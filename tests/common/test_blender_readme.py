@@ -3,10 +3,10 @@ folder of its own holding the built Linux zip (tier: blender).
 
 - ``python`` blocks whose first line names a file (``# monkey_pn.py``) are written to that file; other ``python``
   blocks run in the ``bpy`` module;
-- ``sh`` blocks run in bash with ``blender`` on PATH: `blender_cli.py`, the ``bpy`` module standing in for the
-  Blender executable these machines do not have (Blender's own extension command, user preferences and enabled
-  add-ons loaded at startup as Blender loads them). A block that starts ``# on the farm`` runs with a user folder of
-  its own, where Tessera was never installed;
+- ``sh`` blocks run in bash with ``blender`` on PATH: Debian's packaged Blender (Python 3.14) where it runs here
+  (root: the window tier's chroot), else `blender_cli.py`, the ``bpy`` module standing in for the executable
+  (Blender's own extension command, user preferences and enabled add-ons loaded at startup as Blender loads them).
+  A block that starts ``# on the farm`` runs with a user folder of its own, where Tessera was never installed;
 - the ``make`` block (the two commands) is checked, not run (it is what CI runs): every target exists and ``make -n``
   accepts it, and ``.ci/run`` runs ``make test``.
 
@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from blender_helpers import blender_on_path
+from blender_helpers import cli_blender_on_path
 
 pytestmark = pytest.mark.blender
 
@@ -55,7 +55,8 @@ def test_every_readme_block_runs_as_printed(built_zips, tmp_path):
     home = tmp_path / "home"
     home.mkdir()
     shutil.copy2(linux, home / linux.name)
-    env = dict(blender_on_path(tmp_path), BLENDER_USER_RESOURCES=str(tmp_path / "user"))
+    env, _ = cli_blender_on_path(tmp_path, [tmp_path])
+    env = dict(env, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     farm_env = dict(env, BLENDER_USER_RESOURCES=str(tmp_path / "farm_user"))
     printed = []
     for language, code in blocks:
