@@ -352,8 +352,7 @@ def write_with(path, writer, expected=None):
     """Call ``writer(temporary path)`` to write ``path``, check the file whole (`written.check_written`), and return
     the `Pending` that renames it: the file at ``path`` is complete or absent. Formats that name files beside them
     (`_SIDECARS`) are written under their final names in a folder of their own, moved at the commit, the main file
-    last. Every failure is a `WriteFailed` naming the path and the cause; a stop (SIGTERM) while the writer runs is
-    held until it returns."""
+    last. Every failure is a `WriteFailed` naming the path and the cause (a stop while the writer runs: `Stopped`)."""
     path = os.path.abspath(path)
     probe_output(path)
     folder = os.path.dirname(path)
@@ -393,7 +392,7 @@ def write_with(path, writer, expected=None):
 def _run_writer(path, writer, target):
     """``writer(target)`` with its output held back: on failure one sentence (`WriteFailed`), not the exporter's
     traceback; on success what it printed is passed on."""
-    with stopping.deferred(), _captured_output() as captured:
+    with _captured_output() as captured:
         try:
             writer(target)
             error = None

@@ -1,8 +1,6 @@
-"""SIGTERM on the command line (farm managers send it to stop a task): the run unwinds at once, its partial files
-removed, except while an exporter writes: then the stop waits until the exporter returns (`deferred`), so the task
-ends with one sentence instead of the exporter's traceback, and nothing is written."""
-
-from contextlib import contextmanager
+"""SIGTERM on the command line (farm managers send it to stop a task): the run unwinds at once and its partial files
+are removed. A stop that lands inside an exporter fails the exporter; its traceback is held back with the rest of
+what it printed (`files._captured_output`), so the task still ends with one sentence."""
 
 
 class Stopped(Exception):
@@ -12,7 +10,6 @@ class Stopped(Exception):
 #: The signals received since the run began (an operator that a signal interrupted reports a failure; this tells them
 #: apart).
 requested = set()
-_deferring = []
 
 
 def message():
@@ -20,19 +17,6 @@ def message():
 
 
 def handler(signum, frame):
-    """The SIGTERM handler of a run: raise `Stopped` now, or when the write under way returns."""
+    """The SIGTERM handler of a run."""
     requested.add(signum)
-    if not _deferring:
-        raise Stopped(message())
-
-
-@contextmanager
-def deferred():
-    """Hold a stop until the block ends (an exporter writing), then raise `Stopped`."""
-    _deferring.append(True)
-    try:
-        yield
-    finally:
-        _deferring.pop()
-    if requested and not _deferring:
-        raise Stopped(message())
+    raise Stopped(message())

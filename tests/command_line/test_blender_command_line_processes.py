@@ -261,3 +261,22 @@ def test_a_killed_task_takes_its_render_worker_and_job_folder_with_it(blender, b
         time.sleep(0.05)
     assert not any(_processes_naming(f"{f}/job.json") for f in folders), "a render worker outlived its task"
     assert not any(f.exists() for f in folders), "the job folder outlived its task"
+
+
+def test_a_task_stopped_while_the_gltf_exporter_writes_ends_in_one_sentence(blender, heavy, tmp_path):
+    """SIGTERM while Blender's glTF exporter (Python) runs: the stop waits for it, then nothing is written and no
+    exporter traceback is printed."""
+    out = tmp_path / "out"
+    proc = blender.start("-c", "tessera", "tessellate", heavy, "--level", "3", "-o", out / "grid.glb")
+    for line in proc.stderr:  # the mesh is made; the exporter starts now
+        if " -> " in line:
+            break
+    time.sleep(0.3)
+    assert proc.poll() is None, "the task ended before it could be stopped"
+    proc.send_signal(signal.SIGTERM)
+    stdout, err = proc.communicate(timeout=300)
+    said = stdout + err
+    assert proc.returncode == 1, said[-3000:]
+    assert "tessera: stopped by signal 15; nothing was written" in said
+    assert "Traceback" not in said and "wrote " not in said
+    assert not out.exists() or os.listdir(out) == []
