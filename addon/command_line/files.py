@@ -18,8 +18,9 @@ from dataclasses import dataclass
 
 import bpy
 
+from ...kernels.common import written
 from .. import render_jobs
-from . import stopping, written
+from . import stopping
 
 #: Importers by file extension: (operator path, keyword arguments).
 IMPORTERS = {
@@ -128,7 +129,7 @@ def check_input(path, readable):
         with open(path, "rb") as f:
             head = f.read(7)
     except OSError as err:
-        raise FileProblem(f"{path}: cannot be read: {os_cause(err)}") from None
+        raise FileProblem(f"{path}: cannot be read: {written.os_cause(err)}") from None
     if ext == ".blend" and not head.startswith(_BLEND_MAGIC):
         raise FileProblem(f"{path}: is not a Blender file (it does not begin as a .blend does)")
     if ext in IMPORTERS and not available(IMPORTERS[ext][0]):
@@ -203,23 +204,11 @@ def _partial(path):
     return os.path.join(folder, f".{stem}.tessera-partial-{_host()}-{os.getpid()}{ext}")
 
 
-#: What an operating-system error means for a file being written, in the user's words.
-_CAUSES = {errno.ENOSPC: "no space left on the device", errno.EDQUOT: "the disk quota is used up",
-           errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
-           errno.EPERM: "permission denied", errno.EISDIR: "it is a folder; give a file name",
-           errno.ENOTDIR: "a folder in its path is a file", errno.ENAMETOOLONG: "the name is too long",
-           errno.EIO: "the device reported an input/output error"}
-_ERRNO_TEXT = re.compile(r"\[Errno (\d+)\]")
 
 
 def failed(path, cause):
     """The `WriteFailed` of ``path``: "PATH: not written: CAUSE"."""
     return WriteFailed(f"{path}: not written: {cause}")
-
-
-def os_cause(err):
-    """The cause of an `OSError` in the user's words."""
-    return _CAUSES.get(err.errno) or (err.strerror or str(err)).lower()
 
 
 def _writable(folder):
@@ -228,10 +217,10 @@ def _writable(folder):
         return None
     try:
         if os.statvfs(folder).f_flag & os.ST_RDONLY:
-            return _CAUSES[errno.EROFS]
+            return written.CAUSES[errno.EROFS]
     except (OSError, AttributeError):
         pass
-    return _CAUSES[errno.EACCES]
+    return written.CAUSES[errno.EACCES]
 
 
 def probe_output(path):
@@ -240,7 +229,7 @@ def probe_output(path):
     write."""
     path = os.path.abspath(path)
     if os.path.isdir(path):
-        raise failed(path, _CAUSES[errno.EISDIR])
+        raise failed(path, written.CAUSES[errno.EISDIR])
     folder = os.path.dirname(path)
     while not os.path.lexists(folder) and os.path.dirname(folder) != folder:
         folder = os.path.dirname(folder)
@@ -331,7 +320,7 @@ def _check_space(path, objects, ext):
             need += written.least_size(ext, len(me.vertices), len(me.loops), len(me.polygons))
     need *= _ABORTS_WHEN_FULL.get(ext, 1.0)
     if need > free:
-        raise failed(os.path.abspath(path), f"{_CAUSES[errno.ENOSPC]} (it needs at least {_megabytes(need)}; "
+        raise failed(os.path.abspath(path), f"{written.CAUSES[errno.ENOSPC]} (it needs at least {_megabytes(need)}; "
                                             f"{_megabytes(free)} free)")
 
 
@@ -359,7 +348,7 @@ def write_with(path, writer, expected=None):
     try:
         os.makedirs(folder, exist_ok=True)
     except OSError as err:
-        raise failed(path, os_cause(err)) from None
+        raise failed(path, written.os_cause(err)) from None
     remove_stale_partials(folder)
     ext = extension(path)
     sidecars = ext in _SIDECARS
@@ -375,9 +364,9 @@ def write_with(path, writer, expected=None):
         try:
             written.check_written(main, expected)
         except written.ShortWrite as err:
-            raise failed(path, _CAUSES[errno.ENOSPC] if written.disk_full(folder) else str(err)) from None
+            raise failed(path, written.CAUSES[errno.ENOSPC] if written.disk_full(folder) else str(err)) from None
         except OSError as err:
-            raise failed(path, os_cause(err)) from None
+            raise failed(path, written.os_cause(err)) from None
         if sidecars:
             names = sorted(os.listdir(partial), key=lambda n: n == os.path.basename(path))  # the main file last
             pending.moves = [(os.path.join(partial, n), os.path.join(folder, n)) for n in names]
@@ -397,38 +386,24 @@ def _run_writer(path, writer, target):
             writer(target)
             error = None
         except OSError as err:
-            error = os_cause(err)
+            error = written.os_cause(err)
         except RuntimeError as err:  # the exporter's report, or its Python exception
             error = str(err)
     if error is None:
-        cause = _os_error_said(captured.text)
+        cause = written.cause_in_text(captured.text)
         if cause is None:
             captured.replay()
             return
         raise failed(path, cause)  # the exporter printed an operating-system error but reported nothing (USD)
     if stopping.requested:
         raise stopping.Stopped(stopping.message())
-    found = _ERRNO_TEXT.findall(error + captured.text)
-    if found:
-        cause = _CAUSES.get(int(found[-1])) or os.strerror(int(found[-1])).lower()
-    elif written.disk_full(os.path.dirname(path)):
-        cause = _CAUSES[errno.ENOSPC]
-    else:
+    cause = written.cause_in_text(error + captured.text)
+    if cause is None and written.disk_full(os.path.dirname(path)):
+        cause = written.CAUSES[errno.ENOSPC]
+    if cause is None:
         lines = [ln.strip() for ln in error.splitlines() if ln.strip() and not ln.startswith((" ", "Traceback"))]
         cause = (lines[-1] if lines else "the exporter failed").removeprefix("Error: ")
     raise failed(path, cause)
-
-
-#: Operating-system errors an exporter may print while reporting success: a write that failed.
-_PRINTED = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO)
-
-
-def _os_error_said(text):
-    """The cause, when ``text`` (what an exporter printed) names a failed write (`_PRINTED`): else None."""
-    for number in _PRINTED:
-        if os.strerror(number) in text:
-            return _CAUSES[number]
-    return None
 
 
 class _Captured:

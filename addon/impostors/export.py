@@ -12,6 +12,7 @@ The card is written from a temporary copy (its own mesh, material and object), r
 file is written next to its destination and moved into place once whole.
 """
 
+import errno
 import os
 import tempfile
 
@@ -19,6 +20,7 @@ import addon_utils
 import bpy
 import numpy as np
 
+from ...kernels.common import written
 from ...kernels.common.errors import InvalidInputError, TesseraError
 from ...kernels.impostors.octahedral import cell_of
 from ..node_groups import Graph
@@ -51,7 +53,10 @@ def export_card(card, filepath):
     extras = {**info, "layout": "hemi-octahedral" if hemi else "octahedral", "fallback_view": [int(c) for c in cell],
               "atlas": image.name}
     made, selection = [], (list(bpy.context.selected_objects), bpy.context.view_layer.objects.active)
-    handle, part = tempfile.mkstemp(suffix=".glb", dir=folder)
+    try:
+        handle, part = tempfile.mkstemp(suffix=".glb", dir=folder)
+    except OSError as err:
+        raise TesseraError(f"{filepath}: not written: {written.os_cause(err)}") from None
     os.close(handle)
     try:
         ob = _export_copy(card, image, grid, cell, extras, made)
@@ -59,9 +64,21 @@ def export_card(card, filepath):
             other.select_set(False)
         ob.select_set(True)
         bpy.context.view_layer.objects.active = ob
-        result = bpy.ops.export_scene.gltf(filepath=part, export_format="GLB", use_selection=True, export_extras=True)
+        try:
+            result = bpy.ops.export_scene.gltf(filepath=part, export_format="GLB", use_selection=True,
+                                               export_extras=True)
+        except RuntimeError as err:  # the exporter's exception: the cause when it is the disk's
+            cause = written.cause_in_text(str(err))
+            if cause is None:
+                raise
+            raise TesseraError(f"{filepath}: not written: {cause}") from None
         if result != {"FINISHED"} or os.path.getsize(part) == 0:
             raise TesseraError(f"Blender's glTF exporter did not write {filepath!r}")
+        try:
+            written.check_written(part)  # the exporter says nothing of a short write (a full disk)
+        except written.ShortWrite as err:
+            cause = written.CAUSES[errno.ENOSPC] if written.disk_full(folder) else str(err)
+            raise TesseraError(f"{filepath}: not written: {cause}") from None
         os.replace(part, filepath)
     finally:
         if os.path.exists(part):

@@ -24,7 +24,7 @@ CHECKED = {
 
 @pytest.fixture
 def written(addon_module):
-    return addon_module("addon.command_line.written")
+    return addon_module("kernels.common.written")
 
 
 @pytest.fixture

@@ -11,11 +11,14 @@ so every file is checked, as its format allows, before it gets its final name.
   whose frames add up to its size;
 - every format: a file system left with no free block means the write was cut short.
 
-No Blender imports: the checks read bytes only. `check_written` raises `ShortWrite` with the reason.
+No Blender imports: the checks read bytes only. `check_written` raises `ShortWrite` with the reason; `os_cause` says
+what an operating-system error means for a file being written.
 """
 
+import errno
 import json
 import os
+import re
 import struct
 
 import numpy as np
@@ -23,6 +26,37 @@ import numpy as np
 
 class ShortWrite(Exception):
     """The file is not whole: the message says what is missing."""
+
+
+#: What an operating-system error means for a file being written, in the user's words.
+CAUSES = {errno.ENOSPC: "no space left on the device", errno.EDQUOT: "the disk quota is used up",
+          errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
+          errno.EPERM: "permission denied", errno.EISDIR: "it is a folder; give a file name",
+          errno.ENOTDIR: "a folder in its path is a file", errno.ENAMETOOLONG: "the name is too long",
+          errno.EIO: "the device reported an input/output error"}
+
+
+def os_cause(err):
+    """The cause of an `OSError` in the user's words."""
+    return CAUSES.get(err.errno) or (err.strerror or str(err)).lower()
+
+
+_ERRNO_TEXT = re.compile(r"\[Errno (\d+)\]")
+#: Operating-system errors an exporter may print (or put in its exception) while a write fails.
+_PRINTED = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO)
+
+
+def cause_in_text(text):
+    """The cause of a failed write named in ``text`` (what an exporter printed or raised: Python's ``[Errno 28]``,
+    or the C library's "No space left on device"), in the user's words; None when it names none."""
+    found = _ERRNO_TEXT.findall(text)
+    if found:
+        number = int(found[-1])
+        return CAUSES.get(number) or os.strerror(number).lower()
+    for number in _PRINTED:
+        if os.strerror(number) in text:
+            return CAUSES[number]
+    return None
 
 
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
