@@ -1,10 +1,11 @@
 """Build the Tessera extension zips with Blender's own builder, one per platform, wheels bundled.
 
 Steps: validate the source manifest (tags checked against Blender's list); download the wheels of pyopencl and its
-pure-Python needs, and of tifffile (GeoTIFF tags), for each platform and for each Python the supported Blenders use
-(3.11 for 4.2-5.0, 3.13 for 5.1 and 5.2, 3.14 for the distributions' builds), at the versions installed in this venv
-(the ones the tests ran with); stage a copy of the tree whose manifest lists them, with the node-group asset library
-written into it by this venv's Blender; build with ``blender_ext.py build --split-platforms``; validate each zip.
+pure-Python needs, of tifffile (GeoTIFF tags) and of psutil (free memory), for each platform and for each Python the
+supported Blenders use (3.11 for 4.2-5.0, 3.13 for 5.1 and 5.2, 3.14 for the distributions' builds), at the versions
+installed in this venv (the ones the tests ran with); stage a copy of the tree whose manifest lists them, with the
+node-group asset library written into it by this venv's Blender; build with ``blender_ext.py build
+--split-platforms``; validate each zip.
 Blender installs the wheels that match its own Python. numpy is not bundled: Blender ships it.
 
 Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
@@ -27,7 +28,7 @@ PLATFORMS = {
     "macos-arm64": ["macosx_15_0_arm64"],
     "macos-x64": ["macosx_15_0_x86_64"],
 }
-BINARY = ("pyopencl", "siphash24")
+BINARY = ("pyopencl", "siphash24", "psutil")
 PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl", "tifffile")
 #: The Pythons of the supported Blenders: 4.2, 4.5 and 5.0 use 3.11; 5.1 and 5.2 use 3.13; the distributions' builds
 #: of them (Debian, Ubuntu, Fedora, Arch, NixOS) run the system's Python, 3.14 today.

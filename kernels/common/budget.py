@@ -31,24 +31,40 @@ def _proc_kib(path, key):
     return None
 
 
+def _system_memory():
+    """(available RAM + free swap, virtual size this process maps now) in bytes, from psutil (bundled with the
+    extension: Linux, Windows and macOS alike), else from /proc (Linux); None for what the system does not say."""
+    try:
+        import psutil
+    except ImportError:
+        psutil = None
+    if psutil is not None:
+        try:
+            available = psutil.virtual_memory().available + psutil.swap_memory().free
+            mapped = psutil.Process().memory_info().vms
+            return available, mapped
+        except (OSError, RuntimeError, AttributeError):
+            pass
+    available, swap = _proc_kib("/proc/meminfo", "MemAvailable"), _proc_kib("/proc/meminfo", "SwapFree")
+    mapped = _proc_kib(f"/proc/{os.getpid()}/status", "VmSize")
+    return (None if available is None else (available + (swap or 0)) * 1024,
+            None if mapped is None else mapped * 1024)
+
+
 def free_bytes():
-    """Bytes this process can still allocate as far as the system tells: the address-space limit less what the
-    process maps now, and the kernel's available memory plus free swap; the smaller of the two, or None where the
-    system says nothing (not Linux, no limit and no /proc)."""
-    limits = []
+    """Bytes this process can still allocate as far as the system tells: the address-space limit (``ulimit -v``)
+    less what the process maps now, and the available memory plus free swap; the smaller of the two, or None where
+    the system says nothing."""
+    available, mapped = _system_memory()
+    limits = [] if available is None else [available]
     try:
         import resource
 
         soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-        if soft != resource.RLIM_INFINITY:
-            mapped = _proc_kib(f"/proc/{os.getpid()}/status", "VmSize")
-            if mapped is not None:
-                limits.append(soft - mapped * 1024)
-    except (ImportError, OSError, ValueError):
+        if soft != resource.RLIM_INFINITY and mapped is not None:
+            limits.append(soft - mapped)
+    except (ImportError, OSError, ValueError):  # Windows: no address-space limit to read
         pass
-    available, swap = _proc_kib("/proc/meminfo", "MemAvailable"), _proc_kib("/proc/meminfo", "SwapFree")
-    if available is not None:
-        limits.append((available + (swap or 0)) * 1024)
     return max(0, min(limits)) if limits else None
 
 

@@ -35,3 +35,46 @@ def test_free_memory_follows_an_address_space_limit():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120)
     before, after = (int(v) for v in out.stdout.split())
     assert before > 300 * 2**20 and 250 * 2**20 < after <= 300 * 2**20
+
+
+class _FakePsutil:
+    """psutil as a system with ``available`` bytes of RAM, ``swap`` free, this process mapping ``mapped``."""
+
+    def __init__(self, available, swap, mapped):
+        from types import SimpleNamespace
+
+        self.virtual_memory = lambda: SimpleNamespace(available=available)
+        self.swap_memory = lambda: SimpleNamespace(free=swap)
+        self.Process = lambda: SimpleNamespace(memory_info=lambda: SimpleNamespace(vms=mapped))
+
+
+def test_free_memory_comes_from_psutil_on_a_system_without_proc(monkeypatch):
+    """Windows and macOS have no /proc: the bundled psutil says what is free, and a low-memory system refuses."""
+    monkeypatch.setattr(budget, "_proc_kib", lambda path, key: None)  # no /proc
+    monkeypatch.setitem(sys.modules, "psutil", _FakePsutil(available=200 * 2**20, swap=56 * 2**20, mapped=2**30))
+    assert budget.free_bytes() == 256 * 2**20
+    with pytest.raises(BudgetError, match=r"need about 300 MiB, but only 256 MiB of memory is free"):
+        budget.check_bytes(300 * 2**20, 0, "It would have 5 things", "fewer things")
+    assert budget.check_bytes(200 * 2**20, 0, "It would have 5 things", "fewer things") == 200 * 2**20
+
+
+def test_without_psutil_linux_reads_proc_and_other_systems_say_nothing(monkeypatch):
+    monkeypatch.setitem(sys.modules, "psutil", None)  # import psutil fails
+    if sys.platform.startswith("linux"):
+        assert budget.free_bytes() > 0
+    monkeypatch.setattr(budget, "_proc_kib", lambda path, key: None)
+    import resource
+
+    if resource.getrlimit(resource.RLIMIT_AS)[0] == resource.RLIM_INFINITY:
+        assert budget.free_bytes() is None  # nothing known: the user's budget alone decides
+
+
+def test_psutil_and_proc_agree_here():
+    pytest.importorskip("psutil")
+    if not sys.platform.startswith("linux"):
+        pytest.skip("/proc is Linux's")
+    import psutil
+
+    proc = (budget._proc_kib("/proc/meminfo", "MemAvailable") + budget._proc_kib("/proc/meminfo", "SwapFree")) * 1024
+    ours = psutil.virtual_memory().available + psutil.swap_memory().free
+    assert abs(ours - proc) < 0.05 * proc + 64 * 2**20

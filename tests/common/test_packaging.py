@@ -52,7 +52,7 @@ local = bpy.utils.user_resource("EXTENSIONS", path=".local")
 def bundled():
     names = {os.path.basename(p).split(".")[0]
              for p in glob.glob(os.path.join(local, "lib", "python*", "site-packages", "*"))}
-    return sorted(names & {"pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile"})
+    return sorted(names & {"psutil", "pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile"})
 wheels_installed = bundled()
 bpy.ops.extensions.package_uninstall(repo_index=repo_index, pkg_id="tessera")
 print("RESULT" + json.dumps({"enabled": enabled, "results": results, "faces": faces,
@@ -124,6 +124,7 @@ def test_one_zip_per_platform_without_dev_files(built_zips):
         assert "blender_manifest.toml" in names and "kernels/tessellation/gather_weighted.cl" in names
         assert not any(n.startswith(("tests/", "samples/", "bench/", "docs/", ".ci/", "tools/")) for n in names)
         assert any(n.startswith("wheels/pyopencl-") for n in names)
+        assert any(n.startswith("wheels/psutil-") for n in names)
         assert not any("numpy" in n for n in names)
 
 
@@ -151,6 +152,6 @@ def test_install_enable_run_uninstall(built_zips, tmp_root):
         ("tessellate", "tubes", "terrain_add", "displacement_add", "displacement_stroke"), ["FINISHED"])
     assert report["faces"] == 12 * 6  # cube: 12 triangles, level 2 -> 6 each
     assert report["opencl"], "the bundled pyopencl found no OpenCL device (PoCL) in the installed extension"
-    assert report["wheels"] == ["pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile"]  # bundled wheels
+    assert report["wheels"] == ["psutil", "pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile"]  # bundled
     assert report["wheels_after"] == []  # and removed with the extension
     assert not report["after"] and not report["op_after"]

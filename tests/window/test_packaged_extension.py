@@ -25,14 +25,16 @@ step tessellate blender --command tessera tessellate --level 2 -o "$out/cube.ply
 step opencl blender --background --python-expr "
 import importlib, json, sys
 rt = importlib.import_module('bl_ext.user_default.tessera.kernels.common.opencl_runtime').get_runtime()
-import pyopencl
+budget = importlib.import_module('bl_ext.user_default.tessera.kernels.common.budget')
+import psutil, pyopencl
 print('RESULT' + json.dumps({'device': rt is not None and rt.device.name, 'pyopencl': pyopencl.__file__,
+                             'psutil': psutil.__file__, 'free': budget.free_bytes(),
                              'python': '%d.%d' % sys.version_info[:2]}))"
 step remove blender --command extension remove user_default.tessera
 find "$ext" -mindepth 1 -not -path "*/.cache*" -not -name __pycache__ -not -path "*/__pycache__/*" \
   >"$out/left.txt" 2>&1
 """
-BUNDLED = ("pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile")
+BUNDLED = ("psutil", "pyopencl", "pytools", "siphash24", "threadpoolctl", "tifffile")
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +84,7 @@ def test_the_bundled_pyopencl_finds_a_device(packaged_install):
     report = json.loads(lines[-1][len("RESULT"):])
     assert report["python"] == "3.14"
     assert "/extensions/.local/" in report["pyopencl"]  # the zip's wheel, not the distribution's package
+    assert "/extensions/.local/" in report["psutil"] and report["free"] > 2**20
     assert report["device"], "the bundled pyopencl found no OpenCL device (PoCL)"
 
 
