@@ -161,6 +161,23 @@ def opencl():
     opencl_runtime.configure()
 
 
+@pytest.fixture
+def addon_opencl(addon_module):
+    """The OpenCL runtime of the add-on's own copy of the kernels (``bl_ext…``: the copy its operators run, not the
+    ``tessera.`` copy `opencl` configures), required; the add-on's preferences are applied again after."""
+    runtime_module = addon_module("kernels.common.opencl_runtime")
+    errors = addon_module("kernels.common.errors")
+    runtime_module.configure(mode="require")
+    try:
+        runtime = runtime_module.get_runtime()
+    except errors.OpenCLUnavailableError as err:
+        tier_unavailable(str(err))
+    yield runtime
+    import bpy
+
+    addon_module("addon.preferences").apply_opencl_settings(bpy.context.preferences.addons[ADDON_MODULE].preferences)
+
+
 @pytest.fixture(scope="session")
 def built_zips(bpy_module, tmp_root):
     """The extension zips: those in $TESSERA_ZIP_DIR when set (`make test-all` builds them once for every Blender),

@@ -253,7 +253,8 @@ def test_map_over_the_memory_budget_makes_nothing(clean_scene, bpy_module, addon
 
 
 @pytest.mark.opencl
-def test_a_custom_kernel_writing_nan_changes_nothing_anywhere(clean_scene, bpy_module, addon_module, opencl, tmp_path):
+def test_a_custom_kernel_writing_nan_changes_nothing_anywhere(clean_scene, bpy_module, addon_module, addon_opencl,
+                                                              tmp_path):
     """Host map, device buffer, Blender image and an export are bit-identical before and after the refusal."""
     bpy = bpy_module
     maps = addon_module("addon.displacement.maps")
@@ -263,8 +264,8 @@ def test_a_custom_kernel_writing_nan_changes_nothing_anywhere(clean_scene, bpy_m
     settings = ob.tessera.displacement
     state = maps.map_state(settings.image, maps.channels_for(settings))
     state.host[...] = np.random.default_rng(2).random(state.host.shape, np.float32)
-    if state.device is not None:
-        state.device.push()
+    assert state.device is not None  # the add-on's own runtime has the device: the device half is checked
+    state.device.push()
     state.to_image(settings.image)
     host = state.host.tobytes()
     first = tmp_path / "before.exr"
@@ -278,10 +279,9 @@ def test_a_custom_kernel_writing_nan_changes_nothing_anywhere(clean_scene, bpy_m
     finally:
         bpy.context.preferences.filepaths.use_scripts_auto_execute = False
     assert state.host.tobytes() == host
-    if state.device is not None:
-        on_device = np.empty_like(state.host)
-        state.device.runtime.cl.enqueue_copy(state.device.runtime.queue, on_device, state.device.buf)
-        assert on_device.tobytes() == host
+    on_device = np.empty_like(state.host)
+    state.device.runtime.cl.enqueue_copy(state.device.runtime.queue, on_device, state.device.buf)
+    assert on_device.tobytes() == host
     second = tmp_path / "after.exr"
     assert bpy.ops.tessera.displacement_export(filepath=str(second)) == {"FINISHED"}
     from tessera.kernels.displacement.map_io import read_map

@@ -6,7 +6,7 @@ import pytest
 pytestmark = [pytest.mark.blender, pytest.mark.opencl]
 
 
-def test_warm_up_thread_builds_every_program_and_is_waited_for(bpy_module, addon_module, opencl):
+def test_warm_up_thread_builds_every_program_and_is_waited_for(bpy_module, addon_module, addon_opencl):
     warmup = addon_module("addon.opencl_warmup")
     runtime_module = addon_module("kernels.common.opencl_runtime")
     preferences = addon_module("addon.preferences")

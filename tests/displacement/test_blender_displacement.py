@@ -146,8 +146,9 @@ def test_export_and_import_round_trip(clean_scene, bpy_module, addon_module, tmp
     assert state_of(addon_module, other).host.tobytes() == painted.tobytes()
 
 
-def test_save_reload_is_exact_and_custom_kernels_need_trust(clean_scene, bpy_module, addon_module, tmp_path, opencl,
-                                                           monkeypatch):
+@pytest.mark.opencl
+def test_save_reload_is_exact_and_custom_kernels_need_trust(clean_scene, bpy_module, addon_module, tmp_path,
+                                                           addon_opencl, monkeypatch):
     bpy = bpy_module
     custom = addon_module("operators.custom_kernel")
     map_edit = addon_module("kernels.displacement.map_edit")
