@@ -1,6 +1,6 @@
-"""Command-line options made from an operator's own properties: one ``--name`` per setting, with the tooltip as its
-help, the enum items as its choices and the property's hard range checked, so the command line always offers exactly
-what the redo panel offers.
+"""Command-line options made from an operator's own properties: one ``--name`` per setting, with its panel label and
+tooltip as its help, the enum items as its choices and the property's hard range checked, so the command line always
+offers exactly what the redo panel offers.
 
 - booleans: ``--culling`` / ``--no-culling``;
 - numbers: ``--level 4``; vectors: ``--block 0,1,2,2``;
@@ -97,7 +97,8 @@ def _enum(p):
 
 
 def _help(p):
-    text = (p.description or p.name).rstrip(".")
+    """The option's help: the setting's label as the panels show it, its tooltip, its choices or range, its default."""
+    text = f"{p.name}: {p.description}".rstrip(".") if p.description else p.name
     if p.type == "ENUM":
         items = "; ".join(f"{i.identifier.lower()}: {i.description or i.name}" for i in p.enum_items)
         default = ",".join(sorted(p.default_flag)).lower() if p.is_enum_flag else p.default.lower()

@@ -63,9 +63,11 @@ def test_help_lists_every_verb_and_every_setting_with_its_tooltip(cli, bpy_modul
     skipped = cli.verbs._NOT_OPTIONS | {"rna_type"}  # set by the command line itself, or needing a window
     shown = [p for p in rna.properties if p.identifier not in skipped and not p.is_hidden]
     assert len(shown) > 15
+    words = " ".join(out.split())
     for p in shown:
         assert "--" + p.identifier.replace("_", "-") in out, p.identifier
-    words = " ".join(out.split())
+        label = f"{p.name}: {' '.join(p.description.split())[:30]}" if p.description else p.name
+        assert label in words, (p.identifier, label)  # the label the panels show, beside the flag
     assert "Target edge length on screen (0.5 to 100000; default 10)" in words
     for verb in ("tubes", "loop", "surface", "impostors", "terrain", "join", "plan"):
         assert cli.execute([verb, "--help"]) == 0, verb
