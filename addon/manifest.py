@@ -1,5 +1,5 @@
-"""The extension's own ``blender_manifest.toml``, read once: its website (the manual), maintainer, license and
-copyright, for the sidebar's start panel and the node-group assets' metadata."""
+"""The extension's own ``blender_manifest.toml``, read once: its website, maintainer, license and copyright, for the
+sidebar's start panel and the node-group assets' metadata; and where the manual is (`manual_url`)."""
 
 import functools
 import tomllib
@@ -19,6 +19,16 @@ def manifest():
 
 def website():
     return manifest().get("website", "")
+
+
+#: The manual as it ships in the extension (HTML made by tools/manual.py at the build); absent in a source tree.
+MANUAL = MANIFEST.parent / "manual" / "index.html"
+
+
+def manual_url():
+    """Where the Manual button goes: the copy inside the extension (offline, and true to this version), else the
+    website; "" when there is neither."""
+    return MANUAL.as_uri() if MANUAL.is_file() else website()
 
 
 def license_id():

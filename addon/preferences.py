@@ -1,8 +1,9 @@
-"""Add-on preferences: memory budget and compute backend (OpenCL mode and device)."""
+"""Add-on preferences: memory budget, compute backend (OpenCL mode and device), and the Manual."""
 
 import bpy
 
 from ..kernels.common import opencl_runtime
+from .manifest import manual_url
 
 BASE_PACKAGE = __package__.rpartition(".")[0]
 
@@ -71,6 +72,8 @@ class TESSERA_AddonPreferences(bpy.types.AddonPreferences):
         except Exception as err:  # shown, not raised: drawing must never fail
             layout.label(text=str(err), icon="ERROR")
         layout.label(text=f"Compute device: {runtime.description if runtime else 'numpy (CPU)'}")
+        if manual_url():
+            layout.operator("wm.url_open", text="Manual", icon="HELP").url = manual_url()
 
 
 def get_preferences(context=None):

@@ -3,7 +3,7 @@ is active, with the creators (Add › Tessera), what to select for the other too
 
 import bpy
 
-from .manifest import website
+from .manifest import manual_url
 from .menus import ADD_MENU, ICONS
 from .sidebar import Sidebar, panel_order, wrapped_label
 from .viewport import stopped_previews
@@ -37,8 +37,8 @@ class TESSERA_PT_start(Sidebar, bpy.types.Panel):
         layout.label(text="Or select an object to work on:")
         for icon, text in SELECT_HINTS:
             wrapped_label(layout, context, text, icon)
-        if website():
-            layout.operator("wm.url_open", text="Manual", icon="HELP").url = website()
+        if manual_url():
+            layout.operator("wm.url_open", text="Manual", icon="HELP").url = manual_url()
 
 
 class TESSERA_PT_gpu_notice(bpy.types.Panel):

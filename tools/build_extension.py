@@ -4,8 +4,8 @@ Steps: validate the source manifest (tags checked against Blender's list); downl
 pure-Python needs, of tifffile (GeoTIFF tags) and of psutil (free memory), for each platform and for each Python the
 supported Blenders use (3.11 for 4.2-5.0, 3.13 for 5.1 and 5.2, 3.14 for the distributions' builds), at the versions
 installed in this venv (the ones the tests ran with); stage a copy of the tree whose manifest lists them, with the
-node-group asset library written into it by this venv's Blender; build with ``blender_ext.py build
---split-platforms``; validate each zip.
+node-group asset library written into it by this venv's Blender and the manual as HTML (`manual.py`); build with
+``blender_ext.py build --split-platforms``; validate each zip.
 Blender installs the wheels that match its own Python. numpy is not bundled: Blender ships it.
 
 Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
@@ -19,6 +19,9 @@ import tempfile
 import tomllib
 from importlib import metadata
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from manual import build_manual  # noqa: E402 -- tools/ is not a package
 
 ROOT = Path(__file__).resolve().parents[1]
 # Blender platform -> pip platform tags for the binary wheels.
@@ -82,6 +85,7 @@ def stage(wheel_dir, wheels, staging):
     (staging / "blender_manifest.toml").write_text(manifest, encoding="utf-8")
     tomllib.loads(manifest)  # fail here, not in Blender, if the edit broke the TOML
     write_node_library(staging)
+    build_manual(staging / "manual")  # the manual, offline: the sidebar's Manual button opens it
 
 
 #: Writes the node-group library into the staged package (run by this venv's Blender, the bpy module).

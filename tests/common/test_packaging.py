@@ -48,6 +48,10 @@ results["library"] = {"entries": len(entries), "groups": in_library,
                       "shipped_here": library._complete(library.SHIPPED_DIR),
                       "uses_shipped": bool(entries) and os.path.realpath(entries[0].path)
                       == os.path.realpath(library.SHIPPED_DIR)}
+from urllib.parse import unquote, urlparse
+manual = importlib.import_module(module + ".addon.manifest").manual_url()
+results["manual"] = {"url": manual, "exists": manual.startswith("file://")
+                     and os.path.isfile(unquote(urlparse(manual).path))}
 local = bpy.utils.user_resource("EXTENSIONS", path=".local")
 def bundled():
     names = {os.path.basename(p).split(".")[0]
@@ -125,7 +129,27 @@ def test_one_zip_per_platform_without_dev_files(built_zips):
         assert not any(n.startswith(("tests/", "samples/", "bench/", "docs/", ".ci/", "tools/")) for n in names)
         assert any(n.startswith("wheels/pyopencl-") for n in names)
         assert any(n.startswith("wheels/psutil-") for n in names)
+        _check_manual(z)
         assert not any("numpy" in n for n in names)
+
+
+def _check_manual(zip_path):
+    """The zip's manual: every page of docs/ and the README as HTML, a few MB, every link inside it or on the web."""
+    import re
+    import zipfile
+
+    with zipfile.ZipFile(zip_path) as z:
+        manual = {n.removeprefix("manual/"): z.getinfo(n).file_size for n in z.namelist() if n.startswith("manual/")}
+        pages = {n: z.read("manual/" + n).decode("utf-8") for n in manual if n.endswith(".html")}
+    docs = sorted(p.stem for p in (ROOT / "docs").glob("*.md"))
+    assert sorted(n.removesuffix(".html") for n in pages if n != "readme.html") == docs
+    assert "readme.html" in pages and "index.html" in pages
+    assert sum(manual.values()) < 5 * 2**20, f"the manual takes {sum(manual.values()):,} bytes"
+    for name, text in pages.items():
+        for target in re.findall(r'(?:href|src)="([^"]*)"', text):
+            if target.startswith(("https://", "http://", "#")):
+                continue
+            assert target.split("#")[0] in manual, f"{name} links to {target}, which the manual lacks"
 
 
 def test_install_enable_run_uninstall(built_zips, tmp_root):
@@ -141,6 +165,8 @@ def test_install_enable_run_uninstall(built_zips, tmp_root):
     assert proc.returncode == _minimal_extension_exit_code(tmp_root), proc.stdout[-3000:] + proc.stderr[-3000:]
     report = json.loads(lines[-1][len("RESULT"):])
     library = report["results"].pop("library")
+    manual = report["results"].pop("manual")
+    assert manual["exists"] and manual["url"].endswith("/manual/index.html"), manual  # the Manual button, offline
     # the node groups' asset library: one entry, every group in it; the zip's own where this Blender built it
     assert library["entries"] == 1 and library["groups"] == library["expected"] and len(library["groups"]) >= 4
     assert library["uses_shipped"] == library["shipped_here"]
