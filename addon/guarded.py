@@ -24,6 +24,7 @@ import traceback
 
 import bpy
 
+from ..kernels.common import opencl_runtime
 from ..kernels.common.errors import InvalidInputError, TesseraError
 
 #: ID type -> its collection in bpy.data, for removal on rollback.
@@ -157,6 +158,9 @@ def guarded(execute):
             return _failed(self, tx, err)
         if "CANCELLED" in result:
             tx.rollback()
+        notice = opencl_runtime.fallback_notice()  # once: where a window shows it (the status bar)
+        if notice:
+            self.report({"WARNING"}, notice)
         return result
 
     return wrapper

@@ -134,7 +134,7 @@ class Runtime:
 
 
 _settings = _Settings()
-_state = {"resolved": False, "runtime": None, "warned": False}
+_state = {"resolved": False, "runtime": None, "warned": False, "why": "", "told": False}
 _sources = {}
 #: held while the runtime is chosen or the settings change, so a runtime made on one thread (`warm_up`) is never
 #: stored after `configure` has reset the choice on another
@@ -156,7 +156,7 @@ def configure(mode=None, device=None, cache_dir=None):
         raise TesseraError(f"OpenCL mode must be one of {', '.join(MODES)}; got {mode!r}")
     with _choice:
         _settings.mode, _settings.device, _settings.cache_dir = mode, device, cache_dir
-        _state.update(resolved=False, runtime=None, warned=False)
+        _state.update(resolved=False, runtime=None, warned=False, why="", told=False)
 
 
 def current_mode():
@@ -224,6 +224,7 @@ def get_runtime():
                 if mode == "require":
                     raise
                 _state["runtime"] = None
+                _state["why"] = str(err)
                 if not _state["warned"]:
                     _state["warned"] = True
                     warnings.warn(f"Tessera: OpenCL unavailable, using numpy instead. {err}", RuntimeWarning,
@@ -232,6 +233,17 @@ def get_runtime():
         if _state["runtime"] is None and mode == "require":
             raise OpenCLUnavailableError("OpenCL is required (TESSERA_OPENCL=require) but unavailable")
         return _state["runtime"]
+
+
+def fallback_notice():
+    """Once after OpenCL was found missing (when the runtime has been asked for; this never starts it): a sentence for
+    the user's status bar, else "". The console's warning alone goes unseen in a window."""
+    with _choice:
+        if not _state["resolved"] or _state["runtime"] is not None or not _state["why"] or _state["told"]:
+            return ""
+        _state["told"] = True
+        return ("No OpenCL device was found, so Tessera computes with numpy on the CPU (slower; the results are the "
+                "same). Install an OpenCL driver (PoCL for the CPU, or the GPU's), or see the manual's Troubleshooting")
 
 
 def program_names():

@@ -39,6 +39,19 @@ def test_fallback_warns_exactly_once(no_platform):
     assert np.allclose(out, [2.0, 3.0])
 
 
+def test_the_fallback_reaches_the_status_bar_once(no_platform):
+    """`fallback_notice` (what the guarded operators report as a warning): nothing before the runtime is asked for
+    (it never starts OpenCL), one sentence after the fallback, then nothing."""
+    opencl_runtime.configure(mode="1")
+    assert opencl_runtime.fallback_notice() == ""
+    with pytest.warns(RuntimeWarning):
+        opencl_runtime.get_runtime()
+    notice = opencl_runtime.fallback_notice()
+    assert notice.startswith("No OpenCL device was found, so Tessera computes with numpy")
+    assert "Troubleshooting" in notice
+    assert opencl_runtime.fallback_notice() == ""
+
+
 def test_require_mode_raises(no_platform):
     opencl_runtime.configure(mode="require")
     with pytest.raises(OpenCLUnavailableError, match="simulated"):
