@@ -32,7 +32,8 @@ Verbs:
 """
 
 
-def _join(argv):
+def join_parser():
+    """The parser of ``join``."""
     p = verbs._Parser(prog=f"blender -c {COMMAND} join", allow_abbrev=False,
                       description="Join the meshes of several files (.blend or any importable mesh file) into one "
                                   "object, welding the vertices that coincide exactly: the blocks a farm meshed of "
@@ -42,7 +43,11 @@ def _join(argv):
                    help="where to write the joined object: .blend or " + ", ".join(sorted(files.EXPORTERS)))
     p.add_argument("--name", default=None, help="the joined object's name (default: the output's name)")
     p.add_argument("--json", nargs="?", const="-", metavar="FILE", help="print a JSON summary as the last line")
-    args = p.parse_args(argv)
+    return p
+
+
+def _join(argv):
+    args = join_parser().parse_args(argv)
     files.check_output(args.out)
     for path in args.inputs:
         files.check_input(path, {".blend", *files.IMPORTERS})
@@ -68,7 +73,8 @@ def _join(argv):
     return verbs.EXIT_OK
 
 
-def _plan(argv):
+def plan_parser():
+    """The parser of ``plan`` (its own options; the verb's follow it)."""
     p = verbs._Parser(prog=f"blender -c {COMMAND} plan", allow_abbrev=False, add_help=False,
                       description="Print the independent tasks of a job as JSON (or write them to the file given "
                                   "with --json FILE), each a command line for any machine: one per object "
@@ -77,6 +83,11 @@ def _plan(argv):
     p.add_argument("verb", choices=sorted(verbs.VERBS))
     p.add_argument("--blocks", type=plan.blocks_arg, default=(2, 2), metavar="CxR",
                    help="terrain: split into C columns by R rows of tiles (default 2x2)")
+    return p
+
+
+def _plan(argv):
+    p = plan_parser()
     if argv in ([], ["--help"], ["-h"]):
         p.print_help()
         return verbs.EXIT_OK

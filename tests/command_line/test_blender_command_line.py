@@ -341,3 +341,32 @@ def test_a_plan_goes_to_a_file_when_asked(cli, scene, tmp_path):
     tasks = json.loads(to.read_text())["tasks"]
     assert sorted(t["outputs"][0] for t in tasks) == [str(tmp_path / "Cube.ply"), str(tmp_path / "Suzanne.ply")]
     assert all("--json" not in t["argv"] for t in tasks)
+
+
+#: Flags of other programs the docs show: Blender's own, and the bench scripts' (checked in their source).
+BLENDER_FLAGS = {"--command", "--background", "--python", "--python-expr", "--version", "--enable-event-simulate",
+                 "--help"}
+TOOL_FLAGS = {"--run": "tools/bench_report.py", "--full": "bench/terrain.py"}
+
+
+def test_every_flag_the_readme_and_the_docs_name_exists(cli):
+    """A flag named in the README or a docs page is an option of a verb, of join or plan, Blender's own, or a bench
+    script's: a renamed option cannot stay in the manual."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    ours = set()
+    parsers = [cli.verbs.parser_for(v) for v in cli.verbs.VERBS.values()] + [cli.join_parser(), cli.plan_parser()]
+    for parser in parsers:
+        ours |= {flag for action in parser._actions for flag in action.option_strings}
+    for flag, source in TOOL_FLAGS.items():
+        assert f'"{flag}"' in (root / source).read_text(encoding="utf-8"), (flag, source)
+    pages = [root / "README.md", *sorted((root / "docs").glob("*.md"))]
+    unknown = set()
+    for page in pages:
+        for flag in re.findall(r"(?:^|[\s`\"(])(--[a-z][a-z0-9-]+)", page.read_text(encoding="utf-8"), re.MULTILINE):
+            if flag not in ours | BLENDER_FLAGS | set(TOOL_FLAGS):
+                unknown.add((page.name, flag))
+    assert not unknown, f"the docs name flags nothing has: {sorted(unknown)}"
+    assert {"--edge-pixels", "--no-culling", "--blocks", "--name"} <= ours  # the parsers were read
