@@ -25,6 +25,7 @@ from ...kernels.impostors.resample import resample_board
 from .. import render_jobs
 from ..compat import RENDER_STATS_IN_WORKERS
 from ..render_jobs import job_folder, remove_folder, render_device, stop_process, track
+from ..viewport import source_mesh
 
 SCRIPT = Path(__file__).with_name("worker_script.py")
 
@@ -163,9 +164,8 @@ def check_renderable(ob, depsgraph=None):
     """Raise `TesseraError` when ``ob`` would render nothing or garbage: no faces once evaluated (an empty curve, a
     mesh of loose points), or vertices that are not numbers (NaN or infinite), which would fill the images with
     non-finite pixels."""
-    source = ob.evaluated_get(depsgraph or bpy.context.evaluated_depsgraph_get())
+    mesh, release = source_mesh(ob, depsgraph or bpy.context.evaluated_depsgraph_get())  # under a preview too
     try:
-        mesh = source.to_mesh()
         faces = 0 if mesh is None else len(mesh.polygons)
         bad = 0
         if faces:
@@ -173,7 +173,7 @@ def check_renderable(ob, depsgraph=None):
             mesh.vertices.foreach_get("co", pos)
             bad = int((~np.isfinite(pos.reshape(-1, 3))).any(axis=1).sum())
     finally:
-        source.to_mesh_clear()
+        release()
     if not faces:
         raise TesseraError(f"{ob.name!r} has no faces to render (an empty curve or loose points render nothing): "
                            "give it geometry, or pick another object")

@@ -391,3 +391,16 @@ def test_closing_a_workers_leash_ends_it_and_removes_its_folder(addon_module, tm
     render_jobs.remove_folder(folder)
     for pid in worker:
         assert not os.path.exists(f"/proc/{pid}") or "Z" in open(f"/proc/{pid}/stat").read().split()[2]
+
+
+def test_an_object_drawn_by_its_live_board_still_counts_its_faces(clean_scene, bpy_module, addon_module):
+    """Under the preview modifier (what the viewport draws while the board stands for the object: zero-size
+    instances) the object still renders its geometry: it is not refused as having no faces."""
+    bpy = bpy_module
+    worker, viewport = addon_module("addon.impostors.worker"), addon_module("addon.viewport")
+    ob = _box(bpy)
+    mod = ob.modifiers.new(viewport.SOURCE_MODIFIER, "NODES")
+    mod.node_group = viewport._source_group()
+    bpy.context.view_layer.update()
+    assert len(ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh().polygons) == 0  # what is drawn
+    worker.check_renderable(ob)  # what renders: the box
