@@ -400,10 +400,35 @@ def _run_writer(path, writer, target):
     cause = written.cause_in_text(error + captured.text)
     if cause is None and written.disk_full(os.path.dirname(path)):
         cause = written.CAUSES[errno.ENOSPC]
+    if cause is None:  # the writer's own words hide the cause (Blender 4.x's .blend writer says "No such file…")
+        need, free = _needed_bytes(writer, os.path.basename(target)), written.free_bytes(os.path.dirname(path))
+        if need is not None and free is not None and need > free:
+            cause = f"{written.CAUSES[errno.ENOSPC]} (it needs {_megabytes(need)}; {_megabytes(free)} free)"
     if cause is None:
         lines = [ln.strip() for ln in error.splitlines() if ln.strip() and not ln.startswith((" ", "Traceback"))]
         cause = (lines[-1] if lines else "the exporter failed").removeprefix("Error: ")
     raise failed(path, cause)
+
+
+def _needed_bytes(writer, name):
+    """The bytes ``writer`` writes for a file called ``name``, learnt by writing it into memory (a tmpfs,
+    ``/dev/shm``), to tell a full disk behind a writer's unclear failure; None where that cannot be learnt."""
+    import tempfile
+
+    if not os.path.isdir("/dev/shm"):
+        return None
+    try:
+        folder = tempfile.mkdtemp(prefix="tessera-size-", dir="/dev/shm")
+    except OSError:
+        return None
+    try:
+        with _captured_output():
+            writer(os.path.join(folder, name))
+        return sum(os.path.getsize(os.path.join(folder, n)) for n in os.listdir(folder))
+    except (OSError, RuntimeError):  # it fails in memory too (or memory is short): nothing learnt
+        return None
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 class _Captured:

@@ -7,8 +7,8 @@ so every file is checked, as its format allows, before it gets its final name.
   ``.bin`` buffer it names has the byte length it gives;
 - OBJ: the number of ``v`` and ``f`` lines is the number of vertices and faces written (when known), and the file ends
   with a whole line;
-- .blend: an uncompressed one ends with its ``ENDB`` block; a compressed one (zstd, seekable) ends with a seek table
-  whose frames add up to its size;
+- .blend: an uncompressed one ends with its ``ENDB`` block's header, exactly; a compressed one (zstd, seekable) ends
+  with a seek table whose frames add up to its size;
 - every format: a file system left with no free block means the write was cut short.
 
 No Blender imports: the checks read bytes only. `check_written` raises `ShortWrite` with the reason; `os_cause` says
@@ -275,10 +275,13 @@ _SEEK_TABLE = 0x8F92EAB1  # the zstd seekable format's footer (Blender writes co
 
 
 def _blend(f, size, path, expected):
-    head = f.read(7)
-    if head == b"BLENDER":
-        f.seek(max(0, size - 64))
-        if b"ENDB" not in f.read():
+    head = f.read(12)
+    if head.startswith(b"BLENDER"):
+        # the file ends with the ENDB block's header and nothing after it: 32 bytes in the format of Blender 5.0+
+        # ("BLENDER17-…"), else 24 (8-byte pointers, "BLENDER-") or 20 (4-byte pointers, "BLENDER_")
+        last = 32 if head[7:9] == b"17" else 24 if head[7:8] == b"-" else 20
+        f.seek(max(0, size - last))
+        if size < last or f.read(4) != b"ENDB":
             raise ShortWrite("the .blend stops before its last block")
         return
     if not head.startswith(_ZSTD):
