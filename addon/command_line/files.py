@@ -223,6 +223,13 @@ def _writable(folder):
     return written.CAUSES[errno.EACCES]
 
 
+def _nearest_existing(folder):
+    """``folder``, or the nearest folder above it that exists (what a write there will be made in)."""
+    while not os.path.lexists(folder) and os.path.dirname(folder) != folder:
+        folder = os.path.dirname(folder)
+    return folder
+
+
 def probe_output(path):
     """Raise `WriteFailed` when ``path`` cannot be written: it is a folder, a folder on its way is a file, or its
     folder (or the nearest one that exists) is read-only or not ours. Checked before any work, and again at the
@@ -230,9 +237,7 @@ def probe_output(path):
     path = os.path.abspath(path)
     if os.path.isdir(path):
         raise failed(path, written.CAUSES[errno.EISDIR])
-    folder = os.path.dirname(path)
-    while not os.path.lexists(folder) and os.path.dirname(folder) != folder:
-        folder = os.path.dirname(folder)
+    folder = _nearest_existing(os.path.dirname(path))
     if not os.path.isdir(folder):
         raise failed(path, f"{folder} is a file, not a folder")
     why = _writable(folder)
@@ -278,8 +283,9 @@ class Outputs:
         if ext == ".blend":
             return self.write_with(path, lambda p: bpy.ops.wm.save_as_mainfile(filepath=p, copy=True,
                                                                               check_existing=False))
-        _check_space(path, objects, ext)
-        return self.write_with(path, lambda p: _export(p, objects, ext), _expected(objects, ext))
+        counts = _mesh_counts(objects)
+        _check_space(path, counts, ext)
+        return self.write_with(path, lambda p: _export(p, objects, ext), _expected(objects, counts, ext))
 
     def write_with(self, path, writer, expected=None):
         """Call ``writer(partial path)`` to write ``path`` (`write_with`): the final paths."""
@@ -303,38 +309,36 @@ class Outputs:
 _ABORTS_WHEN_FULL = {".abc": 1.25}
 
 
-def _check_space(path, objects, ext):
+def _check_space(path, counts, ext):
     """Refuse, before the exporter runs, an output that cannot fit: the file system has less free space than the least
-    its meshes take (`written.least_size`; more for formats whose exporter aborts on a full disk)."""
-    folder = os.path.dirname(os.path.abspath(path))
-    while not os.path.isdir(folder) and os.path.dirname(folder) != folder:
-        folder = os.path.dirname(folder)
-    free = written.free_bytes(folder)
+    its meshes take (``counts``: `_mesh_counts`; `written.least_size`; more for formats whose exporter aborts on a
+    full disk)."""
+    free = written.free_bytes(_nearest_existing(os.path.dirname(os.path.abspath(path))))
     if free is None:
         return
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    need = 0
-    for ob in objects:
-        if ob.type == "MESH":
-            me = ob.evaluated_get(depsgraph).data
-            need += written.least_size(ext, len(me.vertices), len(me.loops), len(me.polygons))
-    need *= _ABORTS_WHEN_FULL.get(ext, 1.0)
+    need = sum(written.least_size(ext, v, c, f) for v, c, f in counts) * _ABORTS_WHEN_FULL.get(ext, 1.0)
     if need > free:
         raise failed(os.path.abspath(path), f"{written.CAUSES[errno.ENOSPC]} (it needs at least {_megabytes(need)}; "
                                             f"{_megabytes(free)} free)")
+
+
+def _mesh_counts(objects):
+    """(vertices, face corners, faces) of each mesh object of ``objects``, evaluated (as exporters write them)."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    meshes = [ob.evaluated_get(depsgraph).data for ob in objects if ob.type == "MESH"]
+    return [(len(m.vertices), len(m.loops), len(m.polygons)) for m in meshes]
 
 
 def _megabytes(n):
     return f"{n / 1e6:.1f} MB" if n >= 1e5 else f"{n / 1e3:.0f} kB"
 
 
-def _expected(objects, ext):
-    """What an OBJ of ``objects`` holds ({"vertices", "faces"}), when every one is a mesh; else None."""
-    if ext != ".obj" or not objects or any(ob.type != "MESH" for ob in objects):
+def _expected(objects, counts, ext):
+    """What an OBJ of ``objects`` holds ({"vertices", "faces"}; ``counts``: `_mesh_counts`), when every one is a
+    mesh; else None."""
+    if ext != ".obj" or not objects or len(counts) != len(objects):
         return None
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    meshes = [ob.evaluated_get(depsgraph).data for ob in objects]
-    return {"vertices": sum(len(m.vertices) for m in meshes), "faces": sum(len(m.polygons) for m in meshes)}
+    return {"vertices": sum(v for v, _, _ in counts), "faces": sum(f for _, _, f in counts)}
 
 
 def write_with(path, writer, expected=None):

@@ -347,8 +347,7 @@ def finish(args, summary, outputs, t0):
     summary.seconds = round(time.perf_counter() - t0, 3)
     try:
         if args.json not in (None, "-"):
-            text = json.dumps(asdict(summary)) + "\n"
-            files.write_with(args.json, lambda p: _write_text(p, text)).commit()
+            _write_summary(args.json, summary)
     except BaseException:
         summary.ok = False
         raise
@@ -358,20 +357,25 @@ def finish(args, summary, outputs, t0):
         print(json.dumps(asdict(summary)), flush=True)
 
 
-def _write_text(path, text):
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+def _write_summary(path, summary):
+    """The summary as a file, whole or absent (`files.write_with`)."""
+    text = json.dumps(asdict(summary)) + "\n"
+
+    def write(partial):
+        with open(partial, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    files.write_with(path, write).commit()
 
 
 def _summary_out(args, summary):
     """Print or write the summary of a run that failed (best effort: a summary that cannot be written is said)."""
     if not args.json:
         return
-    text = json.dumps(asdict(summary))
     if args.json == "-":
-        print(text, flush=True)
+        print(json.dumps(asdict(summary)), flush=True)
         return
     try:
-        files.write_with(args.json, lambda p: _write_text(p, text + "\n")).commit()
+        _write_summary(args.json, summary)
     except (files.WriteFailed, OSError) as err:
         _say(f"the summary was not written either: {err}")

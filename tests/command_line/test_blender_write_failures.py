@@ -92,11 +92,15 @@ def test_an_output_that_cannot_fit_is_refused_before_the_exporter(blender, spher
     assert left == ["filler"]
 
 
-def test_a_read_only_folder_is_refused_before_any_work(blender, sphere, tmp_path):
+def _read_only(tmp_path):
+    """A folder made read-only in the task's namespace: (the folder, the listing file, the shell lines)."""
     folder = tmp_path / "ro"
     folder.mkdir()
-    listing = tmp_path / "listing.txt"
-    mounts = f"mount --bind {folder} {folder}\nmount -o remount,bind,ro {folder}"
+    return folder, tmp_path / "listing.txt", f"mount --bind {folder} {folder}\nmount -o remount,bind,ro {folder}"
+
+
+def test_a_read_only_folder_is_refused_before_any_work(blender, sphere, tmp_path):
+    folder, listing, mounts = _read_only(tmp_path)
     out = folder / "sphere.ply"
     done = _in_namespace(blender, mounts, folder, listing, "-c", "tessera", "tessellate", sphere, "-o", out)
     said = done.stdout + done.stderr
@@ -107,10 +111,7 @@ def test_a_read_only_folder_is_refused_before_any_work(blender, sphere, tmp_path
 
 
 def test_a_summary_that_cannot_be_written_leaves_the_output_unwritten(blender, sphere, tmp_path):
-    folder = tmp_path / "ro"
-    folder.mkdir()
-    listing = tmp_path / "listing.txt"
-    mounts = f"mount --bind {folder} {folder}\nmount -o remount,bind,ro {folder}"
+    folder, listing, mounts = _read_only(tmp_path)
     out = tmp_path / "sphere.ply"
     done = _in_namespace(blender, mounts, folder, listing, "-c", "tessera", "tessellate", sphere, "-o", out,
                          "--json", folder / "summary.json")
