@@ -104,8 +104,10 @@ def _place(context, ob, geo, report):
     voids = hm.samples.void_count
     what = "none" if not voids else f"{voids:,} samples {'cut out' if hm.samples.cut else 'filled'}"
     (tx, ty), files = geo.texel, len(geo.files)
-    report({"INFO"}, f"GeoTIFF: {files} file{'s' if files > 1 else ''}, {geo.grid.shape[1]:,} x {geo.grid.shape[0]:,} "
-                     f"samples, {tx:.4g} x {ty:.4g} m apart; no-data: {what}")
+    notes = sorted({note for info in geo.files for note in info.notes})
+    report({"INFO"}, f"Elevation data: {files} file{'s' if files > 1 else ''}, {geo.grid.shape[1]:,} x "
+                     f"{geo.grid.shape[0]:,} samples, {tx:.4g} x {ty:.4g} m apart; no-data: {what}"
+                     + "".join(f"; {note}" for note in notes))
 
 
 class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
@@ -116,7 +118,8 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     # the options: TerrainOptions (addon/terrain/settings.py), shared with Object.tessera.terrain
-    filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw", options={"HIDDEN"},
+    filter_glob: bpy.props.StringProperty(default="*.png;*.tif;*.tiff;*.exr;*.r16;*.r32;*.raw;*.hgt;*.asc;*.img;"
+                                                  "*.vrt;*.dem;*.bil;*.flt;*.dt0;*.dt1;*.dt2", options={"HIDDEN"},
                                           description="Files listed")
     # several files picked at once (the adjacent tiles of one elevation model) become one terrain
     files: bpy.props.CollectionProperty(type=bpy.types.OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})

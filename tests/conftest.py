@@ -230,3 +230,16 @@ class Recorder:
 
     def __getattr__(self, name):  # label, separator, template_*, menu, popover ...: nothing to record
         return lambda *args, **kwargs: self._child()
+
+
+@pytest.fixture(params=["gdal", "tiff"])
+def elevation_reader(request, monkeypatch):
+    """Each elevation reader in turn: GDAL (the bundled rasterio), and the TIFF reader a zip falls back to where
+    GDAL does not load (made to believe rasterio is missing)."""
+    from tessera.kernels.terrain import gdal_raster
+
+    if request.param == "gdal":
+        pytest.importorskip("rasterio")
+    else:
+        monkeypatch.setattr(gdal_raster, "why_not", lambda: "rasterio is not installed (a test)")
+    return request.param

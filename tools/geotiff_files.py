@@ -1,5 +1,6 @@
-"""GeoTIFF files for the tests, the bench and the demo, written with tifffile (an independent, well-kept writer):
-known placements, units, no-data values, tiled or striped, compressed."""
+"""Elevation files for the tests, the bench and the demo, from heights the caller knows: GeoTIFFs written with
+tifffile (an independent, well-kept writer; known tags, tiled or striped, compressed) and rasters of every kind
+written by GDAL itself through rasterio (`write_raster`: the files GIS tools give users)."""
 
 import numpy as np
 import tifffile
@@ -41,4 +42,56 @@ def write_geotiff(path, top_first, spacing=(30.0, 30.0), corner=(500000.0, 46000
         kw["predictor"] = predictor
     tifffile.imwrite(path, np.ascontiguousarray(top_first), compression=compression, extratags=extratags,
                      photometric="minisblack", metadata=None, **kw)
+    return path
+
+
+def write_raster(path, top_first, spacing=(30.0, 30.0), corner=(500000.0, 4600000.0), crs="EPSG:32633",
+                 driver="GTiff", nodata=None, scale=None, offset=None, mask=None, units=None, point=False,
+                 transform=None, count=1, **creation):
+    """Write ``top_first`` ((H, W), or (count, H, W)) with GDAL itself (rasterio): any driver GDAL can create or
+    copy to (GTiff, COG, SRTMHGT, AAIGrid, HFA...), a no-data value, the band's ``scale`` and ``offset``, a
+    ``mask`` ((H, W) bool, True valid) as GDAL's internal mask band, the band's ``units``, ``point`` for
+    PixelIsPoint; ``corner`` is the top-left pixel's corner (its sample for ``point``); ``transform`` a
+    rasterio `Affine` instead; ``creation`` GDAL creation options (COMPRESS="ZSTD", TILED=True, BIGTIFF="YES"...)."""
+    import rasterio
+    from rasterio.transform import from_origin
+
+    data = np.asarray(top_first)
+    bands = data if data.ndim == 3 else data[None]
+    if transform is None:
+        x, y = corner
+        if point:  # GDAL stores PixelIsPoint by moving its corner-based transform by half a sample
+            x, y = x - 0.5 * spacing[0], y + 0.5 * spacing[1]
+        transform = from_origin(x, y, spacing[0], spacing[1])
+    profile = dict(width=bands.shape[2], height=bands.shape[1], count=bands.shape[0], dtype=bands.dtype.name,
+                   crs=crs, transform=transform, nodata=nodata, **creation)
+    copy_only = driver not in ("GTiff", "HFA", "ENVI")
+
+    def fill(ds):
+        ds.write(bands)
+        if point:
+            ds.update_tags(AREA_OR_POINT="Point")
+        if scale is not None or offset is not None:
+            ds.scales = (scale or 1.0,) * bands.shape[0]
+            ds.offsets = (offset or 0.0,) * bands.shape[0]
+        if units is not None:
+            ds.units = (units,) * bands.shape[0]
+        if mask is not None:
+            ds.write_mask(np.where(mask, 255, 0).astype(np.uint8))
+
+    with rasterio.Env(GDAL_TIFF_INTERNAL_MASK=True):
+        if not copy_only:
+            with rasterio.open(path, "w", driver=driver, **profile) as ds:
+                fill(ds)
+            return path
+        import rasterio.shutil
+
+        staged = path + ".staging.tif"
+        with rasterio.open(staged, "w", driver="GTiff", **{k: v for k, v in profile.items()
+                                                             if k not in creation}) as ds:
+            fill(ds)
+        try:
+            rasterio.shutil.copy(staged, path, driver=driver, **creation)
+        finally:
+            rasterio.shutil.delete(staged)
     return path

@@ -16,7 +16,7 @@ from ...kernels.terrain import geotiff, heightmap_io
 from ...kernels.terrain.analysis import tile_table
 from .. import bridge
 from ..preferences import get_preferences
-from .settings import is_tiff, source_key
+from .settings import is_elevation_file, source_key
 
 _cache = {}  # object session_uid -> (source key, HeightMap, TileTable, GeoGrid or None)
 #: Scene custom property: the model position (x, y), CRS code and kind (1: geographic) that the scene's origin
@@ -36,15 +36,15 @@ def _unit_metres(scene):
 
 
 def read_source(s, scene=None, progress=None):
-    """``(HeightMap, GeoGrid or None)`` named by terrain settings ``s`` (GeoTIFFs in the units of ``scene``).
-    Raises `TesseraError` with what to fix."""
-    if s.source == "FILE" and s.filepath and s.georeferenced and is_tiff(s.filepath):
+    """``(HeightMap, GeoGrid or None)`` named by terrain settings ``s`` (elevation files in the units of
+    ``scene``). Raises `TesseraError` with what to fix."""
+    if s.source == "FILE" and s.filepath and s.georeferenced and is_elevation_file(s.filepath):
         paths = source_paths(s)
-        if os.path.isfile(paths[0]) and geotiff.read_geoinfo(paths[0]) is not None:
+        if os.path.isfile(paths[0]) and geotiff.read_geoinfo(paths[0], s.band) is not None:
             scene = scene or bpy.context.scene
             hm, geo = geotiff.read_geotiff(paths, voids=s.voids, exaggeration=s.exaggeration,
                                            budget_bytes=get_preferences().memory_budget_bytes,
-                                           unit_metres=_unit_metres(scene), progress=progress)
+                                           unit_metres=_unit_metres(scene), progress=progress, band=s.band)
             return dataclasses.replace(hm, offset=s.height_offset), geo
     return _read_plain(s), None
 

@@ -5,12 +5,14 @@
 import bpy
 
 from ...kernels.common.limits import MAX_FACTOR, MAX_PIXELS, MAX_WORLD_VALUE
+from ...kernels.terrain import geotiff
 from ...kernels.terrain.lod import TerrainLod
 from ..cameras import CAMERA_ITEMS
 from ..viewport import invalidator, with_update
 
 SOURCE_ITEMS = (
-    ("FILE", "File", "GeoTIFF elevation data, PNG/TIFF (8 or 16 bit), EXR/TIFF (float) or raw .r16/.r32 files"),
+    ("FILE", "File", "Elevation data (GeoTIFF, SRTM .hgt, ESRI .asc, ERDAS .img, GDAL .vrt...), PNG/TIFF (8 or 16 "
+                     "bit), EXR/TIFF (float) or raw .r16/.r32 files"),
     ("IMAGE", "Image", "An image in this Blender file (its first channel)"),
 )
 MODE_ITEMS = (
@@ -46,17 +48,22 @@ class TerrainOptions:
     source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE",
                                    description="Read the heights from a file or from an image in this Blender file")
     filepath: bpy.props.StringProperty(name="Height Map", subtype="FILE_PATH",
-                                       description="The height map file (GeoTIFF, PNG, TIFF, EXR, or raw .r16/.r32)")
+                                       description="The height map file (GeoTIFF, .hgt, .asc, .img, .vrt, PNG, TIFF, "
+                                                   "EXR, or raw .r16/.r32)")
     tile_files: bpy.props.StringProperty(name="More Tiles",
-                                         description="Other GeoTIFF files of the same elevation data (adjacent "
+                                         description="Other files of the same elevation data (adjacent "
                                                      "tiles) in the height map's folder, separated by semicolons: "
                                                      "they become one terrain")
     georeferenced: bpy.props.BoolProperty(name="Use Georeferencing", default=True,
-                                          description="For GeoTIFF files: take the texel size, the height units and "
-                                                      "the position from the file (Texel Size and Height Scale are "
-                                                      "then not used)")
+                                          description="For elevation files: take the texel size, the height units "
+                                                      "and the position from the file (Texel Size and Height Scale "
+                                                      "are then not used)")
+    band: bpy.props.IntProperty(name="Band", default=0, min=0, soft_max=16,
+                                description="Which band of the file holds the heights (0: the only one; a picture's "
+                                            "colour bands are not heights)")
     exaggeration: bpy.props.FloatProperty(name="Vertical Exaggeration", default=1.0, min=0.0, max=MAX_FACTOR,
-                                          soft_max=10.0, description="Factor on a GeoTIFF's heights (1: true scale)")
+                                          soft_max=10.0,
+                                          description="Factor on an elevation file's heights (1: true scale)")
     voids: bpy.props.EnumProperty(name="No-Data", items=VOID_ITEMS, default="FILL",
                                   description="What becomes of samples the file marks as having no height "
                                               "(voids, sea)")
@@ -107,7 +114,7 @@ class TerrainOptions:
 TOPIC = "terrain"
 _changed = invalidator(TOPIC)
 TERRAIN_SETTING_NAMES = tuple(TerrainOptions.__annotations__)
-SOURCE_NAMES = ("source", "filepath", "tile_files", "georeferenced", "exaggeration", "voids", "image_name",
+SOURCE_NAMES = ("source", "filepath", "tile_files", "georeferenced", "band", "exaggeration", "voids", "image_name",
                 "raw_width", "raw_height", "texel_size", "height_scale", "height_offset", "tile_size")
 
 
@@ -121,9 +128,9 @@ class TESSERA_PG_terrain(bpy.types.PropertyGroup):
     }
 
 
-def is_tiff(path):
-    """Whether a height-map path names a TIFF (which may carry GeoTIFF tags)."""
-    return path.lower().endswith((".tif", ".tiff"))
+def is_elevation_file(path):
+    """Whether a height-map path names an elevation file (which may carry its placement)."""
+    return geotiff.is_elevation_file(path)
 
 
 def copy_terrain_settings(source, target):
@@ -147,12 +154,14 @@ def draw_terrain_settings(layout, s, show_source=True):
     col = layout.column()
     if show_source:
         col.prop(s, "source")
-        geo = s.source == "FILE" and s.georeferenced and is_tiff(s.filepath)
+        geo = s.source == "FILE" and s.georeferenced and is_elevation_file(s.filepath)
         if s.source == "FILE":
             col.prop(s, "filepath")
-            if is_tiff(s.filepath):
+            if is_elevation_file(s.filepath):
                 col.prop(s, "tile_files")
                 col.prop(s, "georeferenced")
+                if geo:
+                    col.prop(s, "band")
                 col.prop(s, "voids")
             else:
                 sub = col.column(align=True)

@@ -1,17 +1,20 @@
-"""GeoTIFF elevation data (SRTM, Copernicus DEM, USGS 3DEP, national lidar DEMs): placement, units, voids.
+"""Elevation data as GIS tools write it (SRTM, Copernicus DEM, USGS 3DEP, national lidar DEMs): placement, units,
+voids, several files as one grid.
 
-The GeoTIFF tags are read with tifffile [tifffile] (the header only); the samples with OpenImageIO, a block at
-a time (`sample_grid`), so a file of any size is never decoded whole. What is taken from the file:
+Files are read through GDAL (`gdal_raster`: GeoTIFF with every compression, BigTIFF, COG, ``.hgt``, ``.asc``,
+``.img``, ``.vrt``...) where the bundled rasterio imports; where it does not (a platform without a wheel, a broken
+install), GeoTIFFs are read here from their tags with tifffile [tifffile] and their samples with OpenImageIO, a
+block at a time (`sample_grid`), and what only GDAL resolves (a unit named only by an EPSG code this module does
+not list, a mask band) is refused with that reason. What is taken from the file:
 
-- **Placement** (`GeoInfo`): the model coordinates of the first sample's centre and the sample spacing, from
-  ModelPixelScale + ModelTiepoint or from a ModelTransformation without rotation; *PixelIsArea* files (the
-  usual) put a sample at the centre of its pixel, *PixelIsPoint* files on the tie point itself. North must be up:
-  a rotated or sheared transform, or one whose rows run south to north, is refused with the reason.
-- **Units**: horizontal from ProjLinearUnitsGeoKey, vertical from VerticalUnitsGeoKey (metre, foot, US survey
-  foot; metres where the file does not say). Geographic files (degrees) are measured at the data's centre on
-  the WGS 84 ellipsoid (metres per degree east and north).
-- **No-data**: the GDAL_NODATA tag (-32768, -9999, NaN...); NaN samples are voids too. Voids are filled or cut
-  (`void_fill`), never a height.
+- **Placement** (`GeoInfo`): the model coordinates of the first sample's centre and the sample spacing.
+  *PixelIsArea* files (the usual) put a sample at the centre of its pixel, *PixelIsPoint* files on the tie point
+  itself. GDAL warps a rotated, sheared or south-up raster north up; the TIFF reader refuses it with the reason.
+- **Units**: horizontal and vertical from the CRS (metre, foot, US survey foot; metres where the file does not
+  say, noted). Geographic files (degrees) are measured at the data's centre on the WGS 84 ellipsoid.
+- **No-data**: the no-data value (-32768, -9999, the lowest float32, NaN...), the mask band, NaN samples. Voids are
+  filled or cut (`void_fill`), never a height.
+- **Scale and offset** (a sample means ``offset + scale * stored``): applied by the sources.
 
 Several files of one DEM (adjacent tiles, each with its own placement) are laid on one grid when they share the
 sample spacing, the units and the grid: their offsets must be whole samples. Samples no file covers are voids.
@@ -24,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
+from . import gdal_raster
 from .sample_grid import Mosaic, TiffSource, tiff_layout
 
 #: EPSG unit codes (GeoTIFF 1.1, §B.4) -> metres.
@@ -39,7 +43,11 @@ class GeoInfo:
     """One file's placement: ``origin`` (x, y) model coordinates of the centre of the file's top-left sample,
     ``spacing`` (dx, dy) > 0 model units between samples east and south, ``size`` (width, height) in samples,
     ``geographic`` (degrees) or projected, ``metres`` per horizontal model unit (projected files), ``vertical``
-    metres per stored height unit, ``nodata`` (None: none), ``crs`` (EPSG code or 0)."""
+    metres per stored height unit, ``nodata`` (None: none), ``crs`` (EPSG code or 0) and ``crs_text`` (the CRS as
+    GDAL names it; "" for the TIFF reader), ``height_scale`` and ``height_offset`` (a sample means
+    ``offset + scale * stored``; the sources apply them), ``quantum`` the step between heights an integer file can
+    hold (stored units after the scale; 0 for floats), ``band`` (1-based), ``warp`` (read through a north-up warp),
+    ``reader`` ("gdal" or "tiff"), ``notes`` what the reader decided that the user should know."""
 
     path: str
     origin: tuple
@@ -50,6 +58,24 @@ class GeoInfo:
     vertical: float
     nodata: float | None
     crs: int
+    crs_text: str = ""
+    height_scale: float = 1.0
+    height_offset: float = 0.0
+    quantum: float = 0.0
+    band: int = 1
+    warp: bool = False
+    reader: str = "tiff"
+    notes: tuple = ()
+
+
+#: Projected EPSG codes in metres that the TIFF reader knows without GDAL (UTM on WGS 84, NAD83, ETRS89, NAD27;
+#: Web Mercator, LAEA Europe, Lambert-93, British National Grid, GDA94/GDA2020 MGA).
+_METRE_CRS = (*((a, b) for a, b in ((32601, 32660), (32701, 32760), (26901, 26923), (25828, 25838), (26701, 26722),
+                                      (28348, 28358), (7846, 7859))), (3857, 3857), (3035, 3035), (2154, 2154),
+              (27700, 27700))
+#: Vertical EPSG codes -> metres per unit that the TIFF reader knows without GDAL.
+_VERTICAL_CRS = {5703: 1.0, 5773: 1.0, 3855: 1.0, 5701: 1.0, 5714: 1.0, 7837: 1.0, 5783: 1.0, 6360: 1200.0 / 3937.0,
+                 8228: 0.3048}
 
 
 def _key(tags, name):
@@ -57,11 +83,91 @@ def _key(tags, name):
     return None if value is None else int(value)
 
 
-def read_geoinfo(path):
-    """The `GeoInfo` of a GeoTIFF, or None when the TIFF carries no GeoTIFF tags (a plain height-map image).
+def read_geoinfo(path, band=0):
+    """The `GeoInfo` of an elevation raster, or None when the file carries no placement (a plain height-map image).
 
-    Raises `InvalidInputError` naming the file for what cannot be placed: a rotated transform, south-up rows,
-    a tie point without a pixel scale, unknown units."""
+    Read through GDAL where the bundled rasterio imports (every format GDAL reads), otherwise from the TIFF tags.
+    ``band``: 0 picks the height band (a picture's colour bands are refused), N the N-th. Raises
+    `InvalidInputError` naming the file and the reason for what cannot be read or placed."""
+    if gdal_raster.available():
+        return _gdal_geoinfo(path, band)
+    if not is_tiff(path):
+        raise InvalidInputError(f"{os.path.basename(path)}: this Tessera reads only GeoTIFF files, because GDAL "
+                                f"(rasterio) is not available on this system ({gdal_raster.why_not()})")
+    return _tiff_geoinfo(path)
+
+
+def is_tiff(path):
+    """Whether ``path`` names a TIFF by its extension."""
+    return path.lower().endswith((".tif", ".tiff"))
+
+
+#: Extensions of the elevation files read with their placement: GeoTIFF, SRTM tiles, ESRI ASCII and binary grids,
+#: ERDAS Imagine, GDAL virtual mosaics, USGS DEM, DTED. (GDAL reads more; these are the ones the file browser lists.)
+ELEVATION_EXTENSIONS = (".tif", ".tiff", ".hgt", ".asc", ".img", ".vrt", ".dem", ".bil", ".flt", ".dt0", ".dt1",
+                        ".dt2")
+
+
+def is_elevation_file(path):
+    """Whether ``path`` names a file that may carry a placement (a GeoTIFF or another elevation format)."""
+    return path.lower().endswith(ELEVATION_EXTENSIONS)
+
+
+def _gdal_geoinfo(path, band):
+    name = os.path.basename(path)
+    ds, band, warped, notes = gdal_raster.open_dataset(path, band)
+    try:
+        src = warped or ds
+        if src.transform.is_identity:
+            return None
+        t = src.transform
+        if not (np.isfinite([t.a, t.e, t.c, t.f]).all() and t.a > 0 and t.e < 0):
+            raise InvalidInputError(f"{name} has an unusable sample spacing ({t.a!r}, {-t.e!r})")
+        if src.crs is None:
+            geographic, metres, code, text = False, 1.0, 0, ""
+            notes.append("no coordinate system: positions read as metres")
+        else:
+            geographic, metres, code = gdal_raster.horizontal(src, name)
+            text = src.crs.to_string()
+        vertical, stated = gdal_raster.vertical_metres(ds, band, name)
+        if not stated:
+            notes.append("heights read as metres (the file names no vertical unit)")
+        dtype = np.dtype(ds.dtypes[band - 1])
+        scale, offset = float(ds.scales[band - 1] or 1.0), float(ds.offsets[band - 1] or 0.0)
+        if scale != 1.0 or offset != 0.0:
+            notes.append(f"stored values x {scale:g} + {offset:g}")
+        x0, y0 = t.c + 0.5 * t.a, t.f + 0.5 * t.e  # GDAL gives pixel corners for PixelIsPoint files too
+        nodata = ds.nodatavals[band - 1]
+        return GeoInfo(path, (float(x0), float(y0)), (float(t.a), float(-t.e)), (src.width, src.height), geographic,
+                       metres, vertical, None if nodata is None else float(nodata), code, text, scale, offset,
+                       abs(scale) if dtype.kind in "iu" else 0.0, band, warped is not None, "gdal", tuple(notes))
+    finally:
+        gdal_raster.close(ds, warped)
+
+
+def _gdal_metadata_scale(page):
+    """(scale, offset) of band 0 from the GDAL_METADATA tag (42112, XML), (1, 0) where it says none."""
+    import xml.etree.ElementTree as ET
+
+    tag = page.tags.get(42112)
+    found = {"scale": 1.0, "offset": 0.0}
+    if tag is not None:
+        try:
+            items = ET.fromstring(str(tag.value)).iter("Item")
+        except ET.ParseError:
+            items = ()
+        for item in items:
+            role = (item.get("role") or "").lower()
+            if role in found and item.get("sample", "0") == "0":
+                try:
+                    found[role] = float(item.text)
+                except (TypeError, ValueError):
+                    raise InvalidInputError(f"{os.path.basename(page.parent.filehandle.path)} has a band {role} "
+                                            f"that is not a number: {item.text!r}") from None
+    return found["scale"], found["offset"]
+
+
+def _tiff_geoinfo(path):
     name = os.path.basename(path)
     try:
         import tifffile
@@ -71,12 +177,19 @@ def read_geoinfo(path):
         with tifffile.TiffFile(path) as tf:
             page = tf.pages.first
             tags = page.geotiff_tags or {}
-            nodata = page.nodata if 42113 in page.tags else None
+            # tifffile drops a no-data value at the edge of float32 (GDAL's -3.4028234663852886e+38) as 0
+            nodata = page.tags[42113].value if 42113 in page.tags else None
             width, height = int(page.imagewidth), int(page.imagelength)
+            integer = page.dtype is not None and np.dtype(page.dtype).kind in "iu"
+            masked = any(int(p.subfiletype) & 4 for p in tf.pages[1:])
+            band_scale, band_offset = _gdal_metadata_scale(page)
     except (tifffile.TiffFileError, OSError, ValueError, IndexError, KeyError) as err:
         raise InvalidInputError(f"{name} is not a TIFF file that can be read: {err}") from err
     if not tags:
         return None
+    if masked:
+        raise InvalidInputError(f"{name} marks its voids with a mask band, which Tessera reads only through GDAL, "
+                                f"not available on this system ({gdal_raster.why_not()})")
     scale, tie, matrix = tags.get("ModelPixelScale"), tags.get("ModelTiepoint"), tags.get("ModelTransformation")
     if tie is not None:  # tifffile gives one tie point flat, several as a list of six-value lists
         tie = np.asarray(tie, np.float64).ravel()
@@ -105,6 +218,10 @@ def read_geoinfo(path):
         x0, y0 = x0 + 0.5 * dx, y0 - 0.5 * dy
     geographic = _key(tags, "GTModelTypeGeoKey") == 2
     unit = _key(tags, "ProjLinearUnitsGeoKey")
+    crs = _key(tags, "GeographicTypeGeoKey" if geographic else "ProjectedCSTypeGeoKey") or 0
+    if not geographic and unit is None and crs and not any(a <= crs <= b for a, b in _METRE_CRS):
+        raise InvalidInputError(f"{name} names its unit only through EPSG code {crs}, which Tessera resolves only "
+                                f"through GDAL, not available on this system ({gdal_raster.why_not()})")
     if not geographic and unit is not None and unit not in LINEAR_UNITS:
         raise InvalidInputError(f"{name} gives its positions in unit code {unit}, which Tessera does not know "
                                 "(metre, foot, US survey foot, kilometre, nautical mile)")
@@ -112,13 +229,31 @@ def read_geoinfo(path):
     if geographic and angular not in (None, 9102):
         raise InvalidInputError(f"{name} gives its angles in unit code {angular}; Tessera reads degrees (9102)")
     vertical = _key(tags, "VerticalUnitsGeoKey")
-    if vertical is not None and vertical not in LINEAR_UNITS:
+    vertical_crs = _key(tags, "VerticalCSTypeGeoKey")
+    notes = []
+    if vertical is None and vertical_crs is not None:
+        if vertical_crs not in _VERTICAL_CRS:
+            raise InvalidInputError(f"{name} names its height unit only through EPSG code {vertical_crs}, which "
+                                    "Tessera resolves only through GDAL, not available on this system "
+                                    f"({gdal_raster.why_not()})")
+        vertical_metres = _VERTICAL_CRS[vertical_crs]
+    elif vertical is not None and vertical not in LINEAR_UNITS:
         raise InvalidInputError(f"{name} gives its heights in unit code {vertical}, which Tessera does not know "
                                 "(metre, foot, US survey foot)")
-    crs = _key(tags, "GeographicTypeGeoKey" if geographic else "ProjectedCSTypeGeoKey") or 0
-    nodata = None if nodata is None else float(nodata)
+    else:
+        vertical_metres = LINEAR_UNITS.get(vertical, 1.0)
+        if vertical is None:
+            notes.append("heights read as metres (the file names no vertical unit)")
+    if nodata is not None:
+        try:
+            nodata = float(str(nodata).strip().rstrip("\x00"))
+        except ValueError as err:
+            raise InvalidInputError(f"{name} has a no-data value that is not a number: {nodata!r}") from err
+    if band_scale != 1.0 or band_offset != 0.0:
+        notes.append(f"stored values x {band_scale:g} + {band_offset:g}")
     return GeoInfo(path, (float(x0), float(y0)), (float(dx), float(dy)), (width, height), geographic,
-                   LINEAR_UNITS.get(unit, 1.0), LINEAR_UNITS.get(vertical, 1.0), nodata, crs)
+                   LINEAR_UNITS.get(unit, 1.0), vertical_metres, nodata, crs, "", band_scale, band_offset,
+                   abs(band_scale) if integer else 0.0, 1, False, "tiff", tuple(notes))
 
 
 def metres_per_unit(info, latitude=None):
@@ -153,26 +288,27 @@ class GeoGrid:
         return (self.origin[0] + 0.5 * (w - 1) * self.spacing[0], self.origin[1] - 0.5 * (h - 1) * self.spacing[1])
 
 
-def open_geotiffs(paths):
-    """Lay the GeoTIFFs ``paths`` on one grid: a `GeoGrid`. Files that are not GeoTIFFs, or that do not share
-    one grid (spacing, units, CRS, whole-sample offsets), are refused with the file's name and the reason."""
+def open_geotiffs(paths, band=0):
+    """Lay the elevation files ``paths`` on one grid: a `GeoGrid`. Files without a placement, or that do not share
+    one grid (spacing, units, CRS, whole-sample offsets), are refused with the file's name and the reason.
+    ``band``: see `read_geoinfo`."""
     infos = []
     for path in sorted(paths):
         if not os.path.isfile(path):
             raise InvalidInputError(f"No such elevation file: {path}")
-        info = read_geoinfo(path)
+        info = read_geoinfo(path, band)
         if info is None:
-            raise InvalidInputError(f"{os.path.basename(path)} has no GeoTIFF tags (no placement); load it as a "
-                                    "height-map image and give its Texel Size")
+            raise InvalidInputError(f"{os.path.basename(path)} has no placement (no GeoTIFF tags or geotransform); "
+                                    "load it as a height-map image and give its Texel Size")
         infos.append(info)
     if not infos:
         raise InvalidInputError("Choose at least one GeoTIFF file")
     first = infos[0]
     for info in infos[1:]:
         name = os.path.basename(info.path)
-        for what, a, b in (("CRS", info.crs, first.crs), ("geographic or projected kind", info.geographic,
-                                                          first.geographic), ("units", info.metres, first.metres),
-                           ("height units", info.vertical, first.vertical)):
+        for what, a, b in (("CRS", info.crs, first.crs), ("CRS", info.crs_text, first.crs_text),
+                           ("geographic or projected kind", info.geographic, first.geographic),
+                           ("units", info.metres, first.metres), ("height units", info.vertical, first.vertical)):
             if a != b:
                 raise InvalidInputError(f"{name} and {os.path.basename(first.path)} differ in {what} ({a} and {b}): "
                                         "files of one terrain must share one grid")
@@ -195,11 +331,7 @@ def open_geotiffs(paths):
     height = max(r + i.size[1] for (_, r), i in zip(offsets, infos, strict=True)) - r0
     placements = []
     for (c, r), info in zip(offsets, infos, strict=True):
-        layout = tiff_layout(info.path)
-        if (layout.width, layout.height) != info.size:
-            raise InvalidInputError(f"{os.path.basename(info.path)}: OpenImageIO and the TIFF header disagree on "
-                                    "its size (a damaged file)")
-        placements.append((TiffSource(info.path, layout, info.nodata), c - c0, r - r0))
+        placements.append((_source(info), c - c0, r - r0))
     origin = (first.origin[0] + c0 * dx, first.origin[1] - r0 * dy)
     grid = Mosaic(placements, width, height)
     centre_lat = origin[1] - 0.5 * (height - 1) * dy
@@ -210,15 +342,26 @@ def open_geotiffs(paths):
     return GeoGrid(grid, origin, (dx, dy), (dx * mx, dy * my), first.vertical, tuple(infos))
 
 
-def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_metres=1.0, progress=None):
+def _source(info):
+    """The block reader of one file's samples (file order, voids NaN, scale and offset applied)."""
+    if info.reader == "gdal":
+        return gdal_raster.GdalSource(info.path, info.band, info.warp, (info.size[1], info.size[0]))
+    layout = tiff_layout(info.path)
+    if (layout.width, layout.height) != info.size:
+        raise InvalidInputError(f"{os.path.basename(info.path)}: OpenImageIO and the TIFF header disagree on "
+                                "its size (a damaged file)")
+    return TiffSource(info.path, layout, info.nodata, info.height_scale, info.height_offset)
+
+
+def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_metres=1.0, progress=None, band=0):
     """A terrain `HeightMap` from GeoTIFFs ``paths`` (one DEM, one file or several adjacent ones) and its
     `GeoGrid`: ``(hm, geo)``.
 
     voids: "FILL" (filled from their valid neighbours) or "HOLES" (filled for the analysis, cut from the mesh);
     budget_bytes: the memory budget the void windows must fit; exaggeration: a factor on the heights; unit_metres:
     metres per world unit (Blender's Unit Scale), so texels and heights come out in scene units;
-    progress(done, total): the void scan's bands. Heights are ``exaggeration * vertical / unit_metres * sample``:
-    a valid sample keeps its value exactly when the factor is 1."""
+    progress(done, total): the void scan's bands; band: see `read_geoinfo`. Heights are
+    ``exaggeration * vertical / unit_metres * sample``: a valid sample keeps its value exactly when the factor is 1."""
     from .heightmap_io import HeightMap
     from .void_fill import FilledGrid
 
@@ -226,7 +369,7 @@ def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_met
         raise InvalidInputError(f"Voids must be FILL or HOLES; got {voids!r}")
     if not (np.isfinite(unit_metres) and unit_metres > 0):
         raise InvalidInputError(f"The unit scale must be positive; got {unit_metres!r}")
-    geo = open_geotiffs(paths)
+    geo = open_geotiffs(paths, band)
     names = ", ".join(os.path.basename(i.path) for i in geo.files)
     filled = FilledGrid(geo.grid, cut=voids == "HOLES", budget_bytes=budget_bytes, name=names, progress=progress)
     tx, ty = (t / unit_metres for t in geo.texel)

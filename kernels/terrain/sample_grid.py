@@ -91,11 +91,13 @@ def tiff_layout(path):
 class TiffSource:
     """One TIFF image's first channel, decoded a block of rows at a time (file order: row 0 at the top).
 
-    ``nodata``: the file's no-data value (None: none); its samples, and NaN, read as NaN.
+    ``nodata``: the file's no-data value (None: none); its samples, and NaN, read as NaN. ``scale``, ``offset``:
+    a sample means ``offset + scale * stored`` (GDAL's band scale and offset).
     """
 
-    def __init__(self, path, layout, nodata=None):
+    def __init__(self, path, layout, nodata=None, scale=1.0, offset=0.0):
         self.path, self.layout, self.nodata = path, layout, nodata
+        self.scale, self.offset = float(scale), float(offset)
         self._cache = OrderedDict()  # block index -> (rows, W) float32
         self._keep = max(2, CACHE_BYTES // max(1, layout.block_rows * layout.width * 4))
 
@@ -140,9 +142,12 @@ class TiffSource:
         void = ~np.isfinite(out)
         if self.nodata is not None and np.isfinite(self.nodata):
             if raw.dtype.kind not in "iu":
-                void |= out == np.float32(self.nodata)
+                with np.errstate(over="ignore"):  # the lowest float32, as GDAL writes it, compared as float32
+                    void |= raw == raw.dtype.type(self.nodata)
             elif float(self.nodata).is_integer() and np.iinfo(raw.dtype).min <= self.nodata <= np.iinfo(raw.dtype).max:
                 void |= raw == raw.dtype.type(int(self.nodata))  # compared as stored, not after rounding
+        if self.scale != 1.0 or self.offset != 0.0:
+            out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
         out[void] = np.nan
         return out
 

@@ -90,14 +90,44 @@ def test_voids_fill_or_cut_and_survive_save_and_reload(scene, tmp_path):
 def test_bad_geotiffs_are_refused_by_name_and_change_nothing(scene, tmp_path):
     bpy = scene
     top = _dem(40, 50)
-    rotated = np.array([[2.0, 0.5, 0, 100.0], [0.5, -2.0, 0, 900.0], [0, 0, 0, 0], [0, 0, 0, 1]])
-    bad = write_geotiff(str(tmp_path / "rotated.tif"), top, transform=rotated)
+    (tmp_path / "junk.asc").write_text("ncols 3\nnrows\n")
     empty = write_geotiff(str(tmp_path / "empty.tif"), np.full_like(top, NODATA), nodata=NODATA)
     n_objects, n_meshes = len(bpy.data.objects), len(bpy.data.meshes)
-    for path, words in ((bad, "rotated.tif.*rotated"), (empty, "empty.tif.*no-data")):
+    for path, words in ((str(tmp_path / "junk.asc"), "junk.asc"), (empty, "empty.tif.*no-data")):
         with pytest.raises(RuntimeError, match=words):
             bpy.ops.tessera.terrain_add(filepath=path)
     with pytest.raises(RuntimeError, match="No such elevation file"):
         bpy.ops.tessera.terrain_add(filepath=write_geotiff(str(tmp_path / "ok.tif"), top), tile_files="missing.tif")
     assert len(bpy.data.objects) == n_objects and len(bpy.data.meshes) == n_meshes
     assert "tessera_geo_origin" not in bpy.context.scene
+
+
+def test_elevation_files_that_are_not_geotiff_and_a_picture_band(scene, tmp_path):
+    """An ESRI ASCII grid with voids cut out and an ERDAS Imagine file become terrains at their true scale; a
+    picture (RGB bytes) is refused by name until its Band is chosen."""
+    pytest.importorskip("rasterio")
+    from tessera.tools.geotiff_files import write_raster
+
+    bpy = scene
+    top = _dem(41, 49).astype(np.float32)  # 48 x 40 texels: whole tiles of 8 (Uniform is then every sample)
+    void = np.zeros(top.shape, bool)
+    void[10:15, 20:30] = True
+    asc = write_raster(str(tmp_path / "dem.asc"), np.where(void, -9999.0, top).astype(np.float32), nodata=-9999.0,
+                       driver="AAIGrid", spacing=(5.0, 5.0), corner=(0.0, 200.0))
+    add_camera(bpy, (0, -300, 300))
+    ob = _add(bpy, asc, voids="HOLES", tile_size=8)
+    pos, tris = mesh_tris(ob.data)
+    assert np.ptp(pos[:, 0]) == 240.0 and np.ptp(pos[:, 1]) == 200.0
+    assert set(np.round(pos[:, 2], 3)) <= set(np.round(top[~void], 3))  # every vertex a written height
+    assert len(pos) == top.size - void.sum()  # the void's samples cut out
+    img = write_raster(str(tmp_path / "dem.img"), top, driver="HFA", spacing=(2.0, 2.0))
+    pos, _ = mesh_tris(_add(bpy, img, tile_size=8).data)
+    assert np.ptp(pos[:, 0]) == 96.0 and np.array_equal(np.sort(pos[:, 2]), np.sort(top.ravel()))
+    rgb = np.stack([np.clip(top / 4, 0, 255).astype(np.uint8)] * 3)
+    photo = write_raster(str(tmp_path / "photo.tif"), rgb, PHOTOMETRIC="RGB")
+    n_objects = len(bpy.data.objects)
+    with pytest.raises(RuntimeError, match=r"photo\.tif is a picture.*Band"):
+        bpy.ops.tessera.terrain_add(filepath=photo)
+    assert len(bpy.data.objects) == n_objects
+    ob = _add(bpy, photo, band=2, tile_size=8)
+    assert ob.tessera.terrain.band == 2 and len(ob.data.vertices) == top.size

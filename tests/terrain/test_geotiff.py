@@ -8,10 +8,10 @@ import pytest
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import BudgetError, InvalidInputError
 from tessera.kernels.terrain import analysis as ta
+from tessera.kernels.terrain import gdal_raster, sample_grid, void_fill
 from tessera.kernels.terrain import geotiff as gt
 from tessera.kernels.terrain import lod as tl
 from tessera.kernels.terrain import mesh as tm
-from tessera.kernels.terrain import sample_grid, void_fill
 from tessera.kernels.terrain.synth import ridged_terrain
 from tessera.tools.geotiff_files import write_geotiff
 from test_terrain_lod import _random_camera
@@ -34,7 +34,7 @@ def _with_voids(top_first, fill):
 
 @pytest.mark.parametrize("dtype, layout", [("float32", "tiled"), ("int16", "tiled"), ("float32", "strips"),
                                            ("int16", "strips"), ("int16", "predictor")])
-def test_placement_texels_and_every_valid_height_exact(tmp_path, dtype, layout):
+def test_placement_texels_and_every_valid_height_exact(tmp_path, dtype, layout, elevation_reader):
     top = _dem()
     data = top.astype(np.int16) if dtype == "int16" else top
     tile = (64, 32) if layout == "tiled" else None
@@ -52,7 +52,7 @@ def test_placement_texels_and_every_valid_height_exact(tmp_path, dtype, layout):
     assert np.array_equal(hm.sample(xs.astype(float), ys.astype(float)), want[ys, xs])
 
 
-def test_units_point_rasters_transforms_and_geographic_spacing(tmp_path):
+def test_units_point_rasters_transforms_and_geographic_spacing(tmp_path, elevation_reader):
     top = _dem(60, 80)
     feet = write_geotiff(str(tmp_path / "feet.tif"), top, spacing=(3.0, 3.0), linear=9002, vertical=9002, point=True,
                          corner=(1000.0, 2000.0))
@@ -100,7 +100,7 @@ def test_cells_are_labelled_by_8_connected_components():
 
 
 @pytest.mark.parametrize("dtype, fill", [("int16", NODATA), ("float32", -9999.0), ("float32", "nan")])
-def test_voids_never_become_heights(tmp_path, dtype, fill):
+def test_voids_never_become_heights(tmp_path, dtype, fill, elevation_reader):
     top = _dem()
     value = np.nan if fill == "nan" else fill
     data = _with_voids(top, value).astype(dtype)
@@ -146,7 +146,7 @@ def test_holes_cut_exactly_the_triangles_on_voids_from_random_cameras(tmp_path):
 
 
 @pytest.mark.parametrize("overlap", [0, 1])
-def test_a_dem_split_over_four_files_is_the_single_file_bit_for_bit(tmp_path, overlap):
+def test_a_dem_split_over_four_files_is_the_single_file_bit_for_bit(tmp_path, overlap, elevation_reader):
     """Adjacent tiles, with or without SRTM's shared border row and column; a void crosses the split."""
     top = _with_voids(_dem(), NODATA).astype(np.int16)
     top[95:110, 140:170] = NODATA  # across the four-way corner
@@ -169,7 +169,7 @@ def test_a_dem_split_over_four_files_is_the_single_file_bit_for_bit(tmp_path, ov
         assert m1.positions.tobytes() == m4.positions.tobytes() and np.array_equal(m1.triangles, m4.triangles)
 
 
-def test_a_gap_between_files_is_a_void(tmp_path):
+def test_a_gap_between_files_is_a_void(tmp_path, elevation_reader):
     top = _dem(64, 64)
     a = write_geotiff(str(tmp_path / "a.tif"), top[:, :20], corner=(0.0, 640.0), spacing=(10.0, 10.0))
     b = write_geotiff(str(tmp_path / "b.tif"), top[:, 40:], corner=(400.0, 640.0), spacing=(10.0, 10.0))
@@ -178,11 +178,12 @@ def test_a_gap_between_files_is_a_void(tmp_path):
     assert hm.void_at(np.array([30.0, 5.0]), np.array([10.0, 10.0])).tolist() == [True, False]
 
 
-def test_out_of_core_analysis_keeps_its_memory_bounded(tmp_path, monkeypatch):
+def test_out_of_core_analysis_keeps_its_memory_bounded(tmp_path, monkeypatch, elevation_reader):
     """A 1025 x 16385 float32 map (64 MiB as float32) is scanned and analysed with at most a tenth of that
     allocated: the memory follows the width (a few bands and two decoded blocks), not the size."""
     w, h = 1025, 16385
     monkeypatch.setattr(sample_grid, "CACHE_BYTES", 2**20)
+    monkeypatch.setattr(gdal_raster, "CACHE_BYTES", 2**20)
     block = ridged_terrain(w, seed=4, octaves=5) * 900.0
     heights = np.concatenate([block, block[::-1]] * 8)[:h]
     heights[2000:2040, 100:180] = np.nan
@@ -199,7 +200,9 @@ def test_out_of_core_analysis_keeps_its_memory_bounded(tmp_path, monkeypatch):
     assert peak < w * h * 4 / 10, f"peak {peak / 2**20:.1f} MiB"
 
 
-def test_bad_geotiffs_are_refused_with_the_file_and_the_reason(tmp_path):
+def test_bad_geotiffs_are_refused_with_the_file_and_the_reason(tmp_path, monkeypatch):
+    """The TIFF reader's refusals (GDAL's, and the rasters it warps instead, are in test_gdal_rasters.py)."""
+    monkeypatch.setattr(gdal_raster, "why_not", lambda: "rasterio is not installed (a test)")
     top = _dem(40, 50)
 
     def refused(path, *words, **kw):
@@ -246,7 +249,7 @@ def test_bad_geotiffs_are_refused_with_the_file_and_the_reason(tmp_path):
         gt.read_geotiff([a, c])
 
 
-def test_a_void_too_large_for_the_budget_is_refused_with_the_numbers(tmp_path):
+def test_a_void_too_large_for_the_budget_is_refused_with_the_numbers(tmp_path, elevation_reader):
     top = _dem(256, 256)
     top[10:240, 10:240] = NODATA
     path = write_geotiff(str(tmp_path / "sea.tif"), top.astype(np.int16), nodata=NODATA)
