@@ -1,11 +1,12 @@
 """Build the Tessera extension zips with Blender's own builder, one per platform, wheels bundled.
 
 Steps: validate the source manifest (tags checked against Blender's list); download the wheels of pyopencl and its
-pure-Python needs, of tifffile (GeoTIFF tags) and of psutil (free memory), for each platform and for each Python the
-supported Blenders use (3.11 for 4.2-5.0, 3.13 for 5.1 and 5.2, 3.14 for the distributions' builds), at the versions
-installed in this venv (the ones the tests ran with); stage a copy of the tree whose manifest lists them, with the
-node-group asset library written into it by this venv's Blender and the manual as HTML (`manual.py`); build with
-``blender_ext.py build --split-platforms``; validate each zip.
+pure-Python needs, of rasterio (GDAL and PROJ, for elevation files) and its pure-Python needs, of tifffile (GeoTIFF tags
+where GDAL does not load) and of psutil (free memory), for each platform and for each Python the supported Blenders
+use (3.11 for 4.2-5.0, 3.13 for 5.1 and 5.2, 3.14 for the distributions' builds), at the versions the tests ran with
+(this venv's; the 3.11 Blenders' requirements file for 3.11, where a package pins another version); stage a copy of
+the tree whose manifest lists them, with the node-group asset library written into it by this venv's Blender and the
+manual as HTML (`manual.py`); build with ``blender_ext.py build --split-platforms``; validate each zip.
 Blender installs the wheels that match its own Python. numpy is not bundled: Blender ships it.
 
 Usage: python tools/build_extension.py [--out dist] [--wheels wheels]
@@ -31,8 +32,11 @@ PLATFORMS = {
     "macos-arm64": ["macosx_15_0_arm64"],
     "macos-x64": ["macosx_15_0_x86_64"],
 }
-BINARY = ("pyopencl", "siphash24", "psutil")
-PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl", "tifffile")
+BINARY = ("pyopencl", "siphash24", "psutil", "rasterio")
+PURE = ("pytools", "platformdirs", "typing_extensions", "threadpoolctl", "tifffile", "affine", "attrs", "certifi",
+        "click")
+#: The requirements file of each Python's Blenders, for a version other than this venv's (rasterio 1.5 needs 3.12).
+REQUIREMENTS = {"3.11": ROOT / "requirements" / "blender-5.0.txt"}
 #: The Pythons of the supported Blenders: 4.2, 4.5 and 5.0 use 3.11; 5.1 and 5.2 use 3.13; the distributions' builds
 #: of them (Debian, Ubuntu, Fedora, Arch, NixOS) run the system's Python, 3.14 today.
 PYTHONS = ("3.11", "3.13", "3.14")
@@ -56,6 +60,17 @@ def pip_download(spec, dest, platforms=None, python=None):
     subprocess.run(cmd + [spec], check=True)
 
 
+def pinned(name, python):
+    """The version of ``name`` for ``python``: its pin in that Python's requirements file, else this venv's."""
+    path = REQUIREMENTS.get(python)
+    if path is not None:
+        for line in path.read_text(encoding="utf-8").splitlines():
+            spec = line.split("#")[0].strip()
+            if spec.lower().startswith(name.lower() + "=="):
+                return spec.split("==", 1)[1]
+    return metadata.version(name)
+
+
 def fetch_wheels(dest):
     """Download every needed wheel into ``dest``; returns the file names, sorted."""
     dest.mkdir(parents=True, exist_ok=True)
@@ -65,7 +80,7 @@ def fetch_wheels(dest):
         for python in PYTHONS:
             for name in BINARY:
                 try:
-                    pip_download(f"{name}=={metadata.version(name)}", dest, tags, python)
+                    pip_download(f"{name}=={pinned(name, python)}", dest, tags, python)
                 except subprocess.CalledProcessError as err:
                     raise SystemExit(f"No {name} wheel for {platform} (Python {python}); the zip cannot be "
                                      "built") from err

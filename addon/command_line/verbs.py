@@ -55,7 +55,8 @@ VERBS = {v.name: v for v in (
          frozenset({"SURFACE"}), frozenset({"SURFACE"})),
     Verb("impostors", "tessera.impostor_bake", "Render objects from many directions with Cycles onto impostor cards",
          _GEOMETRY, _GEOMETRY, outputs=(".blend", ".glb")),
-    Verb("terrain", "tessera.terrain_add", "Mesh height maps and GeoTIFF elevation data for the scene camera"),
+    Verb("terrain", "tessera.terrain_add",
+         "Mesh height maps and elevation files (GeoTIFF, .hgt, .asc, .img, .vrt) for the scene camera"),
 )}
 _TERRAIN_BAKE = Verb("terrain", "tessera.terrain_bake", "Mesh a terrain again for the camera")
 #: Operator options the command line sets itself or that need a window.
@@ -265,7 +266,7 @@ def run_terrain(verb, args, summary, outputs):
     frames = terrain_frames(args)
     _check_outputs(verb, args, 1)
     if not maps:
-        raise Usage("Give a height map (PNG, TIFF/GeoTIFF, EXR, .r16/.r32/.raw)")
+        raise Usage("Give a height map (PNG, TIFF/GeoTIFF, .hgt, .asc, .img, .vrt, EXR, .r16/.r32/.raw)")
     if "block" in kwargs:  # checked before anything is read
         try:
             block_tiles(kwargs["block"], (1, 1))

@@ -12,6 +12,12 @@ Tiles split the sample grid into squares of ``tile_size`` intervals; tile (ty, t
 tile table holds, per tile, the HAM maximum, the height range and the position of the highest sample (the
 first in row-major order among equals), [Nunes 2011]'s RGBA tile texture plus ``h_min`` for culling.
 
+Integer elevation data (whole metres, decimetres) is stored in steps of a quantum q: its rounding error is at most q
+in range, which |Sobel| turns into at most 4·sqrt(2)·q of slope and, through the second pass, at most 64·q of HAM
+(texel units). Terraces that rounding made can therefore never raise the HAM by more than 64·q, and the tile table
+discounts exactly that (`quantisation_floor`): a whole-metre DEM of a smooth slope is as smooth as the same slope
+stored as float, never rougher. The mesh keeps the file's values at its samples.
+
 Everything runs on bands of tile rows, so a memory-mapped map of any size is analysed with memory bounded
 by a few bands (`tile_table`), and an edit re-analyses only the tiles it can reach (`update_tiles`).
 """
@@ -25,6 +31,9 @@ from ..common.opencl_runtime import backend_runtime
 
 #: HAM rows at the border of an edit that change: the two Sobel passes each reach one sample.
 HAM_REACH = 2
+#: The most HAM (texel units) a rounding error of one quantum can make: |Sobel| of an error within [0, q] is at most
+#: 4·sqrt(2)·q, and |Sobel| of an error within a range of 8·sqrt(2)·q at most 4·sqrt(2)·8·sqrt(2)·q = 64·q.
+HAM_PER_QUANTUM = 64.0
 #: A map read from disk (memory-mapped, or block by block) goes to the device whole only up to this many bytes of
 #: float32; larger ones stay in bands on the host, so the analysis of any size keeps its memory bound.
 OUT_OF_CORE_DEVICE_BYTES = 64 * 2**20
@@ -152,6 +161,18 @@ def _fill_row(table, ty, tx0, tx1, ham_band, h_band, y0):
     table.peak_x[sl] = np.arange(tx0, tx1) * ts + arg % (ts + 1)
 
 
+def quantisation_floor(hm):
+    """The HAM (texel units) that rounding to ``hm.quantum`` can make on its own: float (0 for continuous data)."""
+    return HAM_PER_QUANTUM * float(getattr(hm, "quantum", 0.0)) / hm.mean_texel
+
+
+def _discount(table, hm, sl=(slice(None), slice(None))):
+    """Take the quantisation floor off tiles ``sl``'s HAM maxima (max(HAM - f) = max(HAM) - f, so per tile)."""
+    floor = quantisation_floor(hm)
+    if floor > 0:
+        table.ham_max[sl] = np.maximum(table.ham_max[sl] - np.float32(floor), 0)
+
+
 def tile_table(hm, tile_size=64, backend="auto", progress=None):
     """Analyse a `heightmap_io.HeightMap` into a `TileTable`.
 
@@ -167,10 +188,12 @@ def tile_table(hm, tile_size=64, backend="auto", progress=None):
         from .opencl_path import analyse_on_device
 
         analyse_on_device(runtime, hm, table)
+        _discount(table, hm)
         if progress is not None:
             progress(nty, nty)
         return table
     _analyse(table, hm, 0, nty, 0, ntx, progress)
+    _discount(table, hm)
     return table
 
 
@@ -198,5 +221,6 @@ def update_tiles(table, hm, region):
     tx0, ty0 = max(0, (gx0 - 1) // ts), max(0, (gy0 - 1) // ts)
     tx1, ty1 = min(ntx, gx1 // ts + 1), min(nty, gy1 // ts + 1)
     _analyse(table, hm, ty0, ty1, tx0, tx1)
+    _discount(table, hm, (slice(ty0, ty1), slice(tx0, tx1)))
     table.derived.clear()
     return tx0, ty0, tx1, ty1

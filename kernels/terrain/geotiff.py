@@ -374,6 +374,8 @@ def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_met
     filled = FilledGrid(geo.grid, cut=voids == "HOLES", budget_bytes=budget_bytes, name=names, progress=progress)
     tx, ty = (t / unit_metres for t in geo.texel)
     same = abs(tx - ty) <= GRID_TOLERANCE * tx
-    hm = HeightMap(filled, texel_size=tx, texel_size_y=0.0 if same else ty,
-                   scale=exaggeration * geo.vertical / unit_metres, source=names)
+    scale = exaggeration * geo.vertical / unit_metres
+    quantum = max(info.quantum for info in geo.files) * abs(scale)  # integer files: their step, in world units
+    hm = HeightMap(filled, texel_size=tx, texel_size_y=0.0 if same else ty, scale=scale, source=names,
+                   quantum=quantum)
     return hm, geo

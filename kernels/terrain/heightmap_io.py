@@ -38,6 +38,9 @@ class HeightMap:
     block by block: a GeoTIFF, its voids filled); row 0 at the bottom.
     texel_size: world distance between neighbouring samples along x (> 0); texel_size_y: along y (0: the same;
     geographic data has longer rows than columns away from the equator). scale, offset: see the module docstring.
+    quantum: the world height between neighbouring values the file could store (an integer DEM's step: 1 m for
+    whole metres), 0 for continuous data; the roughness analysis discounts what that rounding can fake
+    (`analysis.quantisation_floor`).
     """
 
     samples: np.ndarray
@@ -46,6 +49,7 @@ class HeightMap:
     offset: float = 0.0
     source: str = ""
     texel_size_y: float = 0.0
+    quantum: float = 0.0
 
     def __post_init__(self):
         s = self.samples
@@ -60,6 +64,8 @@ class HeightMap:
             if not (np.isfinite(value) and abs(value) <= MAX_WORLD_VALUE):
                 raise InvalidInputError(f"{label} must be a finite number between {-MAX_WORLD_VALUE:g} and "
                                         f"{MAX_WORLD_VALUE:g}; got {value!r}")
+        if not (np.isfinite(self.quantum) and 0 <= self.quantum <= MAX_WORLD_VALUE):
+            raise InvalidInputError(f"The height step must be a finite number >= 0; got {self.quantum!r}")
         if not (self.texel_size > 0 and self.texel_size_y >= 0):
             raise InvalidInputError(f"The texel size must be positive; got {self.texel_size!r}")
 
