@@ -2,9 +2,9 @@
 
 The height map goes up once as an R32F texture (at most `MAX_TEXTURE` texels a side: larger maps are
 strided for the preview). Per view, `TerrainDrawData.set_selection` uploads 48 bytes per visible tile (its
-rectangle and levels) into one texture per pattern class; each class's pattern (`kernels.terrain.mesh`) is
-drawn instanced, one instance per tile, and the vertex shader places and displaces its vertices with the
-same partition as the numpy bake, so shared edges produce the same vertices from both tiles.
+rectangle, edge levels and inner levels along x and y) into one texture per pattern class; each class's pattern
+(`kernels.terrain.mesh`) is drawn instanced, one instance per tile, and the vertex shader places and displaces its
+vertices with the same partition as the numpy bake, so shared edges produce the same vertices from both tiles.
 """
 
 import numpy as np
@@ -22,7 +22,7 @@ MAX_TEXTURE = 8192
 def _describe():
     info = shaded_create_info("terrain", "partition.glsl", "terrain/terrain_vert.glsl")
     info.push_constant("VEC4", "edge_counts")
-    info.push_constant("FLOAT", "inner_count")
+    info.push_constant("VEC2", "inner_counts")
     info.push_constant("VEC4", "grid")
     info.push_constant("FLOAT", "height_stride")
     info.push_constant("INT", "tex_width")
@@ -63,12 +63,12 @@ class TerrainDrawData:
         sp = selection.spacing
         h, v = clamp_levels(selection.h_edges, sp), clamp_levels(selection.v_edges, sp)
         levels = np.stack([h[:-1], v[:, 1:], h[1:], v[:, :-1]], -1).reshape(-1, 4).astype(np.float32)
-        inner = clamp_levels(selection.inner, sp).ravel().astype(np.float32)
+        inner = np.stack([clamp_levels(level, sp).ravel() for level in selection.inner_levels], -1).astype(np.float32)
         self.fractional = sp == "FRACTIONAL_EVEN"
         self.buckets, self.tile_bytes = {}, 0
         for key, tiles in pattern_classes(selection).items():
             rows = np.zeros((len(tiles), 3, 4), np.float32)
-            rows[:, 0], rows[:, 1], rows[:, 2, 0] = self.rects[tiles], levels[tiles], inner[tiles]
+            rows[:, 0], rows[:, 1], rows[:, 2, :2] = self.rects[tiles], levels[tiles], inner[tiles]
             self.buckets[key] = (rgba_texture(rows.reshape(-1, 4)), len(tiles))
             self.tile_bytes += rows.nbytes
 
@@ -86,6 +86,6 @@ class TerrainDrawData:
         shader.uniform_sampler("heights", self.heights)
         for key, (texture, count) in self.buckets.items():
             shader.uniform_float("edge_counts", tuple(float(c) for c in key[:4]))
-            shader.uniform_float("inner_count", float(key[4]))
+            shader.uniform_float("inner_counts", (float(key[4]), float(key[5])))
             shader.uniform_sampler("tiles", texture)
             _pattern_batch(shader, key, wireframe).draw_instanced(shader, instance_start=0, instance_count=count)

@@ -1,7 +1,7 @@
 /* Terrain preview ([Nunes 2011, §5.6], without a tessellation stage): one instanced pattern per tile class
- * (four edge segment counts `edge_counts` and the inner count `inner_count`), one instance per tile.
- * Instance t reads texels 3t..3t+2 of `tiles`: (x0, y0, x1, y1) in samples, the four edge levels, (inner
- * level, 0, 0, 0). Pattern vertex `code` = (kind, a, b): 0 corner (a, b); 1-4 point a of side BOTTOM, RIGHT,
+ * (four edge segment counts `edge_counts` and the inner counts along x and y `inner_counts`), one instance per
+ * tile. Instance t reads texels 3t..3t+2 of `tiles`: (x0, y0, x1, y1) in samples, the four edge levels, (inner
+ * level along x, along y, 0, 0). Pattern vertex `code` = (kind, a, b): 0 corner (a, b); 1-4 point a of side BOTTOM, RIGHT,
  * TOP, LEFT; 5 inner grid point (a, b). Heights are sampled bilinearly from `heights` (R32F, one texel per
  * sample, `height_stride` samples per texel) in the vertex shader. `param` is partition.glsl. */
 
@@ -26,7 +26,7 @@ void main()
 {
   vec4 rect = fetch_tile(3 * gl_InstanceID);
   vec4 lev = fetch_tile(3 * gl_InstanceID + 1);
-  float f_in = fetch_tile(3 * gl_InstanceID + 2).x;
+  vec2 f_in = fetch_tile(3 * gl_InstanceID + 2).xy;
   bool frac = fractional != 0;
   int kind = int(code.x);
   vec2 uv;
@@ -46,7 +46,7 @@ void main()
     uv = vec2(0.0, param(lev.w, edge_counts.w, code.y, frac));
   }
   else {
-    uv = vec2(param(f_in, inner_count, code.y, frac), param(f_in, inner_count, code.z, frac));
+    uv = vec2(param(f_in.x, inner_counts.x, code.y, frac), param(f_in.y, inner_counts.y, code.z, frac));
   }
   vec2 s = rect.xy + uv * (rect.zw - rect.xy);
   float z = height_at(s);

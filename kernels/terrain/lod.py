@@ -78,9 +78,10 @@ class TerrainLod:
 
 @dataclass
 class Selection:
-    """Levels for one camera. Per tile (nty, ntx): t_max, t_min, inner (float64), culled (bool); ``edge``
+    """Levels for one camera. Per tile (nty, ntx): t_max, t_min, inner (float64: along x), culled (bool); ``edge``
     (nty, ntx, 4) as each tile computed its own sides (BOTTOM, RIGHT, TOP, LEFT). Shared per edge:
-    h_edges (nty + 1, ntx) and v_edges (nty, ntx + 1) (rounded levels, what the mesh uses)."""
+    h_edges (nty + 1, ntx) and v_edges (nty, ntx + 1) (rounded levels, what the mesh uses). ``inner_y``: the inner
+    level along y where it differs (a partial tile longer one way than the other; None: ``inner``)."""
 
     t_max: np.ndarray
     t_min: np.ndarray
@@ -90,10 +91,17 @@ class Selection:
     h_edges: np.ndarray
     v_edges: np.ndarray
     spacing: str
+    inner_y: np.ndarray | None = None
+
+    @property
+    def inner_levels(self):
+        """Inner levels along x and along y: two (nty, ntx) float64."""
+        return self.inner, self.inner if self.inner_y is None else self.inner_y
 
     @property
     def inner_counts(self):
-        return segment_counts(self.inner, self.spacing)
+        """Inner segment counts along x and along y: two (nty, ntx) int."""
+        return tuple(segment_counts(level, self.spacing) for level in self.inner_levels)
 
 
 def to_world(hm, x, y, z):
@@ -337,6 +345,8 @@ def select(hm, table, camera, settings=TerrainLod()):
     ts = table.tile_size
     # "a quad always covers a texel" ([Nunes 2011] §5.4.2): no level above the tile's size in texels
     settings = replace(settings, max_level=min(settings.max_level, ts))
+    if settings.mode == "UNIFORM":  # the top level everywhere, whole: one quad per texel, partial tiles included
+        settings = replace(settings, levels="INTEGER")
     xb = tile_bounds(np.arange(ntx), ts, hm.width)
     yb = tile_bounds(np.arange(nty), ts, hm.height)
     xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
@@ -372,11 +382,14 @@ def select(hm, table, camera, settings=TerrainLod()):
         culled = _culled(hm, table, camera, xs, ys)
     else:
         culled = np.zeros((nty, ntx), bool)
-    # a side's level at most its length in texels, the inner level at most the shorter side: the tiles of a
-    # map smaller than one tile (or the last, partial row and column) never outgrow their full grid
+    # a level at most its length in texels, per side and per axis inside: the tiles of a map smaller than one tile
+    # (or the last, partial row and column) never outgrow their full grid, and reach it at the top level
     wx, wy = x1 - x0, y1 - y0
     rounded = np.minimum(_round(edge, settings), _cap(np.stack([wx, wy, wx, wy], -1), settings.spacing))
-    inner = np.minimum(_round(inner, settings), _cap(np.minimum(wx, wy), settings.spacing))
+    inner = _round(inner, settings)
+    inner_x = np.minimum(inner, _cap(wx, settings.spacing))
+    inner_y = np.minimum(inner, _cap(wy, settings.spacing))
     h_edges = np.concatenate([rounded[:, :, 0], rounded[-1:, :, 2]], axis=0)
     v_edges = np.concatenate([rounded[:, :, 3], rounded[:, -1:, 1]], axis=1)
-    return Selection(t_max, t_min, edge, inner, culled, h_edges, v_edges, settings.spacing)
+    return Selection(t_max, t_min, edge, inner_x, culled, h_edges, v_edges, settings.spacing,
+                     None if np.array_equal(inner_x, inner_y) else inner_y)

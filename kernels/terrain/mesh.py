@@ -1,14 +1,15 @@
 """Crack-free terrain mesh from per-tile levels (a `terrain_lod.Selection`): welded, one pattern per class.
 
-Each tile is a quad domain with four edge segment counts and one inner count (from `partition`). Its pattern:
-an inner grid of ``n - 1`` × ``n - 1`` points, each cell split along its (i, j)-(i+1, j+1) diagonal, and
-four strips that zip the edge points to the grid's outer ring (a monotone merge of two parallel rows of
-points). A tile whose inner count is 1 and whose two opposite sides have one segment each (every tile one texel
-thick, since levels never exceed a side's length in texels) is one strip zipping its two other sides (two
-triangles when all four sides have one segment); otherwise the inner count is at least 2, so a ring exists.
-With `terrain_lod.select`'s caps (a side's level at most its length in texels, the inner level at most the
-shorter side) a tile never has more triangles than its full grid (EQUAL spacing; FRACTIONAL_EVEN needs two
-segments on a side one texel long).
+Each tile is a quad domain with four edge segment counts and an inner count along x and along y (from `partition`;
+the two differ only where a partial tile is longer one way). Its pattern: an inner grid of ``m - 1`` rows of
+``n - 1`` points, each cell split along its (i, j)-(i+1, j+1) diagonal, and four strips that zip the edge points to
+the grid's outer ring (a monotone merge of two parallel rows of points). A tile whose inner count across is 1 and
+whose two opposite sides have one segment each (a tile one texel thick, since levels never exceed a length in
+texels) is one strip zipping its two other sides (two triangles when all four sides have one segment); otherwise
+both inner counts are at least 2, so a ring exists. With `terrain_lod.select`'s caps (a side's level at most its
+length in texels, the inner level along each axis at most the tile's length along it) a tile never has more
+triangles than its full grid, and at the top level it is its full grid: every sample a vertex (EQUAL spacing;
+FRACTIONAL_EVEN needs two segments on a side one texel long).
 
 Vertices are welded by construction: a tile corner is one vertex for four tiles, an edge point one vertex
 for its two tiles (edges run +x or +y, so both tiles read the same points), inner points belong to their
@@ -40,27 +41,30 @@ class TerrainMesh:
 
 
 def _tile_counts(selection):
-    """Edge segment counts (nty, ntx, 4) and the inner counts the patterns use (nty, ntx)."""
+    """Edge segment counts (nty, ntx, 4) and the inner counts the patterns use along x and y: two (nty, ntx)."""
     sp = selection.spacing
     hc, vc = segment_counts(selection.h_edges, sp), segment_counts(selection.v_edges, sp)
     ec = np.stack([hc[:-1], vc[:, 1:], hc[1:], vc[:, :-1]], -1)  # per tile: BOTTOM, RIGHT, TOP, LEFT
-    n = selection.inner_counts.astype(np.int64)
-    strip = ((ec[..., 1] == 1) & (ec[..., 3] == 1)) | ((ec[..., 0] == 1) & (ec[..., 2] == 1))
-    return ec, np.where((n == 1) & ~strip, 2, n)
+    n, m = (c.astype(np.int64) for c in selection.inner_counts)
+    # the patterns' strips (no inner grid): along x when the left and right sides are one segment and m is 1,
+    # along y when the bottom and top are and n is 1; any other count of 1 becomes 2 (a ring must exist)
+    strip = (((ec[..., 1] == 1) & (ec[..., 3] == 1) & (m == 1)) | ((ec[..., 0] == 1) & (ec[..., 2] == 1) & (n == 1)))
+    return ec, np.where((n == 1) & ~strip, 2, n), np.where((m == 1) & ~strip, 2, m)
 
 
 def triangle_count(selection):
     """Triangles `bake` will make, without making them (for memory guards and benchmarks): int."""
-    ec, n = _tile_counts(selection)
-    m = n - 1
-    per_tile = np.where(m == 0, ec.sum(-1) - 2, ec.sum(-1) + 4 * (m - 1) + 2 * (m - 1) ** 2)
+    ec, n, m = _tile_counts(selection)
+    strip = (n == 1) | (m == 1)
+    ring = ec.sum(-1) + 2 * (n - 2) + 2 * (m - 2) + 2 * (n - 2) * (m - 2)
+    per_tile = np.where(strip, ec.sum(-1) - 2, ring)
     return int(per_tile[~selection.culled].sum())
 
 
 def pattern_classes(selection):
-    """Tiles grouped by pattern: dict (c0, c1, c2, c3, n) -> visible tile indices (row-major) int64."""
-    ec, n = _tile_counts(selection)
-    keys = np.concatenate([ec.reshape(-1, 4), n.reshape(-1, 1)], 1)
+    """Tiles grouped by pattern: dict (c0, c1, c2, c3, n, m) -> visible tile indices (row-major) int64."""
+    ec, n, m = _tile_counts(selection)
+    keys = np.concatenate([ec.reshape(-1, 4), n.reshape(-1, 1), m.reshape(-1, 1)], 1)
     visible = np.nonzero(~selection.culled.ravel())[0]
     classes, inverse = np.unique(keys[visible], axis=0, return_inverse=True)
     inverse = inverse.ravel()
@@ -91,20 +95,21 @@ def bake(hm, table, selection):
     corners = np.stack([gx.ravel(), gy.ravel()], 1)  # (nty + 1) * (ntx + 1), row-major
     hc, hf, hxy = _edge_points(selection.h_edges, spacing, gy[:, :-1], gx[:, :-1], gx[:, 1:], True)
     vc, vf, vxy = _edge_points(selection.v_edges, spacing, gx[:-1, :], gy[:-1, :], gy[1:, :], False)
-    _, n = _tile_counts(selection)
-    f_in = clamp_levels(selection.inner, spacing)  # EQUAL spacing ignores it; a forced 2 stays exact
-    # inner grid points per tile, row-major, (n - 1)² each
-    m = (n - 1).ravel()
-    inner_first = np.concatenate([[0], np.cumsum(m * m)])[:-1]
-    tile = np.repeat(np.arange(m.size), m * m)
+    _, n, m = _tile_counts(selection)
+    # EQUAL spacing ignores the levels; a forced 2 stays exact
+    f_x, f_y = (clamp_levels(level, spacing) for level in selection.inner_levels)
+    # inner grid points per tile, row-major, (m - 1) rows of (n - 1)
+    nx, ny = (n - 1).ravel(), (m - 1).ravel()
+    per_tile = nx * ny
+    inner_first = np.concatenate([[0], np.cumsum(per_tile)])[:-1]
+    tile = np.repeat(np.arange(per_tile.size), per_tile)
     local = np.arange(tile.size) - inner_first[tile]
-    mm = np.maximum(m[tile], 1)
-    i, j = local % mm + 1, local // mm + 1
-    ff, nn = f_in.ravel()[tile], n.ravel()[tile]
-    ti, tj = point_params(ff, nn, i, spacing), point_params(ff, nn, j, spacing)
+    row = np.maximum(nx[tile], 1)
+    i, j = local % row + 1, local // row + 1
+    ti = point_params(f_x.ravel()[tile], n.ravel()[tile], i, spacing)
+    tj = point_params(f_y.ravel()[tile], m.ravel()[tile], j, spacing)
     tx, ty = tile % ntx, tile // ntx
     ixy = np.stack([xb[tx] + ti * (xb[tx + 1] - xb[tx]), yb[ty] + tj * (yb[ty + 1] - yb[ty])], 1)
-
     n_c, n_h = corners.shape[0], hxy.shape[0]
     base_in = n_c + n_h + vxy.shape[0]
     samples = np.concatenate([corners, hxy, vxy, ixy])
@@ -118,9 +123,8 @@ def bake(hm, table, selection):
         starts = (n_c + hf[tyi, txi], n_c + n_h + vf[tyi, txi + 1], n_c + hf[tyi + 1, txi], n_c + n_h + vf[tyi, txi])
         for s in range(4):
             cols += [starts[s] + q for q in range(c[s] - 1)]
-        mloc = key[4] - 1
-        if mloc > 0:
-            cols += [base_in + inner_first[tiles] + q for q in range(mloc * mloc)]
+        inner_points = (key[4] - 1) * (key[5] - 1)
+        cols += [base_in + inner_first[tiles] + q for q in range(inner_points)]
         lmap = np.stack(cols, 1)
         tri_parts.append(lmap[:, tmpl].reshape(-1, 3))
     tris = np.concatenate(tri_parts) if tri_parts else np.zeros((0, 3), np.int64)

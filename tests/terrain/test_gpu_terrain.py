@@ -8,8 +8,10 @@ pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 
 
 def terrain(addon_module, size=193):
+    """``size`` rows of ``size - 8`` samples: with tiles of 32, the last column of tiles is 24 texels wide (partial
+    tiles, whose inner grids are longer along y than along x at the top levels)."""
     hio = addon_module("kernels.terrain.heightmap_io")
-    y, x = np.mgrid[0:size, 0:size] / (size - 1)
+    y, x = np.mgrid[0:size, 0:size - 8] / (size - 1)
     h = 25 * np.sin(7 * x) * np.cos(5 * y) + 12 * np.sin(19 * x * y)
     h[(x - 0.6) ** 2 + (y - 0.4) ** 2 < 0.02] += 18.0  # a mesa with cliffs
     h[:, : size // 5] = 0.0
@@ -34,11 +36,13 @@ def cameras(Camera, rng, n):
                                 height=200, far=2000)
 
 
-@pytest.mark.parametrize("levels", ["POW2", "FRACTIONAL"])
-def test_preview_draws_the_baked_mesh(gpu_renderer, addon_module, levels):
+@pytest.mark.parametrize("levels, mode", [("POW2", "OURS"), ("FRACTIONAL", "OURS"), ("INTEGER", "UNIFORM")])
+def test_preview_draws_the_baked_mesh(gpu_renderer, addon_module, levels, mode):
     tl, tm, offscreen, Camera, hm, table, data = _scene(addon_module)
     for cam in cameras(Camera, np.random.default_rng(2), 3):
-        sel = tl.select(hm, table, cam, tl.TerrainLod(levels=levels))
+        sel = tl.select(hm, table, cam, tl.TerrainLod(levels=levels, mode=mode))
+        if mode == "UNIFORM":
+            assert sel.inner_y is not None  # the partial tiles' rectangular inner grids are drawn
         mesh = tm.bake(hm, table, sel)
         vp = cam.projection @ cam.view
         cpu = offscreen.render_triangles(mesh.positions, mesh.triangles, vp, size=(200, 200), color=(1, 1, 1, 1),

@@ -261,7 +261,8 @@ def test_bad_settings_are_refused():
         tl.select(_terrain(size=129), table, Camera.looking_at((0, -9, 9), (0, 0, 0)))
 
 
-@pytest.mark.parametrize("size, tile", [((7, 5), 64), ((2, 2), 16), ((66, 3), 64), ((40, 97), 32), ((33, 65), 8)])
+@pytest.mark.parametrize("size, tile", [((7, 5), 64), ((2, 2), 16), ((66, 3), 64), ((40, 97), 32), ((33, 65), 8),
+                                        ((257, 201), 64)])
 @pytest.mark.parametrize("mode, levels", [("UNIFORM", "INTEGER"), ("OURS", "POW2"), ("DISTANCE", "FRACTIONAL")])
 def test_a_mesh_never_outgrows_its_full_grid(size, tile, mode, levels):
     """Tiles larger than the map, and the last partial row and column (one texel thick included), get no more
@@ -278,7 +279,7 @@ def test_a_mesh_never_outgrows_its_full_grid(size, tile, mode, levels):
     thin = 1 in ((w - 1) % tile, (h - 1) % tile, w - 1, h - 1)  # a side one texel long
     if levels != "FRACTIONAL" or not thin:  # fractional-even spacing has two segments at least
         assert len(mesh.triangles) <= len(full.triangles)
-    if mode == "UNIFORM" and (w - 1) % tile == (h - 1) % tile == 0:  # square tiles: an n x n inner grid fits
+    if mode == "UNIFORM":  # partial tiles too: their inner grid is as long as they are along each axis
         assert len(mesh.triangles) == len(full.triangles)
         assert np.array_equal(np.unique(mesh.samples, axis=0), np.unique(full.samples, axis=0))
     boundary, counts = _boundary_edges(mesh.triangles)

@@ -23,8 +23,8 @@ step() { name=$1; shift; "$@" >"$out/$name.log" 2>&1; echo $? >"$out/$name.rc"; 
 step install blender --command extension install-file -r user_default -e "$out/$ZIP"
 ls "$ext/.local/lib/"python3*/site-packages >"$out/site_installed.txt" 2>&1
 step tessellate blender --command tessera tessellate --level 2 -o "$out/cube.ply" --json "$out/summary.json"
-step terrain blender --command tessera terrain "$out/dem.asc" --mode uniform --tile-size 8 --no-culling -o "$out/dem.ply" \
-  --json "$out/terrain.json"
+step terrain blender --command tessera terrain "$out/dem.asc" --mode uniform --tile-size 8 --no-culling \
+  -o "$out/dem.ply" --json "$out/terrain.json"
 step opencl blender --background --python-expr "
 import importlib, json, sys
 rt = importlib.import_module('bl_ext.user_default.tessera.kernels.common.opencl_runtime').get_runtime()
