@@ -5,6 +5,11 @@
   needs no decoding), same run: wall time of each and their ratio, peak Python-side allocation (tracemalloc)
   against the size of the map as float32 (1 GiB: what a reader that decodes the whole file, as BlenderGIS does,
   holds at least), and the files' sizes.
+- ``gdal_reader``: the same GeoTIFF read through GDAL (the bundled rasterio, the default) against the TIFF reader
+  (tifffile tags, OpenImageIO blocks: the reader before GDAL and the fallback where it does not load), each read and
+  analysed in a fresh process, same run: wall time of each and their ratio, the peak resident memory's growth over
+  the process's memory before the read (GDAL allocates outside Python, so tracemalloc cannot see it), and whether
+  the two tile tables are identical.
 - ``geotiff_split``: the same DEM cut into four files (adjacent tiles) read as one terrain, against the single file:
   time ratio and whether the tile tables are identical.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/geotiff.py
@@ -14,6 +19,8 @@ import atexit
 import json
 import os
 import shutil
+import subprocess
+import sys
 import tempfile
 import time
 import tracemalloc
@@ -82,6 +89,50 @@ def measured(fn):
     return out, dt, peak
 
 
+def _status_kib(field):
+    """A ``/proc/self/status`` memory field (VmRSS, VmHWM) in KiB."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    raise RuntimeError(f"no {field} in /proc/self/status")
+
+
+def child(reader, path, out):
+    """Read and analyse ``path`` with ``reader`` ("gdal" or "tiff") in this fresh process; the figures and the tile
+    table into ``out`` (.npz)."""
+    from tessera.kernels.terrain import gdal_raster
+
+    if reader == "tiff":
+        gdal_raster.why_not = lambda: "the bench's TIFF reader run"
+    else:
+        assert gdal_raster.available(), gdal_raster.why_not()
+    before = _status_kib("VmRSS")
+    t = time.perf_counter()
+    hm, geo = gt.read_geotiff([path])
+    table = tile_table(hm, 64, backend="numpy")
+    dt = time.perf_counter() - t
+    assert geo.files[0].reader == reader
+    np.savez(out, ham_max=table.ham_max, h_min=table.h_min, h_max=table.h_max, seconds=dt,
+             growth_mib=(_status_kib("VmHWM") - before) / 1024)
+
+
+def compare_readers(folder, geo):
+    runs = {}
+    for reader in ("gdal", "tiff"):
+        out = os.path.join(folder, f"{reader}.npz")
+        subprocess.run([sys.executable, __file__, "--child", reader, geo, out], check=True)
+        runs[reader] = np.load(out)
+    g, t = runs["gdal"], runs["tiff"]
+    same = all(np.array_equal(g[k], t[k]) for k in ("ham_max", "h_min", "h_max"))
+    print(json.dumps({"case": "gdal_reader", "map": f"{SIZE}x{SIZE} float32, tiles {TILE}², deflate",
+                      "gdal_s": round(float(g["seconds"]), 2), "tiff_reader_s": round(float(t["seconds"]), 2),
+                      "time_ratio": round(float(g["seconds"] / t["seconds"]), 2),
+                      "gdal_rss_growth_mib": round(float(g["growth_mib"]), 1),
+                      "tiff_reader_rss_growth_mib": round(float(t["growth_mib"]), 1),
+                      "identical_tables": same}), flush=True)
+
+
 def main():
     folder = tempfile.mkdtemp(prefix="tessera-geotiff-")
     atexit.register(shutil.rmtree, folder, ignore_errors=True)
@@ -105,6 +156,7 @@ def main():
                       "geotiff_peak_mib": round(peak_geo / 2**20, 1), "raw_peak_mib": round(peak_raw / 2**20, 1),
                       "finite_tiles": bool(np.isfinite(table.h_min).all())}), flush=True)
     os.unlink(raw)
+    compare_readers(folder, geo)
 
     # four adjacent files of a 4097² DEM against the single file
     part = rows_of(tile, 0, 4097, 0, 4097)
@@ -123,4 +175,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:2] == ["--child"]:
+        child(*sys.argv[2:5])
+    else:
+        main()

@@ -79,6 +79,7 @@ def _rasterio():
 
             set_gdal_config("GDAL_CACHEMAX", GDAL_CACHE_BYTES)  # bytes (rasterio calls GDALSetCacheMax64)
             set_gdal_config("GDAL_DISABLE_READDIR_ON_OPEN", "EMPTY_DIR")  # no folder listing per open
+            set_gdal_config("GDAL_NUM_THREADS", "ALL_CPUS")  # a band of tiles decompressed on every core
             _configured = True
     return rasterio
 
@@ -297,14 +298,16 @@ class GdalSource:
         except RasterioError as err:
             raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {os.path.basename(self.path)} failed: "
                                     f"{_gdal_words(err)}") from err
-        void = _nodata_mask(raw, self.nodata)
+        nan_nodata = self.nodata is not None and math.isnan(self.nodata)
+        void = np.zeros(raw.shape, bool) if nan_nodata else _nodata_mask(raw, self.nodata)  # NaN: isfinite below
         if mask is not None:
             void |= mask == 0
         if self.scale != 1.0 or self.offset != 0.0:
             out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
         else:
-            out = raw.astype(np.float32)
-        void |= ~np.isfinite(out)
+            out = raw if raw.dtype == np.float32 else raw.astype(np.float32)  # a fresh array either way
+        if out.dtype.kind == "f" and (raw.dtype.kind == "f" or self.scale != 1.0 or self.offset != 0.0):
+            void |= ~np.isfinite(out)
         out[void] = np.nan
         return out
 
