@@ -15,7 +15,7 @@ import time
 import bpy
 
 from ...kernels.common.errors import TesseraError
-from . import files, join, plan, stopping, verbs
+from . import files, join, plan, schedulers, stopping, verbs
 
 COMMAND = "tessera"
 _handles = []
@@ -43,11 +43,17 @@ def join_parser():
                    help="where to write the joined object: .blend or " + ", ".join(sorted(files.EXPORTERS)))
     p.add_argument("--name", default=None, help="the joined object's name (default: the output's name)")
     p.add_argument("--json", nargs="?", const="-", metavar="FILE", help="print a JSON summary as the last line")
+    p.add_argument("--frame", type=int, default=None, metavar="N",
+                   help="put N for the frame pattern (#### or {frame}) in the files' names: one frame's join of a "
+                        "plan whose tasks differ only in their frame")
     return p
 
 
 def _join(argv):
     args = join_parser().parse_args(argv)
+    if args.frame is not None:
+        args.inputs = [files.output_name(p, None, args.frame) for p in args.inputs]
+        args.out = files.output_name(args.out, None, args.frame)
     files.check_output(args.out)
     for path in args.inputs:
         files.check_input(path, {".blend", *files.IMPORTERS})
@@ -76,13 +82,17 @@ def _join(argv):
 def plan_parser():
     """The parser of ``plan`` (its own options; the verb's follow it)."""
     p = verbs._Parser(prog=f"blender -c {COMMAND} plan", allow_abbrev=False, add_help=False,
-                      description="Print the independent tasks of a job as JSON (or write them to the file given "
-                                  "with --json FILE), each a command line for any machine: one per object "
-                                  "(per-object verbs) or one per block of --blocks CxR per frame (terrain, with a "
-                                  "join task per frame). Tessera runs none of them.")
+                      description="Print the independent tasks of a job (or write them to the file given with --json "
+                                  "FILE), each a command line for any machine: one per object (per-object verbs) "
+                                  "or one per block of --blocks CxR per frame (terrain, with a join task per "
+                                  "frame), as JSON or as a scheduler's job (--format). Tessera runs none of them.")
     p.add_argument("verb", choices=sorted(verbs.VERBS))
     p.add_argument("--blocks", type=plan.blocks_arg, default=(2, 2), metavar="CxR",
                    help="terrain: split into C columns by R rows of tiles (default 2x2)")
+    p.add_argument("--format", choices=schedulers.FORMATS, default="json",
+                   help="json: the plan (default); openjd: an Open Job Description job template (Deadline Cloud, "
+                        "'openjd run'); slurm: a script that submits one sbatch array job per step; flamenco: a "
+                        "Flamenco 3 job type holding the plan")
     return p
 
 
@@ -103,11 +113,11 @@ def _plan(argv):
             print("tessera: warning: the Log roughness curve and the Log2/As Printed error rules use log2, whose last "
                   "bit can differ between processors: on a farm of mixed machines, blocks may not weld exactly "
                   "(keep --g sqrt --t-min-rule search)", file=sys.stderr, flush=True)
-        tasks = plan.plan_terrain(verb, args, props, frames, mine.blocks)
+        steps, tasks = plan.plan_terrain(verb, args, props, frames, mine.blocks)
     else:
         files.read_inputs(args.inputs)
-        tasks = plan.plan_objects(verb, args, props, verbs.targets(verb, args.objects))
-    plan.print_plan(verb, tasks, args.json)
+        steps, tasks = plan.plan_objects(verb, args, props, verbs.targets(verb, args.objects))
+    plan.print_plan(schedulers.render(mine.format, plan.plan_dict(verb, steps, tasks)), args.json)
     return verbs.EXIT_OK
 
 

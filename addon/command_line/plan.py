@@ -1,7 +1,10 @@
-"""``blender -c tessera plan VERB ...``: a large job as independent tasks for a render farm, printed as JSON.
+"""``blender -c tessera plan VERB ...``: a large job as independent tasks for a render farm, printed as JSON (or as a
+scheduler's own job: `schedulers`).
 
 Each task is a complete command line (``blender -c tessera VERB ...``) that runs alone on any machine that sees the
-same files (paths are made absolute); Tessera schedules nothing itself. Splits:
+same files (paths are made absolute); Tessera schedules nothing itself. Tasks come in steps: a step's tasks differ
+only in their parameters (``{{Task.Param.NAME}}`` in the step's ``argv``, Open Job Description's notation), and a step
+runs after the steps it names. Splits:
 
 - per-object verbs: one task per source object, each writing its own output (``{object}`` in the name; added before
   the extension when the name has none);
@@ -11,13 +14,27 @@ same files (paths are made absolute); Tessera schedules nothing itself. Splits:
 """
 
 import glob
-import json
 import os
 
 from . import files
 
 #: The ``{block}`` part of a block's output name.
 BLOCK = "{block}"
+
+
+def param(name):
+    """The placeholder of task parameter ``name`` in a step's argv."""
+    return "{{Task.Param." + name + "}}"
+
+
+def fill(argv, params):
+    """A step's ``argv`` with its placeholders replaced by one task's ``params`` (name -> value)."""
+    out = []
+    for word in argv:
+        for name, value in params.items():
+            word = word.replace(param(name), str(value))
+        out.append(word)
+    return out
 
 
 def _render_value(p, value):
@@ -65,41 +82,58 @@ def _with_part(pattern, part):
     return f"{stem}_{part}{ext}"
 
 
-def _task(name, argv, outputs, after=()):
+def _task(name, argv, outputs, after=(), step="", params=None):
     return {"name": name, "argv": argv, "command": ["blender", "-c", "tessera"] + argv, "outputs": outputs,
-            "after": list(after)}
+            "after": list(after), "step": step, "params": dict(params or {})}
+
+
+def _step(name, argv, params, after=()):
+    return {"name": name, "argv": argv, "params": list(params), "after": list(after)}
 
 
 def plan_objects(verb, args, props, targets):
-    """One task per object in ``targets``."""
+    """One task per object in ``targets``: ``(steps, tasks)``."""
     pattern = _with_part(args.out, "{object}")
+    template = task_argv(verb, args, props, objects=param("Object"), out=pattern)
     tasks = []
     for ob in targets:
         out = files.output_name(pattern, ob.name)
-        argv = task_argv(verb, args, props, objects=glob.escape(ob.name).replace(",", "[,]"), out=pattern)
-        tasks.append(_task(f"{verb.name} {ob.name}", argv, [os.path.abspath(out)]))
-    return tasks
+        values = {"Object": glob.escape(ob.name).replace(",", "[,]")}
+        tasks.append(_task(f"{verb.name} {ob.name}", fill(template, values), [os.path.abspath(out)],
+                           step="Objects", params=values))
+    return [_step("Objects", template, ["Object"])], tasks
 
 
 def plan_terrain(verb, args, props, frames, blocks):
-    """``blocks`` = (columns, rows) tasks per frame in ``frames`` (None: the one frame), and a join per frame."""
+    """``blocks`` = (columns, rows) tasks per frame in ``frames`` (None: the one frame), and a join per frame:
+    ``(steps, tasks)``. Output names keep their frame pattern (``####``) and each task is given ``--frame``, so a
+    step's tasks differ only in their frame and block."""
     cols, rows = blocks
     pattern = _with_part(args.out, BLOCK)
+    framed = frames is not None
+    block_argv = task_argv(verb, args, props, out=pattern.replace(BLOCK, param("Part")),
+                           frame=param("Frame") if framed else None, block=param("Block"))
+    parts = [os.path.abspath(pattern.replace(BLOCK, f"b{col}-{row}")) for row in range(rows) for col in range(cols)]
+    join_argv = ["join"] + parts + ["-o", os.path.abspath(args.out)] + (["--frame", param("Frame")] if framed else [])
+    names = ["Frame"] if framed else []
+    steps = [_step("Blocks", block_argv, names + ["Block", "Part"]), _step("Join", join_argv, names, ["Blocks"])]
     tasks = []
     for frame in frames or [args.frame]:
-        names = []
+        at = {"Frame": frame} if framed else {}
+        suffix = "" if frame is None else f" frame {frame}"
+        block_names = []
         for row in range(rows):
             for col in range(cols):
-                out = files.output_name(pattern.replace(BLOCK, f"b{col}-{row}"), None, frame)
-                argv = task_argv(verb, args, props, out=out, frame=frame, block=(col, row, cols, rows))
-                name = f"terrain block {col},{row}" + ("" if frame is None else f" frame {frame}")
-                tasks.append(_task(name, argv, [os.path.abspath(out)]))
-                names.append(name)
+                values = dict(at, Block=f"{col},{row},{cols},{rows}", Part=f"b{col}-{row}")
+                out = files.output_name(pattern.replace(BLOCK, values["Part"]), None, frame)
+                name = f"terrain block {col},{row}{suffix}"
+                tasks.append(_task(name, fill(block_argv, values), [os.path.abspath(out)], step="Blocks",
+                                   params=values))
+                block_names.append(name)
         joined = files.output_name(args.out, None, frame)
-        parts = [t["outputs"][0] for t in tasks[-len(names):]]
-        tasks.append(_task("join" + ("" if frame is None else f" frame {frame}"),
-                           ["join"] + parts + ["-o", os.path.abspath(joined)], [os.path.abspath(joined)], names))
-    return tasks
+        tasks.append(_task("join" + suffix, fill(join_argv, at), [os.path.abspath(joined)], block_names,
+                           step="Join", params=at))
+    return steps, tasks
 
 
 def blocks_arg(text):
@@ -111,9 +145,13 @@ def blocks_arg(text):
     return cols, rows
 
 
-def print_plan(verb, tasks, to=None):
-    """Print the plan as JSON, or write it to the file ``to`` (Blender may print lines of its own)."""
-    text = json.dumps({"verb": verb.name, "tasks": tasks}, indent=1)
+def plan_dict(verb, steps, tasks):
+    """The plan as JSON data: the verb, its steps and its tasks."""
+    return {"verb": verb.name, "steps": steps, "tasks": tasks}
+
+
+def print_plan(text, to=None):
+    """Print the plan's ``text``, or write it to the file ``to`` (Blender may print lines of its own)."""
     if to in (None, "-"):
         print(text, flush=True)
         return

@@ -349,6 +349,22 @@ BLENDER_FLAGS = {"--command", "--background", "--python", "--python-expr", "--ve
 TOOL_FLAGS = {"--run": "tools/bench_report.py", "--full": "bench/terrain.py"}
 
 
+def test_the_docs_flamenco_job_type_is_the_one_plan_writes(cli):
+    """The job type in the docs is `schedulers.flamenco_job_type`'s, its default plan aside."""
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "command_line.md").read_text(encoding="utf-8")
+    shown = page[page.index("```js\n") + 6:page.index("```", page.index("```js\n") + 6)]
+    made = cli.schedulers.flamenco_job_type({"verb": "terrain", "steps": [], "tasks": []})
+    made = re.sub(r"^// .*\n", "", made, flags=re.M)
+
+    def without_default(text):
+        return re.sub(r"default: .*?, *$", "default: …,", text, flags=re.M)
+
+    assert without_default(shown) == without_default(made)
+
+
 def test_every_flag_the_readme_and_the_docs_name_exists(cli):
     """A flag named in the README or a docs page is an option of a verb, of join or plan, Blender's own, or a bench
     script's: a renamed option cannot stay in the manual."""
@@ -362,6 +378,14 @@ def test_every_flag_the_readme_and_the_docs_name_exists(cli):
         ours |= {flag for action in parser._actions for flag in action.option_strings}
     for flag, source in TOOL_FLAGS.items():
         assert f'"{flag}"' in (root / source).read_text(encoding="utf-8"), (flag, source)
+    # the schedulers' own tools the docs show: their flags as their --help lists them
+    import subprocess
+    import sys
+
+    openjd = Path(sys.executable).with_name("openjd")
+    helps = subprocess.run([str(openjd), "run", "--help"], capture_output=True, text=True).stdout
+    ours |= set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]+)", helps))
+    assert "--run-dependencies" in ours
     pages = [root / "README.md", *sorted((root / "docs").glob("*.md"))]
     unknown = set()
     for page in pages:

@@ -6,6 +6,8 @@ registry of add-on commands).
 - a terrain split by ``plan`` into 4 blocks (two frames of a camera path) and into 16 blocks, every task its own
   process, joined: exactly the mesh one process makes (positions bit for bit, the same triangles);
 - impostors planned per object: the same atlases as one process baking both;
+- the same plans as an Open Job Description job template, checked by ``openjd check`` (the model Deadline Cloud
+  validates with) and run by ``openjd run``, step by step with its dependencies: the same meshes;
 - a task stopped (SIGTERM, as farm managers send) or killed (SIGKILL) leaves no output file, and the next task in that
   folder removes what the killed one left; a killed task's render worker and job folder go with it.
 """
@@ -184,6 +186,78 @@ bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))""")
         for key in images[0]:
             assert np.array_equal(images[0][key], images[1][key]), key
             assert images[0][key].max() > 0
+
+
+def _openjd(*args, env=None, cwd=None):
+    """``openjd ARGS`` (the OpenJD reference CLI of this venv) in a process: CompletedProcess."""
+    exe = Path(sys.executable).with_name("openjd")
+    if not exe.exists():
+        pytest.skip("openjd-cli is not installed (requirements)")
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=900, env=env, cwd=cwd)
+
+
+def test_openjd_runs_the_terrain_plan_into_the_single_process_meshes(blender, shot, bpy_module, tmp_path):
+    """``plan --format openjd``: a job template with a Blocks step (frames times blocks) and a Join step after it,
+    valid for Open Job Description's model, run by its reference runner: every frame joins into the mesh one process
+    makes."""
+    bpy = bpy_module
+    args = [shot / "dem.tif", shot / "shot.blend", "--tile-size", "16", "--epsilon", "1.5", "--frames", "1-2"]
+    _ok(blender("-c", "tessera", "terrain", *args, "-o", tmp_path / "single" / "terrain_#.blend"))
+    template = tmp_path / "terrain.json"
+    _ok(blender("-c", "tessera", "plan", "terrain", *args, "--blocks", "2x2", "--format", "openjd",
+                "-o", tmp_path / "farm" / "terrain_#.blend", "--json", template))
+    job = json.loads(template.read_text())
+    assert [s["name"] for s in job["steps"]] == ["Blocks", "Join"]
+    blocks = job["steps"][0]["parameterSpace"]
+    assert blocks["combination"] == "Frame * (Block, Part)"
+    assert {d["name"]: d["range"] for d in blocks["taskParameterDefinitions"]}["Frame"] == [1, 2]
+    check = _openjd("check", template)
+    assert check.returncode == 0, check.stdout + check.stderr
+    sessions = tmp_path / "sessions"  # OpenJD's session folders where the packaged Blender's system sees them
+    sessions.mkdir()
+    run = _openjd("run", template, "--step", "Join", "--run-dependencies", env=dict(blender.env, TMPDIR=str(sessions)),
+                  cwd=tmp_path)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    for frame in (1, 2):
+        whole = _mesh_of(bpy, tmp_path / "single" / f"terrain_{frame}.blend")
+        _same_mesh(whole, _mesh_of(bpy, tmp_path / "farm" / f"terrain_{frame}.blend"))
+    assert len(list((tmp_path / "farm").glob("terrain_*_b*-*.blend"))) == 8
+    assert not [n for n in os.listdir(tmp_path / "farm") if n.startswith(".")]
+
+
+def test_every_plan_format_carries_the_same_command_lines(blender, tmp_path):
+    """Impostors for three objects in every format: OpenJD's template (checked by ``openjd check``) has one task per
+    object, the Slurm script one array task per object with the JSON plan's command line, the Flamenco job type holds
+    the plan itself."""
+    _blend(tmp_path / "three.blend", """
+for i in range(3):
+    bpy.ops.mesh.primitive_cube_add(location=(3 * i, 0, 0))""")
+    plans = {}
+    for fmt in ("json", "openjd", "slurm", "flamenco"):
+        out = tmp_path / f"plan.{fmt}"
+        _ok(blender("-c", "tessera", "plan", "impostors", tmp_path / "three.blend", "--grid", "2", "--format", fmt,
+                    "-o", tmp_path / "farm" / "{object}.blend", "--json", out))
+        plans[fmt] = out.read_text()
+    plan = json.loads(plans["json"])
+    assert [t["params"]["Object"] for t in plan["tasks"]] == ["Cube", "Cube.001", "Cube.002"]
+    job = json.loads(plans["openjd"])
+    (step,) = job["steps"]
+    assert step["parameterSpace"]["taskParameterDefinitions"] == [
+        {"name": "Object", "type": "STRING", "range": ["Cube", "Cube.001", "Cube.002"]}]
+    words = step["script"]["actions"]["onRun"]["args"]
+    filled = [w.replace("{{Task.Param.Object}}", "Cube.001") for w in words]
+    assert filled == ["-c", "tessera"] + plan["tasks"][1]["argv"]
+    check = _openjd("check", tmp_path / "plan.openjd")
+    assert check.returncode == 0, check.stdout + check.stderr
+    import shlex
+
+    script = plans["slurm"]
+    for i, task in enumerate(plan["tasks"]):
+        assert f"Objects:{i}) exec \"$blender\" {shlex.join(['-c', 'tessera', *task['argv']])} ;;" in script
+    assert "--array=0-2" in script and "afterok" not in script  # one step, nothing to wait for
+    js = plans["flamenco"]
+    default = js[js.index("default: ") + len("default: "):js.index(",\n", js.index("default: "))]
+    assert json.loads(json.loads(default)) == plan
 
 
 @pytest.fixture(scope="module")
