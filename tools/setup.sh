@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Set up the virtual environment of one supported Blender and, on Debian as root, the system pieces:
-# Blender's X/GL libraries, Mesa EGL + llvmpipe (headless GPU context), the PoCL OpenCL ICD, and OpenSubdiv
-# (libosd-dev) with g++ for the subdivision oracle the tests build (out/osd/libosd_loop.so).
+# Blender's X/GL libraries, Mesa EGL + llvmpipe (headless GPU context), the PoCL OpenCL ICD, OpenSubdiv
+# (libosd-dev) with g++ for the subdivision oracle the tests build (out/osd/libosd_loop.so), and Slurm with munge
+# for the farm tests (a one-node cluster they start and stop).
 #
 #   tools/setup.sh          .venv for the newest Blender this machine's Pythons can run (5.2 with Python 3.13,
 #                           else 5.0 with Python 3.11): `make demo` and `make test` use it
@@ -43,6 +44,7 @@ system_packages=(
   libgl1 libegl1 libegl-mesa0 libgl1-mesa-dri
   ocl-icd-libopencl1 pocl-opencl-icd
   libosd-dev g++
+  slurmctld slurmd slurm-client munge
 )
 
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -55,6 +57,10 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     echo "setup: installing system packages: ${missing[*]}"
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    # the farm tests start a Slurm node and its munged of their own, and stop them; the packages' services stay off
+    if command -v systemctl >/dev/null 2>&1; then
+      systemctl disable --now munge slurmctld slurmd >/dev/null 2>&1 || true
+    fi
   fi
 else
   echo "setup: not root on Debian; make sure these are installed: ${system_packages[*]} (tiers missing them are skipped)"

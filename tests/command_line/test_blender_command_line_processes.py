@@ -7,7 +7,8 @@ registry of add-on commands).
   process, joined: exactly the mesh one process makes (positions bit for bit, the same triangles);
 - impostors planned per object: the same atlases as one process baking both;
 - the same plans as an Open Job Description job template, checked by ``openjd check`` (the model Deadline Cloud
-  validates with) and run by ``openjd run``, step by step with its dependencies: the same meshes;
+  validates with) and run by ``openjd run``, step by step with its dependencies, and as a Slurm script submitted to a
+  one-node cluster on localhost (`slurm_cluster`), one array job per step: the same meshes, nothing left running;
 - a task stopped (SIGTERM, as farm managers send) or killed (SIGKILL) leaves no output file, and the next task in that
   folder removes what the killed one left; a killed task's render worker and job folder go with it.
 """
@@ -196,13 +197,25 @@ def _openjd(*args, env=None, cwd=None):
     return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=900, env=env, cwd=cwd)
 
 
-def test_openjd_runs_the_terrain_plan_into_the_single_process_meshes(blender, shot, bpy_module, tmp_path):
+FARM_ARGS = ["--tile-size", "16", "--epsilon", "1.5", "--frames", "1-2"]
+
+
+@pytest.fixture(scope="module")
+def single(blender, shot, tmp_path_factory):
+    """The shot's terrain for frames 1 and 2 by one process, with `FARM_ARGS`: its folder (terrain_1, terrain_2)."""
+    out = tmp_path_factory.mktemp("single")
+    _ok(blender("-c", "tessera", "terrain", shot / "dem.tif", shot / "shot.blend", *FARM_ARGS,
+                "-o", out / "terrain_#.blend"))
+    return out
+
+
+@pytest.mark.farm
+def test_openjd_runs_the_terrain_plan_into_the_single_process_meshes(blender, shot, single, bpy_module, tmp_path):
     """``plan --format openjd``: a job template with a Blocks step (frames times blocks) and a Join step after it,
     valid for Open Job Description's model, run by its reference runner: every frame joins into the mesh one process
     makes."""
     bpy = bpy_module
-    args = [shot / "dem.tif", shot / "shot.blend", "--tile-size", "16", "--epsilon", "1.5", "--frames", "1-2"]
-    _ok(blender("-c", "tessera", "terrain", *args, "-o", tmp_path / "single" / "terrain_#.blend"))
+    args = [shot / "dem.tif", shot / "shot.blend", *FARM_ARGS]
     template = tmp_path / "terrain.json"
     _ok(blender("-c", "tessera", "plan", "terrain", *args, "--blocks", "2x2", "--format", "openjd",
                 "-o", tmp_path / "farm" / "terrain_#.blend", "--json", template))
@@ -219,12 +232,46 @@ def test_openjd_runs_the_terrain_plan_into_the_single_process_meshes(blender, sh
                   cwd=tmp_path)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     for frame in (1, 2):
-        whole = _mesh_of(bpy, tmp_path / "single" / f"terrain_{frame}.blend")
+        whole = _mesh_of(bpy, single / f"terrain_{frame}.blend")
         _same_mesh(whole, _mesh_of(bpy, tmp_path / "farm" / f"terrain_{frame}.blend"))
     assert len(list((tmp_path / "farm").glob("terrain_*_b*-*.blend"))) == 8
     assert not [n for n in os.listdir(tmp_path / "farm") if n.startswith(".")]
 
 
+@pytest.mark.farm
+def test_slurm_runs_the_terrain_plan_into_the_single_process_meshes(blender, shot, single, bpy_module, tmp_path):
+    """``plan --format slurm``: the script submits the Blocks array job and the Join array job after it (afterok) to a
+    real slurmctld and slurmd; every job completes, every frame joins into the mesh one process makes, and the
+    cluster stops with nothing left running."""
+    import slurm_cluster
+
+    why = slurm_cluster.missing()
+    if why:
+        pytest.skip(why)
+    bpy = bpy_module
+    args = [shot / "dem.tif", shot / "shot.blend", *FARM_ARGS]
+    script = tmp_path / "terrain.sh"
+    _ok(blender("-c", "tessera", "plan", "terrain", *args, "--blocks", "2x2", "--format", "slurm",
+                "-o", tmp_path / "farm" / "terrain_#.blend", "--json", script))
+    cluster = slurm_cluster.start(tmp_path / "slurm")
+    try:
+        env = dict(blender.env, SLURM_CONF=cluster.env["SLURM_CONF"])  # jobs see the submitter's PATH: its blender
+        submitted = cluster.run("bash", script, cwd=tmp_path, env=env)
+        assert submitted.returncode == 0, submitted.stdout + submitted.stderr
+        assert "Blocks: job" in submitted.stdout and "Join: job" in submitted.stdout
+        states = cluster.wait_idle()
+    finally:
+        cluster.stop()
+    assert cluster.left() == []
+    logs = "".join(p.read_text(errors="replace")[-800:] for p in tmp_path.glob("slurm-*.out"))
+    assert states == ["COMPLETED"] * 10, (states, logs)  # 8 blocks, 2 joins
+    for frame in (1, 2):
+        whole = _mesh_of(bpy, single / f"terrain_{frame}.blend")
+        _same_mesh(whole, _mesh_of(bpy, tmp_path / "farm" / f"terrain_{frame}.blend"))
+    assert not [n for n in os.listdir(tmp_path / "farm") if n.startswith(".")]
+
+
+@pytest.mark.farm
 def test_every_plan_format_carries_the_same_command_lines(blender, tmp_path):
     """Impostors for three objects in every format: OpenJD's template (checked by ``openjd check``) has one task per
     object, the Slurm script one array task per object with the JSON plan's command line, the Flamenco job type holds
