@@ -57,6 +57,41 @@ class Cluster:
         shown = self.run("scontrol", "-o", "show", "job").stdout
         return [line.split("JobState=")[1].split()[0] for line in shown.splitlines() if "JobState=" in line]
 
+    def running(self, timeout=120):
+        """The id of the first job step seen running (an array task: ``JOB_TASK``)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            ids = self.run("squeue", "-h", "-t", "R", "-o", "%i").stdout.split()
+            if ids:
+                return ids[0]
+            time.sleep(0.1)
+        raise TimeoutError(f"no Slurm job ran within {timeout} s:\n{self.run('squeue').stdout}")
+
+    def release(self, job, timeout=60):
+        """Let requeued ``job`` start again at once: Slurm holds a requeued job back by its begin time (two minutes),
+        which can only be moved once the job is pending again (after it stopped: COMPLETING)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            state = self.run("squeue", "-h", "-j", job, "-o", "%T").stdout.strip()
+            if state in ("", "RUNNING", "COMPLETED"):
+                return
+            if state == "PENDING":
+                self.run("scontrol", "update", f"JobId={job}", "StartTime=now")
+            time.sleep(0.2)
+        raise TimeoutError(f"requeued Slurm job {job} did not start again within {timeout} s")
+
+    def restarts(self):
+        """Each job's restart count (``scontrol show job``): {job id: count}."""
+        shown = self.run("scontrol", "-o", "show", "job").stdout
+        out = {}
+        for line in shown.splitlines():
+            fields = dict(f.split("=", 1) for f in line.split() if "=" in f)
+            if "JobId" in fields:
+                name = fields["JobId"] if fields.get("ArrayTaskId") in (None, "N/A") else \
+                    f"{fields.get('ArrayJobId')}_{fields['ArrayTaskId']}"
+                out[name] = int(fields.get("Restarts", 0))
+        return out
+
     def stop(self):
         """Stop the daemons (slurmd, slurmctld, munged) and wait for them: nothing left running."""
         for pidfile in ("slurmd.pid", "slurmctld.pid", "munged.pid"):

@@ -241,7 +241,8 @@ def test_openjd_runs_the_terrain_plan_into_the_single_process_meshes(blender, sh
 @pytest.mark.farm
 def test_slurm_runs_the_terrain_plan_into_the_single_process_meshes(blender, shot, single, bpy_module, tmp_path):
     """``plan --format slurm``: the script submits the Blocks array job and the Join array job after it (afterok) to a
-    real slurmctld and slurmd; every job completes, every frame joins into the mesh one process makes, and the
+    real slurmctld and slurmd. A block task is pre-empted mid-way (``scontrol requeue``: Slurm stops it and runs it
+    again); every job completes, every frame joins into the mesh one process makes, no partial file is left, and the
     cluster stops with nothing left running."""
     import slurm_cluster
 
@@ -259,12 +260,19 @@ def test_slurm_runs_the_terrain_plan_into_the_single_process_meshes(blender, sho
         submitted = cluster.run("bash", script, cwd=tmp_path, env=env)
         assert submitted.returncode == 0, submitted.stdout + submitted.stderr
         assert "Blocks: job" in submitted.stdout and "Join: job" in submitted.stdout
+        victim = cluster.running()
+        time.sleep(1.0)  # Blender is starting: the task is under way (a block takes about 2.5 s here)
+        requeued = cluster.run("scontrol", "requeue", victim)
+        assert requeued.returncode == 0, requeued.stdout + requeued.stderr
+        cluster.release(victim)
         states = cluster.wait_idle()
+        restarts = cluster.restarts()
     finally:
         cluster.stop()
     assert cluster.left() == []
     logs = "".join(p.read_text(errors="replace")[-800:] for p in tmp_path.glob("slurm-*.out"))
     assert states == ["COMPLETED"] * 10, (states, logs)  # 8 blocks, 2 joins
+    assert restarts.get(victim) == 1, (victim, restarts)  # the pre-empted task ran again
     for frame in (1, 2):
         whole = _mesh_of(bpy, single / f"terrain_{frame}.blend")
         _same_mesh(whole, _mesh_of(bpy, tmp_path / "farm" / f"terrain_{frame}.blend"))
