@@ -28,6 +28,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
+from .sample_grid import BlockSource, nodata_mask
 
 #: Bytes of GDAL's own block cache (GDAL_CACHEMAX; its default is 5 % of the RAM). Decoded blocks are kept by the
 #: sources themselves (`CACHE_BYTES`), so GDAL needs only enough for the tiles of one band of rows.
@@ -218,20 +219,19 @@ def block_rows(ds, band):
     return tile * max(1, -(-BLOCK_ROWS // tile)) if 1 < tile < ds.height else BLOCK_ROWS
 
 
-class GdalSource:
-    """One band of a GDAL raster, decoded a block of rows at a time (file order: row 0 at the top); float32 heights
-    in stored units after the band's scale and offset, voids (no-data, the mask band, NaN) as NaN. The dataset stays
-    open while the source lives (opened again after pickling or `close`)."""
+class GdalSource(BlockSource):
+    """One band of a GDAL raster, decoded a block of rows at a time (`sample_grid.BlockSource`; file order: row 0 at
+    the top); float32 heights in stored units after the band's scale and offset, voids (no-data, the mask band, NaN)
+    as NaN. The dataset stays open while the source lives (opened again after pickling or `close`)."""
 
     def __init__(self, path, band=1, warp=False, shape=None):
         self.path, self.band, self.warp = path, band, warp
         self._handles = None
-        self._cache = OrderedDict()
         self._io = threading.Lock()
         ds, src = self._open()
         self.shape = shape or (src.height, src.width)
         self.block_rows = block_rows(src, band) if not warp else BLOCK_ROWS
-        self._keep = max(2, CACHE_BYTES // max(1, self.block_rows * self.shape[1] * 4))
+        self._init_cache(CACHE_BYTES)
         self.scale = float(ds.scales[band - 1] or 1.0)
         self.offset = float(ds.offsets[band - 1] or 0.0)
         from rasterio.enums import MaskFlags
@@ -240,7 +240,6 @@ class GdalSource:
         self._mask = bool(flags & {MaskFlags.per_dataset, MaskFlags.alpha}) and not warp
         nodata = src.nodatavals[0 if warp else band - 1]
         self.nodata = None if nodata is None else float(nodata)
-        self.dtype = np.dtype(src.dtypes[0 if warp else band - 1])
 
     def _open(self):
         if self._handles is None:
@@ -270,17 +269,8 @@ class GdalSource:
         self._io = threading.Lock()
 
     def block(self, index):
-        """Decoded rows of block ``index``: (rows, W) float32 (file order), voids as NaN."""
-        with self._io:
-            hit = self._cache.get(index)
-            if hit is not None:
-                self._cache.move_to_end(index)
-                return hit
-            data = self._decode(index)
-            self._cache[index] = data
-            while len(self._cache) > self._keep:
-                self._cache.popitem(last=False)
-            return data
+        with self._io:  # one dataset handle: GDAL's are not shared between threads
+            return super().block(index)
 
     def _decode(self, index):
         from rasterio.errors import RasterioError
@@ -299,7 +289,7 @@ class GdalSource:
             raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {os.path.basename(self.path)} failed: "
                                     f"{_gdal_words(err)}") from err
         nan_nodata = self.nodata is not None and math.isnan(self.nodata)
-        void = np.zeros(raw.shape, bool) if nan_nodata else _nodata_mask(raw, self.nodata)  # NaN: isfinite below
+        void = np.zeros(raw.shape, bool) if nan_nodata else nodata_mask(raw, self.nodata)  # NaN: isfinite below
         if mask is not None:
             void |= mask == 0
         if self.scale != 1.0 or self.offset != 0.0:
@@ -310,39 +300,3 @@ class GdalSource:
             void |= ~np.isfinite(out)
         out[void] = np.nan
         return out
-
-    def rows(self, r0, r1):
-        """File rows ``[r0, r1)``: (r1 - r0, W) float32, voids NaN."""
-        b = self.block_rows
-        parts = []
-        for index in range(r0 // b, (r1 - 1) // b + 1):
-            lo = index * b
-            parts.append(self.block(index)[max(r0, lo) - lo:min(r1, lo + b) - lo])
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-    def points(self, rows, cols):
-        """Values at file rows and columns (int64 (n,) each, inside the raster): (n,) float32."""
-        out = np.empty(rows.shape, np.float32)
-        block = rows // self.block_rows
-        order = np.argsort(block, kind="stable")
-        edges = np.flatnonzero(np.diff(block[order])) + 1
-        for run in np.split(order, edges):
-            if run.size:
-                index = int(block[run[0]])
-                out[run] = self.block(index)[rows[run] - index * self.block_rows, cols[run]]
-        return out
-
-
-def _nodata_mask(raw, nodata):
-    """Where ``raw`` (stored type) equals the no-data value as the band's type holds it: (H, W) bool."""
-    if nodata is None:
-        return np.zeros(raw.shape, bool)
-    if math.isnan(nodata):
-        return np.isnan(raw) if raw.dtype.kind == "f" else np.zeros(raw.shape, bool)
-    if raw.dtype.kind == "f":
-        with np.errstate(over="ignore"):
-            return raw == raw.dtype.type(nodata)  # the lowest float32 compared as float32, as GDAL writes it
-    info = np.iinfo(raw.dtype)
-    if not (float(nodata).is_integer() and info.min <= nodata <= info.max):
-        return np.zeros(raw.shape, bool)  # a value the band cannot hold marks nothing (GDAL does the same)
-    return raw == raw.dtype.type(int(nodata))

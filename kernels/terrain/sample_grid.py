@@ -11,6 +11,7 @@ void. Values are float32; voids (no file, the file's no-data value, NaN) are NaN
 (`void_fill.FilledGrid`) fills or cuts them before any height reaches the terrain.
 """
 
+import math
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -88,22 +89,36 @@ def tiff_layout(path):
     return TiffLayout(int(spec.width), int(spec.height), int(spec.nchannels), fmt, rows, bool(tile))
 
 
-class TiffSource:
-    """One TIFF image's first channel, decoded a block of rows at a time (file order: row 0 at the top).
+def nodata_mask(raw, nodata):
+    """Where ``raw`` (the file's stored type) equals the no-data value as that type holds it: (H, W) bool. A float's
+    value is compared in the file's float type (the lowest float32, as GDAL writes it, included), an integer's as
+    stored; a value the type cannot hold marks nothing (GDAL does the same); NaN marks the NaN samples."""
+    if nodata is None:
+        return np.zeros(raw.shape, bool)
+    if math.isnan(nodata):
+        return np.isnan(raw) if raw.dtype.kind == "f" else np.zeros(raw.shape, bool)
+    if raw.dtype.kind == "f":
+        with np.errstate(over="ignore"):
+            return raw == raw.dtype.type(nodata)
+    info = np.iinfo(raw.dtype)
+    if not (float(nodata).is_integer() and info.min <= nodata <= info.max):
+        return np.zeros(raw.shape, bool)
+    return raw == raw.dtype.type(int(nodata))
 
-    ``nodata``: the file's no-data value (None: none); its samples, and NaN, read as NaN. ``scale``, ``offset``:
-    a sample means ``offset + scale * stored`` (GDAL's band scale and offset).
-    """
 
-    def __init__(self, path, layout, nodata=None, scale=1.0, offset=0.0):
-        self.path, self.layout, self.nodata = path, layout, nodata
-        self.scale, self.offset = float(scale), float(offset)
+class BlockSource:
+    """One file's samples decoded a block of whole rows at a time (file order: row 0 at the top), the last few blocks
+    kept (`CACHE_BYTES`). A subclass sets ``shape`` (H, W) and ``block_rows`` and decodes one block (`_decode`)."""
+
+    shape = (0, 0)
+    block_rows = BLOCK_ROWS
+
+    def _init_cache(self, cache_bytes):
         self._cache = OrderedDict()  # block index -> (rows, W) float32
-        self._keep = max(2, CACHE_BYTES // max(1, layout.block_rows * layout.width * 4))
+        self._keep = max(2, cache_bytes // max(1, self.block_rows * self.shape[1] * 4))
 
-    @property
-    def shape(self):
-        return self.layout.height, self.layout.width
+    def _decode(self, index):  # pragma: no cover - the interface
+        raise NotImplementedError
 
     def block(self, index):
         """Decoded rows of block ``index``: (rows, W) float32 (file order), voids as NaN."""
@@ -116,6 +131,41 @@ class TiffSource:
         while len(self._cache) > self._keep:
             self._cache.popitem(last=False)
         return data
+
+    def rows(self, r0, r1):
+        """File rows ``[r0, r1)``: (r1 - r0, W) float32, voids NaN."""
+        b = self.block_rows
+        parts = []
+        for index in range(r0 // b, (r1 - 1) // b + 1):
+            lo = index * b
+            parts.append(self.block(index)[max(r0, lo) - lo:min(r1, lo + b) - lo])
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def points(self, rows, cols):
+        """Values at file rows and columns (int64 (n,) each, inside the image): (n,) float32."""
+        out = np.empty(rows.shape, np.float32)
+        block = rows // self.block_rows
+        order = np.argsort(block, kind="stable")
+        edges = np.flatnonzero(np.diff(block[order])) + 1
+        for run in np.split(order, edges):
+            if run.size:
+                index = int(block[run[0]])
+                out[run] = self.block(index)[rows[run] - index * self.block_rows, cols[run]]
+        return out
+
+
+class TiffSource(BlockSource):
+    """One TIFF image's first channel, decoded through OpenImageIO a block of rows at a time (`BlockSource`).
+
+    ``nodata``: the file's no-data value (None: none); its samples, and NaN, read as NaN. ``scale``, ``offset``:
+    a sample means ``offset + scale * stored`` (GDAL's band scale and offset).
+    """
+
+    def __init__(self, path, layout, nodata=None, scale=1.0, offset=0.0):
+        self.path, self.layout, self.nodata = path, layout, nodata
+        self.scale, self.offset = float(scale), float(offset)
+        self.shape, self.block_rows = (layout.height, layout.width), layout.block_rows
+        self._init_cache(CACHE_BYTES)
 
     def _decode(self, index):
         lay = self.layout
@@ -139,37 +189,10 @@ class TiffSource:
             inp.close()
         raw = np.asarray(data).reshape(r1 - r0, lay.width)
         out = raw.astype(np.float32)
-        void = ~np.isfinite(out)
-        if self.nodata is not None and np.isfinite(self.nodata):
-            if raw.dtype.kind not in "iu":
-                with np.errstate(over="ignore"):  # the lowest float32, as GDAL writes it, compared as float32
-                    void |= raw == raw.dtype.type(self.nodata)
-            elif float(self.nodata).is_integer() and np.iinfo(raw.dtype).min <= self.nodata <= np.iinfo(raw.dtype).max:
-                void |= raw == raw.dtype.type(int(self.nodata))  # compared as stored, not after rounding
+        void = ~np.isfinite(out) | nodata_mask(raw, self.nodata)
         if self.scale != 1.0 or self.offset != 0.0:
             out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
         out[void] = np.nan
-        return out
-
-    def rows(self, r0, r1):
-        """File rows ``[r0, r1)``: (r1 - r0, W) float32, voids NaN."""
-        b = self.layout.block_rows
-        parts = []
-        for index in range(r0 // b, (r1 - 1) // b + 1):
-            lo = index * b
-            parts.append(self.block(index)[max(r0, lo) - lo:min(r1, lo + b) - lo])
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-    def points(self, rows, cols):
-        """Values at file rows and columns (int64 (n,) each, inside the image): (n,) float32."""
-        out = np.empty(rows.shape, np.float32)
-        block = rows // self.layout.block_rows
-        order = np.argsort(block, kind="stable")
-        edges = np.flatnonzero(np.diff(block[order])) + 1
-        for run in np.split(order, edges):
-            if run.size:
-                index = int(block[run[0]])
-                out[run] = self.block(index)[rows[run] - index * self.layout.block_rows, cols[run]]
         return out
 
 
