@@ -47,10 +47,11 @@ def write_geotiff(path, top_first, spacing=(30.0, 30.0), corner=(500000.0, 46000
 
 def write_raster(path, top_first, spacing=(30.0, 30.0), corner=(500000.0, 4600000.0), crs="EPSG:32633",
                  driver="GTiff", nodata=None, scale=None, offset=None, mask=None, units=None, point=False,
-                 transform=None, count=1, **creation):
+                 transform=None, internal_mask=True, **creation):
     """Write ``top_first`` ((H, W), or (count, H, W)) with GDAL itself (rasterio): any driver GDAL can create or
     copy to (GTiff, COG, SRTMHGT, AAIGrid, HFA...), a no-data value, the band's ``scale`` and ``offset``, a
-    ``mask`` ((H, W) bool, True valid) as GDAL's internal mask band, the band's ``units``, ``point`` for
+    ``mask`` ((H, W) bool, True valid) as GDAL's mask band (internal, or a ``.msk`` file beside it with
+    ``internal_mask=False``), the band's ``units``, ``point`` for
     PixelIsPoint; ``corner`` is the top-left pixel's corner (its sample for ``point``); ``transform`` a
     rasterio `Affine` instead; ``creation`` GDAL creation options (COMPRESS="ZSTD", TILED=True, BIGTIFF="YES"...)."""
     import rasterio
@@ -79,7 +80,7 @@ def write_raster(path, top_first, spacing=(30.0, 30.0), corner=(500000.0, 460000
         if mask is not None:
             ds.write_mask(np.where(mask, 255, 0).astype(np.uint8))
 
-    with rasterio.Env(GDAL_TIFF_INTERNAL_MASK=True):
+    with rasterio.Env(GDAL_TIFF_INTERNAL_MASK=internal_mask):
         if not copy_only:
             with rasterio.open(path, "w", driver=driver, **profile) as ds:
                 fill(ds)

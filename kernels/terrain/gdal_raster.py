@@ -23,6 +23,7 @@ import math
 import os
 import re
 import threading
+import warnings
 from collections import OrderedDict
 
 import numpy as np
@@ -79,7 +80,6 @@ def _rasterio():
             from rasterio.env import set_gdal_config
 
             set_gdal_config("GDAL_CACHEMAX", GDAL_CACHE_BYTES)  # bytes (rasterio calls GDALSetCacheMax64)
-            set_gdal_config("GDAL_DISABLE_READDIR_ON_OPEN", "EMPTY_DIR")  # no folder listing per open
             set_gdal_config("GDAL_NUM_THREADS", "ALL_CPUS")  # a band of tiles decompressed on every core
             _configured = True
     return rasterio
@@ -106,13 +106,15 @@ def open_dataset(path, band=0):
     (or the first of a raster that is not a picture); a raster that is not north up comes back as a virtual
     north-up warp. The caller closes both (`close`)."""
     rasterio = _rasterio()
-    from rasterio.errors import RasterioError
+    from rasterio.errors import NotGeoreferencedWarning, RasterioError
 
     name = os.path.basename(path)
     if not os.path.isfile(path):
         raise InvalidInputError(f"No such elevation file: {path}")
     try:
-        ds = rasterio.open(path)
+        with warnings.catch_warnings():  # a TIFF without placement is a plain height map, not a warning
+            warnings.simplefilter("ignore", NotGeoreferencedWarning)
+            ds = rasterio.open(path)
     except RasterioError as err:
         raise InvalidInputError(f"GDAL cannot open {name}: {_gdal_words(err)}") from err
     try:

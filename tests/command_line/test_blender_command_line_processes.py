@@ -114,6 +114,17 @@ def _same_mesh(a, b):
     assert tris(pa, ta) == tris(pb, tb)
 
 
+def _impostor_pixels(bpy, path, name):
+    """The impostor images of object ``name`` in the .blend ``path``: {image name: pixels}."""
+    with bpy.data.libraries.load(str(path)) as (src, dst):
+        dst.images = [n for n in src.images if n.startswith(f"{name} impostor")]
+    out = {im.name.rsplit(".", 1)[0] if im.name[-4:-3] == "." else im.name: np.array(im.pixels[:], np.float32)
+           for im in dst.images}
+    for im in dst.images:
+        bpy.data.images.remove(im)
+    return out
+
+
 def _run_plan(blender, plan):
     """Run the plan's tasks as a farm would: the independent ones two at a time, each join after its blocks."""
     tasks = plan["tasks"]
@@ -174,16 +185,8 @@ bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))""")
     assert sorted(t["name"] for t in plan["tasks"]) == ["impostors Cube", "impostors Icosphere"]
     _run_plan(blender, plan)
     for name in ("Cube", "Icosphere"):
-        images = []
-        for folder in ("one", "farm"):
-            with bpy.data.libraries.load(str(tmp_path / folder / f"{name}.blend")) as (src, dst):
-                dst.images = [n for n in src.images if n.startswith(f"{name} impostor")]
-            assert len(dst.images) == 3  # colour, normal, depth
-            images.append({im.name.rsplit(".", 1)[0] if im.name[-4:-3] == "." else im.name:
-                           np.array(im.pixels[:], np.float32) for im in dst.images})
-            for im in dst.images:
-                bpy.data.images.remove(im)
-        assert images[0].keys() == images[1].keys()
+        images = [_impostor_pixels(bpy, tmp_path / folder / f"{name}.blend", name) for folder in ("one", "farm")]
+        assert len(images[0]) == 3 and images[0].keys() == images[1].keys()  # colour, normal, depth
         for key in images[0]:
             assert np.array_equal(images[0][key], images[1][key]), key
             assert images[0][key].max() > 0
@@ -280,17 +283,19 @@ def test_slurm_runs_the_terrain_plan_into_the_single_process_meshes(blender, sho
 
 
 @pytest.mark.farm
-def test_every_plan_format_carries_the_same_command_lines(blender, tmp_path):
-    """Impostors for three objects in every format: OpenJD's template (checked by ``openjd check``) has one task per
-    object, the Slurm script one array task per object with the JSON plan's command line, the Flamenco job type holds
-    the plan itself."""
+def test_every_plan_format_carries_the_same_command_lines(blender, bpy_module, tmp_path):
+    """Impostors for three objects in every format: OpenJD's template (checked by ``openjd check`` and run by ``openjd
+    run``: the atlases one process bakes) has one task per object, the Slurm script one array task per object with the
+    JSON plan's command line, the Flamenco job type holds the plan itself."""
     _blend(tmp_path / "three.blend", """
 for i in range(3):
-    bpy.ops.mesh.primitive_cube_add(location=(3 * i, 0, 0))""")
+    bpy.ops.mesh.primitive_cube_add(location=(3 * i, 0, 0))
+bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))""")
+    opts = ["--grid", "2", "--tile", "16", "--samples", "2"]
     plans = {}
     for fmt in ("json", "openjd", "slurm", "flamenco"):
         out = tmp_path / f"plan.{fmt}"
-        _ok(blender("-c", "tessera", "plan", "impostors", tmp_path / "three.blend", "--grid", "2", "--format", fmt,
+        _ok(blender("-c", "tessera", "plan", "impostors", tmp_path / "three.blend", *opts, "--format", fmt,
                     "-o", tmp_path / "farm" / "{object}.blend", "--json", out))
         plans[fmt] = out.read_text()
     plan = json.loads(plans["json"])
@@ -304,6 +309,17 @@ for i in range(3):
     assert filled == ["-c", "tessera"] + plan["tasks"][1]["argv"]
     check = _openjd("check", tmp_path / "plan.openjd")
     assert check.returncode == 0, check.stdout + check.stderr
+    sessions = tmp_path / "sessions"
+    sessions.mkdir()
+    run = _openjd("run", tmp_path / "plan.openjd", "--step", "Objects", env=dict(blender.env, TMPDIR=str(sessions)),
+                  cwd=tmp_path)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    _ok(blender("-c", "tessera", "impostors", tmp_path / "three.blend", *opts,
+                "-o", tmp_path / "one" / "{object}.blend"))
+    for name in ("Cube", "Cube.001", "Cube.002"):
+        farm, one = (_impostor_pixels(bpy_module, tmp_path / f / f"{name}.blend", name) for f in ("farm", "one"))
+        assert farm.keys() == one.keys() and len(farm) == 3
+        assert all(np.array_equal(farm[k], one[k]) for k in farm)
     import shlex
 
     script = plans["slurm"]

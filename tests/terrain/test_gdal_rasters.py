@@ -83,11 +83,15 @@ def test_us_survey_feet_named_only_by_epsg_codes(tmp_path):
     np.testing.assert_allclose(hm.heights()[::-1], top_ft.astype(np.float32) * US_FOOT, rtol=1e-6)
 
 
-def test_a_mask_band_marks_voids(tmp_path):
+@pytest.mark.parametrize("internal", [True, False], ids=["internal", "msk-file"])
+def test_a_mask_band_marks_voids(tmp_path, internal):
     top = _heights()
     void = _voids(*top.shape)
     data = np.where(void, 0, top).astype(np.float32)  # zeros under the mask: a pit if the mask were ignored
-    hm, _ = _read(write_raster(str(tmp_path / "mask.tif"), data, mask=~void, TILED=True, COMPRESS="LZW"))
+    path = write_raster(str(tmp_path / "mask.tif"), data, mask=~void, internal_mask=internal, TILED=True,
+                        COMPRESS="LZW")
+    assert (tmp_path / "mask.tif.msk").exists() != internal
+    hm, _ = _read(path)
     assert hm.samples.void_count == void.sum()
     _valid_exact(hm, top, void)
     holes, _ = _read(str(tmp_path / "mask.tif"), voids="HOLES")
