@@ -139,6 +139,77 @@ def machine_block():
     return "*Measured " + "; ".join(parts) + ".*\n"
 
 
+#: The summary's rows, each one bench row read back from the page: (Tessera's tool and input, bench, case, Tessera's
+#: time column, the baseline's time column, Tessera's output size column, the baseline's (None: the same output)).
+SUMMARY = (
+    ("Tessellate, PN, smooth Suzanne", "tessellation", "operator_pn_smooth", "seconds", "baseline seconds",
+     "output triangles", "baseline triangles"),
+    ("Tessellate, Phong, smooth Suzanne", "tessellation", "operator_phong_smooth", "seconds", "baseline seconds",
+     "output triangles", "baseline triangles"),
+    ("Tubes from 100,000 hair strands", "tubes", "operator", "median seconds", "baseline median seconds", None, None),
+    ("Loop Subdivide, level 5, flat Suzanne", "subdivision", "operator_level_5", "seconds", "baseline seconds",
+     "output triangles", "baseline triangles"),
+    ("Tessellate Surface, the teapot, same deviation", "surfaces", "tessellate_surface_teapot", "seconds",
+     "baseline seconds", "triangles", "baseline triangles"),
+    ("Tessera PN node group, level 4", "node_groups", "pn_group_level_4_vs_subsurf", "seconds", "baseline seconds",
+     "output triangles", "baseline triangles"),
+    ("Tessera Tubes node group, 3,000 curves", "node_groups", "tubes_group_3000x40_vs_curve_to_mesh", "seconds",
+     "baseline seconds", "output quads", "baseline quads"),
+    ("Tessera Terrain node group, 1025² map", "node_groups", "terrain_group_1025_vs_displace", "seconds",
+     "baseline seconds", "output triangles", "baseline triangles"),
+    ("Live tessellation preview, a redraw", "window", "redraw, tessellation (PN, level 3) preview", "preview ms",
+     "blender ms", None, None),
+    ("Live Loop preview, a redraw", "window", "redraw, Loop (2 levels) preview", "preview ms", "blender ms", None,
+     None),
+    ("Live tubes preview, a redraw", "window", "redraw, tubes (16 sides) preview", "preview ms", "blender ms", None,
+     None),
+    ("Live terrain preview, a redraw", "window", "redraw, terrain (257² heights) preview", "preview ms", "blender ms",
+     None, None),
+)
+
+
+def page_rows(text, bench):
+    """The rows of bench ``bench``'s tables on the page ``text``: dicts of column -> cell text, in page order."""
+    match = next((m for m in BLOCK.finditer(text) if m.group(2) == bench), None)
+    rows = []
+    if match is None:
+        return rows
+    for table in match.group(3).strip().split("\n\n"):
+        lines = [line for line in table.splitlines() if line.startswith("|")]
+        if len(lines) < 3:
+            continue
+        head = [c.strip() for c in lines[0].strip().strip("|").split("|")]
+        for line in lines[2:]:
+            cells = [c.strip() for c in re.split(r"(?<!\\)\|", line.strip().strip("|"))]
+            rows.append(dict(zip(head, cells, strict=False)))
+    return rows
+
+
+def _number(cell):
+    return float(cell.replace(",", ""))
+
+
+def summary_block(text):
+    """The summary table of the page ``text``: for each `SUMMARY` row, the Blender tool it was measured against, how
+    much faster or slower Tessera was in wall time, and how its output compares, read from the bench tables on the
+    same page (their rounded figures: a ratio here may differ from the table's own in its last digit)."""
+    out = ["| Tessera | against, in Blender | wall time | output |", "|---|---|---|---|"]
+    for label, bench, case, ours, theirs, size, their_size in SUMMARY:
+        row = next((r for r in page_rows(text, bench) if r.get("case") == case), None)
+        if row is None or ours not in row or theirs not in row:
+            out.append(f"| {label} | – | not measured (`bench/{bench}.py`) | – |")
+            continue
+        faster = _number(row[theirs]) / _number(row[ours])
+        against = row.get("baseline") or ("Blender drawing the applied mesh" if bench == "window" else "–")
+        if row.get("backend"):
+            label = f"{label} ({row['backend']})"
+        verdict = f"{faster:.2f}x faster" if faster >= 1.0 else f"{1.0 / faster:.2f}x slower"
+        share = _number(row[size]) / _number(row[their_size]) if size else 1.0
+        output = "the same" if abs(share - 1.0) <= 0.05 else f"{share:.2f}x the {size.split()[-1]}"
+        out.append(f"| {label} | {against} | {verdict} | {output} |")
+    return "\n".join(out) + "\n"
+
+
 def write_page(machine_too=True):
     """Fill the page's blocks from out/bench; the machine block only with ``machine_too`` (a run of every bench:
     after a partial run the page's other tables still come from the machine it names)."""
@@ -146,6 +217,8 @@ def write_page(machine_too=True):
 
     def fill(match):
         name = match.group(2)
+        if name == "summary":
+            return match.group(0)  # written below, from the other blocks' new tables
         if name == "machine":
             if not machine_too:
                 return match.group(0)
@@ -160,6 +233,8 @@ def write_page(machine_too=True):
         return f"{match.group(1)}\n{body.rstrip()}\n\n{match.group(4)}"
 
     new = BLOCK.sub(fill, text)
+    new = BLOCK.sub(lambda m: f"{m.group(1)}\n{summary_block(new).rstrip()}\n\n{m.group(4)}" if m.group(2) == "summary"
+                    else m.group(0), new)
     missing = sorted(set(benches()) - {m.group(2) for m in BLOCK.finditer(text)})
     if missing:
         raise SystemExit(f"bench_report: docs/performance.md has no block for {missing}")

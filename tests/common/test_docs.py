@@ -44,3 +44,21 @@ def test_the_manual_has_a_page_per_capability_and_its_links_resolve():
                 if anchor not in headings and f'id="{anchor}"' not in text:
                     bad.append(f"{page.name}: {target}#{anchor}")
     assert not bad, bad
+
+
+def test_the_performance_summary_is_read_from_the_bench_tables_on_the_page():
+    """The summary table at the top of docs/performance.md is what `tools/bench_report.py` reads back from the bench
+    tables below it (never edited by hand), every row measured, each ratio the tables' own times."""
+    import importlib.util
+
+    root = Path(__file__).resolve().parents[2]
+    spec = importlib.util.spec_from_file_location("bench_report", root / "tools" / "bench_report.py")
+    report = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(report)
+    page = (root / "docs" / "performance.md").read_text(encoding="utf-8")
+    block = next(m for m in report.BLOCK.finditer(page) if m.group(2) == "summary").group(3)
+    assert block.strip() == report.summary_block(page).strip()
+    assert "not measured" not in block and block.count("\n| ") == len(report.SUMMARY) + 1
+    row = next(r for r in report.page_rows(page, "tessellation") if r["case"] == "operator_pn_smooth")
+    ratio = float(row["baseline seconds"]) / float(row["seconds"])
+    assert f"| {ratio:.2f}x faster |" in block or f"| {1 / ratio:.2f}x slower |" in block
