@@ -28,12 +28,11 @@ level below its sides' (the kernel zips strips; the group refines a tile to its 
 maps, and heights at the file's own precision (the group reads what Blender's image holds).
 """
 
+from ...kernels.common.partition import MAX_LEVEL  # the largest level: quads a tile side
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Terrain"
 VERSION = 2
-#: The largest level (quads a tile side), the kernel's `kernels.common.partition.MAX_LEVEL`.
-MAX_LEVEL = 64
 _TILE = ("tessera_x0", "tessera_y0", "tessera_wx", "tessera_wy", "tessera_r", "tessera_bottom", "tessera_right",
          "tessera_top", "tessera_left")
 _BORDER = "tessera_border"

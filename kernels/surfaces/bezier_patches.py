@@ -48,6 +48,7 @@ from ..common.budget import Estimate, check_budget
 from ..common.errors import InvalidInputError, OpenCLUnavailableError, TesseraError
 from ..common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
 from ..common.opencl_runtime import backend_runtime
+from ..common.partition import MAX_LEVEL
 from ..common.quad_pattern import pattern, pattern_codes, strips, zip_by_params
 from ..common.rational_bezier import (
     bernstein,
@@ -59,7 +60,6 @@ from ..common.rational_bezier import (
 from . import patch_deviation_opencl, patch_split
 
 METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
-MAX_LEVEL = 64
 #: Rounds of measuring the mesh against the surface and raising levels, for the tolerance.
 TOLERANCE_ROUNDS = 16
 #: Barycentric points where each triangle is measured against the surface: its edges' midpoints, its centroid and
