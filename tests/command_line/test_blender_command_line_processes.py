@@ -316,8 +316,10 @@ bpy.ops.object.light_add(type="SUN", location=(0, 0, 5))""")
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     _ok(blender("-c", "tessera", "impostors", tmp_path / "three.blend", *opts,
                 "-o", tmp_path / "one" / "{object}.blend"))
-    for name in ("Cube", "Cube.001", "Cube.002"):
-        farm, one = (_impostor_pixels(bpy_module, tmp_path / f / f"{name}.blend", name) for f in ("farm", "one"))
+    for task in plan["tasks"]:  # the outputs the plan names (Cube.001 -> Cube_001.blend)
+        name, farm_file = task["params"]["Object"], Path(task["outputs"][0])
+        farm = _impostor_pixels(bpy_module, farm_file, name)
+        one = _impostor_pixels(bpy_module, tmp_path / "one" / farm_file.name, name)
         assert farm.keys() == one.keys() and len(farm) == 3
         assert all(np.array_equal(farm[k], one[k]) for k in farm)
     import shlex
