@@ -10,6 +10,11 @@
   analysed in a fresh process, same run: wall time of each and their ratio, the peak resident memory's growth over
   the process's memory before the read (GDAL allocates outside Python, so tracemalloc cannot see it), and whether
   the two tile tables are identical.
+- ``block_task``: what one task of a 4 x 4 farm split costs against one process meshing the whole terrain, each in a
+  fresh process: wall time and bytes read from the file (``/proc/self/io`` rchar) against the file's size, and the
+  task's triangles against the whole mesh's. Today every block task reads and analyses the whole map (the levels of
+  its border depend on its neighbours; voids are filled over whole regions), so a task reads about what one process
+  reads.
 - ``geotiff_split``: the same DEM cut into four files (adjacent tiles) read as one terrain, against the single file:
   time ratio and whether the tile tables are identical.
 Prints one JSON object per case. Run: make bench, or .venv/bin/python bench/geotiff.py
@@ -117,6 +122,47 @@ def child(reader, path, out):
              growth_mib=(_status_kib("VmHWM") - before) / 1024)
 
 
+def _rchar():
+    with open("/proc/self/io") as f:
+        return int(next(line for line in f if line.startswith("rchar:")).split()[1])
+
+
+def block_child(path, block, out):
+    """Mesh the DEM ``path`` for a fixed camera, whole (``block`` "") or one block "c,r,C,R" of a split, in this fresh
+    process; seconds, bytes read and triangles into ``out`` (.npz)."""
+    from tessera.kernels.common.camera import Camera
+    from tessera.kernels.terrain import lod, mesh
+
+    before, t = _rchar(), time.perf_counter()
+    hm, _ = gt.read_geotiff([path])
+    table = tile_table(hm, 64, backend="numpy")
+    half = 0.5 * (SIZE - 1) * hm.texel[0]
+    cam = Camera.looking_at((0.0, -1.2 * half, 0.6 * half), (0.0, 0.0, 0.0), width=1920, height=1080, far=1e7)
+    sel = lod.select(hm, table, cam, lod.TerrainLod())
+    if block:
+        sel = lod.only_block(sel, tuple(int(v) for v in block.split(",")))
+    tris = len(mesh.bake(hm, table, sel).triangles)
+    np.savez(out, seconds=time.perf_counter() - t, read=_rchar() - before, triangles=tris)
+
+
+def compare_block_task(folder, geo):
+    runs = {}
+    for name, block in (("whole", ""), ("block", "1,1,4,4")):
+        out = os.path.join(folder, f"{name}.npz")
+        subprocess.run([sys.executable, __file__, "--block-child", geo, block, out], check=True)
+        runs[name] = np.load(out)
+    w, b = runs["whole"], runs["block"]
+    size = os.path.getsize(geo)
+    print(json.dumps({"case": "block_task", "map": f"{SIZE}x{SIZE} float32, tiles {TILE}², deflate, split 4x4",
+                      "block": "1,1 of 4x4", "one_process_s": round(float(w["seconds"]), 2),
+                      "task_s": round(float(b["seconds"]), 2),
+                      "time_ratio": round(float(b["seconds"] / w["seconds"]), 2),
+                      "one_process_read_of_file": round(float(w["read"]) / size, 2),
+                      "task_read_of_file": round(float(b["read"]) / size, 2),
+                      "task_triangles_share": round(float(b["triangles"]) / max(1, float(w["triangles"])), 3)}),
+          flush=True)
+
+
 def compare_readers(folder, geo):
     runs = {}
     for reader in ("gdal", "tiff"):
@@ -157,6 +203,7 @@ def main():
                       "finite_tiles": bool(np.isfinite(table.h_min).all())}), flush=True)
     os.unlink(raw)
     compare_readers(folder, geo)
+    compare_block_task(folder, geo)
 
     # four adjacent files of a 4097² DEM against the single file
     part = rows_of(tile, 0, 4097, 0, 4097)
@@ -177,5 +224,7 @@ def main():
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--child"]:
         child(*sys.argv[2:5])
+    elif sys.argv[1:2] == ["--block-child"]:
+        block_child(*sys.argv[2:5])
     else:
         main()

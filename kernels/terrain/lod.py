@@ -183,30 +183,42 @@ def _cached(table, key, make):
     return table.derived[key]
 
 
-def _grid_height_at_peak(hm, table, xs, ys, level):
-    """Height at each tile's peak of a level-``level`` grid over the tile: (nty, ntx) float64.
+def _grid_heights_at_peak(hm, table, xs, ys, levels):
+    """Height at each tile's peak of a level-``level`` grid over the tile, for each of ``levels``: a list of (nty, ntx)
+    float64, from one read of the height map (a file's blocks decoded once for every level).
 
     The grid cell around the peak is split along its (i, j)-(i+1, j+1) diagonal, as the mesh splits it.
     """
     (x0, x1), (y0, y1) = xs, ys
     px, py = table.peak_x.astype(np.float64), table.peak_y.astype(np.float64)
-    sx, sy = (x1 - x0) / level, (y1 - y0) / level
-    fx, fy = (px - x0) / sx, (py - y0) / sy
-    i, j = np.minimum(np.floor(fx), level - 1), np.minimum(np.floor(fy), level - 1)
-    u, v = fx - i, fy - j
-    gx0, gy0 = x0 + i * sx, y0 + j * sy
-    gx1, gy1 = x0 + (i + 1) * sx, y0 + (j + 1) * sy
-    z00, z10 = hm.sample(gx0, gy0).astype(np.float64), hm.sample(gx1, gy0).astype(np.float64)
-    z01, z11 = hm.sample(gx0, gy1).astype(np.float64), hm.sample(gx1, gy1).astype(np.float64)
-    lower = u >= v
-    return np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00))
+    cells, gx, gy = [], [], []
+    for level in levels:
+        sx, sy = (x1 - x0) / level, (y1 - y0) / level
+        fx, fy = (px - x0) / sx, (py - y0) / sy
+        i, j = np.minimum(np.floor(fx), level - 1), np.minimum(np.floor(fy), level - 1)
+        cells.append((fx - i, fy - j))
+        gx0, gy0 = x0 + i * sx, y0 + j * sy
+        gx1, gy1 = x0 + (i + 1) * sx, y0 + (j + 1) * sy
+        gx += [gx0, gx1, gx0, gx1]
+        gy += [gy0, gy0, gy1, gy1]
+    z = hm.sample(np.stack(gx), np.stack(gy)).astype(np.float64)  # (4 * len(levels), nty, ntx)
+    out = []
+    for k, (u, v) in enumerate(cells):
+        z00, z10, z01, z11 = z[4 * k:4 * k + 4]
+        lower = u >= v
+        out.append(np.where(lower, z00 + u * (z10 - z00) + v * (z11 - z10), z00 + u * (z11 - z01) + v * (z01 - z00)))
+    return out
 
 
 def _peak_base(hm, table, xs, ys, level):
-    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height."""
-    def make():
-        return (_grid_height_at_peak(hm, table, xs, ys, level) - table.h_max).ravel()
-    return _cached(table, ("peak_dz", level), make)
+    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height. The
+    powers of two up to `MAX_LEVEL` (what the search tries) are read together, once."""
+    key = ("peak_dz", level)
+    if key not in table.derived:
+        levels = [level] if level & (level - 1) else [1 << k for k in range(MAX_LEVEL.bit_length())]
+        for lv, height in zip(levels, _grid_heights_at_peak(hm, table, xs, ys, levels), strict=True):
+            table.derived.setdefault(("peak_dz", lv), (height - table.h_max).ravel())
+    return table.derived[key]
 
 
 def _peak_clip(hm, table, m):
