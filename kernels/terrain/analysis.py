@@ -163,7 +163,7 @@ def _fill_row(table, ty, tx0, tx1, ham_band, h_band, y0):
 
 def quantisation_floor(hm):
     """The HAM (texel units) that rounding to ``hm.quantum`` can make on its own: float (0 for continuous data)."""
-    return HAM_PER_QUANTUM * float(getattr(hm, "quantum", 0.0)) / hm.mean_texel
+    return HAM_PER_QUANTUM * float(hm.quantum) / hm.mean_texel
 
 
 def _discount(table, hm, sl=(slice(None), slice(None))):

@@ -29,7 +29,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
-from .sample_grid import BlockSource, nodata_mask
+from .sample_grid import BlockSource
 
 #: Bytes of GDAL's own block cache (GDAL_CACHEMAX; its default is 5 % of the RAM). Decoded blocks are kept by the
 #: sources themselves (`CACHE_BYTES`), so GDAL needs only enough for the tiles of one band of rows.
@@ -290,15 +290,4 @@ class GdalSource(BlockSource):
         except RasterioError as err:
             raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {os.path.basename(self.path)} failed: "
                                     f"{_gdal_words(err)}") from err
-        nan_nodata = self.nodata is not None and math.isnan(self.nodata)
-        void = np.zeros(raw.shape, bool) if nan_nodata else nodata_mask(raw, self.nodata)  # NaN: isfinite below
-        if mask is not None:
-            void |= mask == 0
-        if self.scale != 1.0 or self.offset != 0.0:
-            out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
-        else:
-            out = raw if raw.dtype == np.float32 else raw.astype(np.float32)  # a fresh array either way
-        if out.dtype.kind == "f" and (raw.dtype.kind == "f" or self.scale != 1.0 or self.offset != 0.0):
-            void |= ~np.isfinite(out)
-        out[void] = np.nan
-        return out
+        return self._heights(raw, None if mask is None else mask == 0)

@@ -108,10 +108,28 @@ def nodata_mask(raw, nodata):
 
 class BlockSource:
     """One file's samples decoded a block of whole rows at a time (file order: row 0 at the top), the last few blocks
-    kept (`CACHE_BYTES`). A subclass sets ``shape`` (H, W) and ``block_rows`` and decodes one block (`_decode`)."""
+    kept (`CACHE_BYTES`). A subclass sets ``shape`` (H, W), ``block_rows``, ``nodata`` (None: none), ``scale`` and
+    ``offset`` (a sample means ``offset + scale * stored``) and decodes one block (`_decode`, through `_heights`)."""
 
     shape = (0, 0)
     block_rows = BLOCK_ROWS
+    nodata = None
+    scale, offset = 1.0, 0.0
+
+    def _heights(self, raw, void=None):
+        """Stored samples ``raw`` (the file's type, a fresh array) as float32 heights after the scale and offset;
+        voids NaN: ``void`` (bool, e.g. a mask band), the no-data value compared as stored, values not finite."""
+        if self.scale != 1.0 or self.offset != 0.0:
+            out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
+        else:
+            out = raw.astype(np.float32, copy=False)
+        bad = ~np.isfinite(out)  # NaN no-data included
+        if self.nodata is not None and not math.isnan(self.nodata):
+            bad |= nodata_mask(raw, self.nodata)
+        if void is not None:
+            bad |= void
+        out[bad] = np.nan
+        return out
 
     def _init_cache(self, cache_bytes):
         self._cache = OrderedDict()  # block index -> (rows, W) float32
@@ -187,13 +205,7 @@ class TiffSource(BlockSource):
                 raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {self.path} failed: {reason}")
         finally:
             inp.close()
-        raw = np.asarray(data).reshape(r1 - r0, lay.width)
-        out = raw.astype(np.float32)
-        void = ~np.isfinite(out) | nodata_mask(raw, self.nodata)
-        if self.scale != 1.0 or self.offset != 0.0:
-            out = (raw.astype(np.float64) * self.scale + self.offset).astype(np.float32)
-        out[void] = np.nan
-        return out
+        return self._heights(np.asarray(data).reshape(r1 - r0, lay.width))
 
 
 class Mosaic(SampleGrid):
