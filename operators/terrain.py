@@ -13,7 +13,7 @@ from ..addon.terrain import data as terrain_data
 from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
 from ..kernels.common.budget import check_bytes
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
-from ..kernels.terrain.lod import box_distance, only_block, select
+from ..kernels.terrain.lod import box_distance, select
 from ..kernels.terrain.mesh import bake, triangle_count
 from .selection import select_only
 
@@ -51,26 +51,36 @@ def _block_property():
         name="Block", size=4, default=WHOLE, min=0, max=4096, options={"SKIP_SAVE"},
         description="Mesh one block of an even split of the terrain's tiles: column, row, columns, rows (0, 0, 2, 2 "
                     "is the lower-left quarter). Blocks of one split meet without cracks, so render-farm tasks can "
-                    "each mesh one; 0, 0, 1, 1 meshes the whole terrain")
+                    "each mesh one, reading only their part of the elevation data; 0, 0, 1, 1 meshes the whole "
+                    "terrain")
 
 
-def _bake_into(context, ob, camera, report, tx, block=WHOLE):
+def _void_index_property():
+    return bpy.props.StringProperty(
+        name="Void Index", subtype="FILE_PATH", options={"SKIP_SAVE"},
+        description="The no-data voids of the elevation files, found and filled once for every block of a farm "
+                    "split (the farm plan writes it), so a block task reads only its part of the data. Empty: the "
+                    "voids are found by scanning the whole data")
+
+
+def _bake_into(context, ob, camera, report, tx, block=WHOLE, void_index=""):
     """Select levels for ``camera``, check the budget, bake and write the mesh (its new mesh tracked by the
     `Transaction` ``tx``). Returns the selection. Raises `EmptyResultError` when the camera sees no tile.
 
-    ``block`` (column, row, columns, rows) meshes only that block's tiles of an even split: levels are chosen for
-    the whole terrain first, so the blocks of one split weld into exactly the whole terrain's mesh. A block the
-    camera does not see gets an empty mesh."""
+    ``block`` (column, row, columns, rows) meshes only that block's tiles of an even split, reading and analysing
+    only the block and the ring of tiles around it: every level is the one the whole terrain gives, so the blocks of
+    one split weld into exactly the whole terrain's mesh. A block the camera does not see gets an empty mesh.
+    ``void_index``: the voids of elevation files from a farm plan (`terrain_data.read_source`)."""
     s = ob.tessera.terrain
     wm = context.window_manager
-    hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)))
+    whole = tuple(block) == WHOLE
+    part = None if whole else tuple(block)
+    hm, table = terrain_data.analysis(ob, progress=lambda done, total: wm.progress_update(int(80 * done / total)),
+                                      block=part, void_index=void_index)
     t0 = time.perf_counter()
     local_camera = object_camera(camera, ob.matrix_world) if camera else None
-    sel = select(hm, table, local_camera, lod_settings(s))
+    sel = select(hm, table, local_camera, lod_settings(s), block=part)
     t_select = time.perf_counter() - t0
-    whole = tuple(block) == WHOLE
-    if not whole:
-        sel = only_block(sel, block)
     n_tris = triangle_count(sel)
     if n_tris == 0 and whole:  # every tile culled: say which of the camera's settings keeps the terrain out
         raise EmptyResultError(_nothing_seen(hm, table, local_camera))
@@ -100,7 +110,7 @@ def _place(context, ob, geo, report):
     else:
         ob.location = (*(at or (0.0, 0.0)), 0.0)
         terrain_data.set_geo_origin(scene, geo)
-    hm, _ = terrain_data.analysis(ob)  # cached: read once
+    hm = terrain_data.height_map(ob)  # read by the bake
     voids = hm.samples.void_count
     what = "none" if not voids else f"{voids:,} samples {'cut out' if hm.samples.cut else 'filled'}"
     (tx, ty), files = geo.texel, len(geo.files)
@@ -125,6 +135,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
     files: bpy.props.CollectionProperty(type=bpy.types.OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})
     directory: bpy.props.StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"})
     block: _block_property()
+    void_index: _void_index_property()
 
     @classmethod
     def poll(cls, context):
@@ -158,7 +169,8 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
             ob.tessera.terrain.is_terrain = True
             ob.location = context.scene.cursor.location
             context.collection.objects.link(ob)
-            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx, self.block)
+            _bake_into(context, ob, _camera_or_none(context, self.camera_source), self.report, tx, self.block,
+                       bpy.path.abspath(self.void_index) if self.void_index else "")
             geo = terrain_data.georeference(ob)
             if geo is not None:
                 _place(context, ob, geo, self.report)
@@ -176,6 +188,7 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     block: _block_property()
+    void_index: _void_index_property()
 
     @classmethod
     def poll(cls, context):
@@ -194,7 +207,8 @@ class TESSERA_OT_terrain_bake(bpy.types.Operator):
         wm.progress_begin(0, 100)
         try:
             camera = camera_for(context, ob.tessera.terrain.camera_source, "Baking a terrain for a camera")
-            _bake_into(context, ob, camera, self.report, tx, self.block)
+            _bake_into(context, ob, camera, self.report, tx, self.block,
+                       bpy.path.abspath(self.void_index) if self.void_index else "")
         finally:
             wm.progress_end()
         return {"FINISHED"}

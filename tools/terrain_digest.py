@@ -46,7 +46,7 @@ def digest(cameras=8):
         for a in (sel.h_edges, sel.v_edges, sel.inner, sel.culled):
             levels.update(np.ascontiguousarray(a).tobytes())
         for block in ((0, 0, 2, 2), (1, 0, 2, 2), (0, 1, 2, 2), (1, 1, 2, 2)):
-            m = mesh.bake(hm, table, lod.only_block(sel, block))
+            m = mesh.bake(hm, table, lod.select(hm, table, cam, settings, block=block))
             meshes.update(m.positions.tobytes())
             meshes.update(m.triangles.tobytes())
     return {"levels": levels.hexdigest()[:16], "meshes": meshes.hexdigest()[:16]}

@@ -113,12 +113,30 @@ def _plan(argv):
             print("tessera: warning: the Log roughness curve and the Log2/As Printed error rules use log2, whose last "
                   "bit can differ between processors: on a farm of mixed machines, blocks may not weld exactly "
                   "(keep --g sqrt --t-min-rule search)", file=sys.stderr, flush=True)
-        steps, tasks = plan.plan_terrain(verb, args, props, frames, mine.blocks)
+        steps, tasks = plan.plan_terrain(verb, args, props, frames, mine.blocks, _void_index(args))
     else:
         files.read_inputs(args.inputs)
         steps, tasks = plan.plan_objects(verb, args, props, verbs.targets(verb, args.objects))
     plan.print_plan(schedulers.render(mine.format, plan.plan_dict(verb, steps, tasks)), args.json)
     return verbs.EXIT_OK
+
+
+def _void_index(args):
+    """Find the no-data voids of the terrain's elevation files once, for every block task, and write them beside the
+    outputs (`plan.void_index_name`): the index's path, or None for a height map without one (an image, a raw file).
+    Reads the whole data once, so that no task has to."""
+    from ..terrain import data as terrain_data
+
+    _, maps = verbs.terrain_inputs(args)
+    settings = verbs.terrain_source(args, maps)
+    if terrain_data.elevation_files(settings) is None:
+        return None
+    path = plan.void_index_name(args.out)
+    verbs._say(f"plan: finding the no-data voids of {os.path.basename(maps[0])} once for every block task")
+    count = []
+    files.write_with(path, lambda target: count.append(terrain_data.write_void_index(settings, target))).commit()
+    verbs._say(f"plan: {count[0]:,} void samples; the void index is {path}")
+    return path
 
 
 def execute(argv):

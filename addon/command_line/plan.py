@@ -9,12 +9,15 @@ runs after the steps it names. Splits:
 - per-object verbs: one task per source object, each writing its own output (``{object}`` in the name; added before
   the extension when the name has none);
 - ``terrain``: ``--blocks CxR`` tasks per frame, one block each, and per frame a ``join`` task (to run after them)
-  that welds the blocks into exactly the mesh one process makes: levels are chosen for the whole terrain in every
-  task, so the blocks' shared edges have one level and one set of points.
+  that welds the blocks into exactly the mesh one process makes: each block's levels are those the whole terrain
+  gives, so the blocks' shared edges have one level and one set of points. A task reads only its block and the ring
+  of tiles around it; the no-data voids of elevation files (filled over whole regions) are found and filled once,
+  when the plan is made, into a void index beside the outputs (`void_index_name`) that every block task reads.
 """
 
 import glob
 import os
+import re
 
 from . import files
 
@@ -49,8 +52,10 @@ def _render_value(p, value):
     return repr(value) if isinstance(value, float) else str(value)
 
 
-def task_argv(verb, args, props, inputs=None, objects=None, out=None, frame=None, block=None):
-    """The command-line words of one task of ``verb``: its parsed ``args`` with the given parts replaced."""
+def task_argv(verb, args, props, inputs=None, objects=None, out=None, frame=None, settings=None):
+    """The command-line words of one task of ``verb``: its parsed ``args`` with the given parts replaced (``settings``:
+    operator settings by identifier, e.g. a terrain's ``block``)."""
+    settings = settings or {}
     argv = [verb.name] + [os.path.abspath(p) for p in (args.inputs if inputs is None else inputs)]
     objects = objects if objects is not None else getattr(args, "objects", None)
     if objects:
@@ -62,7 +67,7 @@ def task_argv(verb, args, props, inputs=None, objects=None, out=None, frame=None
     if frame is not None:
         argv += ["--frame", str(frame)]
     for p in props:
-        value = block if (p.identifier == "block" and block is not None) else getattr(args, p.identifier)
+        value = settings.get(p.identifier, getattr(args, p.identifier))
         if value is None:
             continue
         word = _render_value(p, value)
@@ -104,15 +109,19 @@ def plan_objects(verb, args, props, targets):
     return [_step("Objects", template, ["Object"])], tasks
 
 
-def plan_terrain(verb, args, props, frames, blocks):
+def plan_terrain(verb, args, props, frames, blocks, void_index=None):
     """``blocks`` = (columns, rows) tasks per frame in ``frames`` (None: the one frame), and a join per frame:
     ``(steps, tasks)``. Output names keep their frame pattern (``####``) and each task is given ``--frame``, so a
-    step's tasks differ only in their frame and block."""
+    step's tasks differ only in their frame and block. ``void_index``: the void index every block task reads (made
+    by `void_index_name`'s caller before the plan is printed), None for data without one."""
     cols, rows = blocks
     pattern = _with_part(args.out, BLOCK)
     framed = frames is not None
+    settings = {"block": param("Block")}
+    if void_index:
+        settings["void_index"] = os.path.abspath(void_index)
     block_argv = task_argv(verb, args, props, out=pattern.replace(BLOCK, param("Part")),
-                           frame=param("Frame") if framed else None, block=param("Block"))
+                           frame=param("Frame") if framed else None, settings=settings)
     parts = [os.path.abspath(pattern.replace(BLOCK, f"b{col}-{row}")) for row in range(rows) for col in range(cols)]
     join_argv = ["join"] + parts + ["-o", os.path.abspath(args.out)] + (["--frame", param("Frame")] if framed else [])
     names = ["Frame"] if framed else []
@@ -134,6 +143,17 @@ def plan_terrain(verb, args, props, frames, blocks):
         tasks.append(_task("join" + suffix, fill(join_argv, at), [os.path.abspath(joined)], block_names,
                            step="Join", params=at))
     return steps, tasks
+
+
+def void_index_name(out):
+    """Where a terrain plan writes its void index: beside the outputs ``out`` (a pattern), named after them without
+    their frame and block parts (``terrain_####.blend`` -> ``terrain.tessera-voids``)."""
+    folder, base = os.path.split(os.path.abspath(out))
+    stem = os.path.splitext(base)[0]
+    for part in ("{frame}", BLOCK, "{object}"):
+        stem = stem.replace(part, "")
+    stem = re.sub(r"#+", "", stem).strip("_-. ") or "terrain"
+    return os.path.join(folder, stem + ".tessera-voids")
 
 
 def blocks_arg(text):

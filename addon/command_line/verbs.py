@@ -18,13 +18,14 @@ import re
 import sys
 import time
 from dataclasses import asdict, dataclass, field
+from types import SimpleNamespace
 
 import bpy
 
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.terrain.lod import block_tiles
 from . import files, stopping
-from .options import add_options, chosen, settable
+from .options import add_options, chosen, operator_rna, settable
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -259,19 +260,12 @@ def run_object_verb(verb, args, summary, outputs):
     return EXIT_OK
 
 
-def run_terrain(verb, args, summary, outputs):
-    kwargs = chosen(args, operator_settings(verb))
+def terrain_inputs(args):
+    """The .blend files and the height maps (absolute paths) among a terrain's inputs; `Usage` for what cannot be."""
     blends = [p for p in args.inputs if files.extension(p) == ".blend"]
     maps = [os.path.abspath(p) for p in args.inputs if files.extension(p) != ".blend"]
-    frames = terrain_frames(args)
-    _check_outputs(verb, args, 1)
     if not maps:
         raise Usage("Give a height map (PNG, TIFF/GeoTIFF, .hgt, .asc, .img, .vrt, EXR, .r16/.r32/.raw)")
-    if "block" in kwargs:  # checked before anything is read
-        try:
-            block_tiles(kwargs["block"], (1, 1))
-        except InvalidInputError as err:
-            raise Usage(f"--block: {err}") from None
     for m in maps:
         if os.path.isdir(m):
             raise Usage(f"{m}: is a folder; give a height map file")
@@ -279,6 +273,29 @@ def run_terrain(verb, args, summary, outputs):
             raise Usage(f"{m}: no such file")
     if any(os.path.dirname(m) != os.path.dirname(maps[0]) for m in maps[1:]):
         raise Usage("A terrain's tiles must lie in one folder")
+    return blends, maps
+
+
+def terrain_source(args, maps):
+    """The terrain settings the operator gets for ``maps`` with ``args`` (the operator's defaults where not given),
+    as an object with their names: what `terrain_data.read_source` reads."""
+    values = {p.identifier: p.default for p in operator_rna(VERBS["terrain"].operator).properties
+              if p.identifier != "rna_type" and not getattr(p, "array_length", 0) and p.type != "COLLECTION"}
+    values.update(chosen(args, operator_settings(VERBS["terrain"])))
+    values.update(filepath=maps[0], tile_files=";".join(os.path.basename(m) for m in maps[1:]), source="FILE")
+    return SimpleNamespace(**values)
+
+
+def run_terrain(verb, args, summary, outputs):
+    kwargs = chosen(args, operator_settings(verb))
+    frames = terrain_frames(args)
+    _check_outputs(verb, args, 1)
+    if "block" in kwargs:  # checked before anything is read
+        try:
+            block_tiles(kwargs["block"], (1, 1))
+        except InvalidInputError as err:
+            raise Usage(f"--block: {err}") from None
+    blends, maps = terrain_inputs(args)
     try:
         files.read_inputs(blends)
     except files.FileProblem as err:
@@ -286,7 +303,7 @@ def run_terrain(verb, args, summary, outputs):
     _scene_settings(args)
     kwargs.update(filepath=maps[0], tile_files=";".join(os.path.basename(m) for m in maps[1:]),
                   source="FILE", camera_source="SCENE")
-    bake = {k: v for k, v in kwargs.items() if k == "block"}
+    bake = {k: v for k, v in kwargs.items() if k in ("block", "void_index")}
     scene, source = bpy.context.scene, os.path.basename(maps[0])
     terrain = None
     for frame in frames or [args.frame]:

@@ -13,12 +13,13 @@ import bpy
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.mesh_arrays import MeshArrays
 from ...kernels.terrain import geotiff, heightmap_io
-from ...kernels.terrain.analysis import tile_table
+from ...kernels.terrain.analysis import tile_counts, tile_table
+from ...kernels.terrain.lod import block_region
 from .. import bridge
 from ..preferences import get_preferences
 from .settings import is_elevation_file, source_key
 
-_cache = {}  # object session_uid -> (source key, HeightMap, TileTable, GeoGrid or None)
+_cache = {}  # object session_uid -> (source key, HeightMap, TileTable, GeoGrid or None, tiles analysed or None)
 #: Scene custom property: the model position (x, y), CRS code and kind (1: geographic) that the scene's origin
 #: stands for, set by the first georeferenced terrain, so that later ones (adjacent tiles) land beside it.
 GEO_ORIGIN = "tessera_geo_origin"
@@ -35,18 +36,36 @@ def _unit_metres(scene):
     return scene.unit_settings.scale_length if scene.unit_settings.system != "NONE" else 1.0
 
 
-def read_source(s, scene=None, progress=None):
-    """``(HeightMap, GeoGrid or None)`` named by terrain settings ``s`` (elevation files in the units of
-    ``scene``). Raises `TesseraError` with what to fix."""
+def elevation_files(s):
+    """The files of terrain settings ``s`` when they are elevation data read with their placement and no-data
+    (`geotiff`), else None (a height-map image or raw file)."""
     if s.source == "FILE" and s.filepath and s.georeferenced and is_elevation_file(s.filepath):
         paths = source_paths(s)
         if os.path.isfile(paths[0]) and geotiff.read_geoinfo(paths[0], s.band) is not None:
-            scene = scene or bpy.context.scene
-            hm, geo = geotiff.read_geotiff(paths, voids=s.voids, exaggeration=s.exaggeration,
-                                           budget_bytes=get_preferences().memory_budget_bytes,
-                                           unit_metres=_unit_metres(scene), progress=progress, band=s.band)
-            return dataclasses.replace(hm, offset=s.height_offset), geo
+            return paths
+    return None
+
+
+def read_source(s, scene=None, progress=None, void_index=""):
+    """``(HeightMap, GeoGrid or None)`` named by terrain settings ``s`` (elevation files in the units of
+    ``scene``); ``void_index``: a void index made of the same elevation files (`write_void_index`, by a farm plan),
+    so the voids are not scanned. Raises `TesseraError` with what to fix."""
+    paths = elevation_files(s)
+    if paths is not None:
+        scene = scene or bpy.context.scene
+        hm, geo = geotiff.read_geotiff(paths, voids=s.voids, exaggeration=s.exaggeration,
+                                       budget_bytes=get_preferences().memory_budget_bytes,
+                                       unit_metres=_unit_metres(scene), progress=progress, band=s.band,
+                                       void_index=void_index or None)
+        return dataclasses.replace(hm, offset=s.height_offset), geo
     return _read_plain(s), None
+
+
+def write_void_index(s, path, progress=None):
+    """Scan the elevation files of terrain settings ``s`` (`elevation_files`) for voids once and write what the tasks
+    of a farm split need to ``path`` (`geotiff.write_void_index`): the count of void samples."""
+    return geotiff.write_void_index(elevation_files(s), path, voids=s.voids, progress=progress, band=s.band,
+                                    budget_bytes=get_preferences().memory_budget_bytes)
 
 
 def _read_plain(s):
@@ -66,20 +85,36 @@ def _read_plain(s):
     return heightmap_io.read_heightmap(os.path.normpath(path), raw_size=raw, **scale)
 
 
-def analysis(ob, progress=None, scene=None):
-    """(HeightMap, TileTable) for terrain object ``ob``, read and analysed on first use or after a change."""
+def analysis(ob, progress=None, scene=None, block=None, void_index=""):
+    """(HeightMap, TileTable) for terrain object ``ob``, read and analysed on first use or after a change.
+
+    ``block`` (column, row, columns, rows): only that block of an even split and the ring of tiles around it are
+    analysed (`lod.block_region`: what `lod.select` needs for the block), reading only their samples: one farm task.
+    ``void_index``: see `read_source`."""
     s = ob.tessera.terrain
     scene = scene or bpy.context.scene
     key = (source_key(s), _unit_metres(scene))
     hit = _cache.get(ob.session_uid)
     if hit is not None and hit[0] == key:
-        return hit[1], hit[2]
+        region = None if block is None else block_region(block, hit[2].counts)
+        if hit[4] is None or hit[4] == region:  # a whole table serves every block
+            return hit[1], hit[2]
     half = None if progress is None else (lambda done, total: progress(done, 2 * total))
-    hm, geo = read_source(s, scene, half)
+    if hit is not None and hit[0] == key:
+        hm, geo = hit[1], hit[3]
+    else:
+        hm, geo = read_source(s, scene, half, void_index)
+    region = None if block is None else block_region(block, tile_counts(hm.width, hm.height, s.tile_size))
     rest = None if progress is None else (lambda done, total: progress(total + done, 2 * total))
-    table = tile_table(hm, s.tile_size, progress=rest)
-    _cache[ob.session_uid] = (key, hm, table, geo)
+    table = tile_table(hm, s.tile_size, progress=rest, tiles=region)
+    _cache[ob.session_uid] = (key, hm, table, geo, region)
     return hm, table
+
+
+def height_map(ob):
+    """The `HeightMap` of terrain object ``ob`` (after `analysis`), or None."""
+    hit = _cache.get(ob.session_uid)
+    return None if hit is None else hit[1]
 
 
 def georeference(ob):

@@ -133,16 +133,20 @@ def _windows(band, tile_size, count, fill):
 
 
 def _analyse(table, hm, ty0, ty1, tx0, tx1, progress=None):
-    """Fill tiles rows ``[ty0, ty1)``, columns ``[tx0, tx1)`` of ``table`` from height map ``hm``."""
+    """Fill tiles rows ``[ty0, ty1)``, columns ``[tx0, tx1)`` of ``table`` from height map ``hm``, reading only those
+    tiles' samples and their HAM halo (`HAM_REACH` samples each side)."""
     ts, (n_rows, width) = table.tile_size, table.shape
     inv_texel = np.float32(1.0 / hm.mean_texel)
     c0, c1 = tx0 * ts, min(width, tx1 * ts + 1)
+    # the halo columns make the HAM of columns [c0, c1) exact: the Sobel passes clamp at the window's edges, which
+    # changes only the HAM_REACH columns next to an edge that is not the map's own
+    w0, w1 = max(0, c0 - HAM_REACH), min(width, c1 + HAM_REACH)
     for ty in range(ty0, ty1):
         y0, y1 = (int(v) for v in tile_bounds(ty, ts, n_rows))
         lo = max(0, y0 - HAM_REACH)
-        rows = hm.rows(lo, min(n_rows, y1 + 1 + HAM_REACH))  # the band and its HAM halo, read once
-        band = ham_rows(lambda idx, rows=rows, lo=lo: rows[idx - lo] * inv_texel, n_rows, y0, y1)[:, c0:c1]
-        _fill_row(table, ty, tx0, tx1, band, rows[y0 - lo:y1 + 1 - lo, c0:c1], y0)
+        rows = hm.window(lo, min(n_rows, y1 + 1 + HAM_REACH), w0, w1)  # the band and its HAM halo, read once
+        band = ham_rows(lambda idx, rows=rows, lo=lo: rows[idx - lo] * inv_texel, n_rows, y0, y1)[:, c0 - w0:c1 - w0]
+        _fill_row(table, ty, tx0, tx1, band, rows[y0 - lo:y1 + 1 - lo, c0 - w0:c1 - w0], y0)
         if progress is not None:
             progress(ty - ty0 + 1, ty1 - ty0)
 
@@ -173,17 +177,26 @@ def _discount(table, hm, sl=(slice(None), slice(None))):
         table.ham_max[sl] = np.maximum(table.ham_max[sl] - np.float32(floor), 0)
 
 
-def tile_table(hm, tile_size=64, backend="auto", progress=None):
+def tile_table(hm, tile_size=64, backend="auto", progress=None, tiles=None):
     """Analyse a `heightmap_io.HeightMap` into a `TileTable`.
 
     numpy works band by band (one tile row at a time, bounded memory: memory-mapped maps of any size);
     OpenCL (``backend="opencl"`` or "auto" with a device) analyses the whole map on the device when it fits
     in memory as float32 (a map read from disk only up to `OUT_OF_CORE_DEVICE_BYTES`). ``progress(done, total)``
-    is called after each band.
+    is called after each band. ``tiles`` = (tx0, ty0, tx1, ty1) (end exclusive) analyses only those tiles (numpy,
+    reading only their samples: one farm task's block and its ring, `lod.block_region`); the others stay zero. The
+    same float32 operations in the same order on either backend: every analysed tile is the whole map's, bit for bit.
     """
     table = TileTable.empty((hm.height, hm.width), tile_size)
-    runtime = backend_runtime(backend, "the terrain analysis")
     ntx, nty = table.counts
+    if tiles is not None and tuple(tiles) != (0, 0, ntx, nty):
+        tx0, ty0, tx1, ty1 = (int(v) for v in tiles)
+        if not (0 <= tx0 < tx1 <= ntx and 0 <= ty0 < ty1 <= nty):
+            raise InvalidInputError(f"Tiles {tuple(tiles)} are not inside the {ntx} x {nty} tiles of the map")
+        _analyse(table, hm, ty0, ty1, tx0, tx1, progress)
+        _discount(table, hm, (slice(ty0, ty1), slice(tx0, tx1)))
+        return table
+    runtime = backend_runtime(backend, "the terrain analysis")
     if runtime is not None and _fits_device(runtime, hm):
         from .opencl_path import analyse_on_device
 

@@ -29,15 +29,11 @@ from collections import OrderedDict
 import numpy as np
 
 from ..common.errors import InvalidInputError, TesseraError
-from .sample_grid import BlockSource
+from .sample_grid import BLOCK_ROWS, CACHE_BYTES, BlockSource, block_shape
 
 #: Bytes of GDAL's own block cache (GDAL_CACHEMAX; its default is 5 % of the RAM). Decoded blocks are kept by the
 #: sources themselves (`CACHE_BYTES`), so GDAL needs only enough for the tiles of one band of rows.
 GDAL_CACHE_BYTES = 32 * 2**20
-#: Bytes of decoded float32 blocks a source keeps (at least two blocks whatever their size).
-CACHE_BYTES = 64 * 2**20
-#: Rows per block read (whole tile rows of a tiled file, at least this many rows).
-BLOCK_ROWS = 256
 #: Band unit names (GDAL's GetUnitType, lower case) -> metres.
 UNIT_METRES = {
     "m": 1.0, "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0,
@@ -215,16 +211,10 @@ def horizontal(ds, name):
     return False, float(factor), code
 
 
-def block_rows(ds, band):
-    """Rows per block read: whole tile rows, at least `BLOCK_ROWS`."""
-    tile = int(ds.block_shapes[band - 1][0])
-    return tile * max(1, -(-BLOCK_ROWS // tile)) if 1 < tile < ds.height else BLOCK_ROWS
-
-
 class GdalSource(BlockSource):
-    """One band of a GDAL raster, decoded a block of rows at a time (`sample_grid.BlockSource`; file order: row 0 at
-    the top); float32 heights in stored units after the band's scale and offset, voids (no-data, the mask band, NaN)
-    as NaN. The dataset stays open while the source lives (opened again after pickling or `close`)."""
+    """One band of a GDAL raster, decoded a block at a time (`sample_grid.BlockSource`; file order: row 0 at the
+    top); float32 heights in stored units after the band's scale and offset, voids (no-data, the mask band, NaN) as
+    NaN. The dataset stays open while the source lives (opened again after pickling or `close`)."""
 
     def __init__(self, path, band=1, warp=False, shape=None):
         self.path, self.band, self.warp = path, band, warp
@@ -232,7 +222,14 @@ class GdalSource(BlockSource):
         self._io = threading.Lock()
         ds, src = self._open()
         self.shape = shape or (src.height, src.width)
-        self.block_rows = block_rows(src, band) if not warp else BLOCK_ROWS
+        # a warp is read in whole-width bands: GDAL's warper approximates its transform per chunk, so its values may
+        # depend on the window asked for; the same bands for every reader keep every sample one value
+        if warp:
+            self.block_rows = BLOCK_ROWS
+        else:
+            tile = tuple(int(v) for v in src.block_shapes[band - 1])
+            self.block_rows, cols = block_shape(tile, src.width, src.height)
+            self.block_cols = 0 if cols >= self.shape[1] else cols
         self._init_cache(CACHE_BYTES)
         self.scale = float(ds.scales[band - 1] or 1.0)
         self.offset = float(ds.offsets[band - 1] or 0.0)
@@ -270,18 +267,15 @@ class GdalSource(BlockSource):
         self.__dict__.update(state)
         self._io = threading.Lock()
 
-    def block(self, index):
+    def block(self, bi, bj=0):
         with self._io:  # one dataset handle: GDAL's are not shared between threads
-            return super().block(index)
+            return super().block(bi, bj)
 
-    def _decode(self, index):
+    def _decode(self, r0, r1, c0, c1):
         from rasterio.errors import RasterioError
         from rasterio.windows import Window
 
-        h, w = self.shape
-        r0 = index * self.block_rows
-        r1 = min(h, r0 + self.block_rows)
-        window = Window(0, r0, w, r1 - r0)
+        window = Window(c0, r0, c1 - c0, r1 - r0)
         _, src = self._open()
         b = 1 if self.warp else self.band
         try:

@@ -20,6 +20,7 @@ Several files of one DEM (adjacent tiles, each with its own placement) are laid 
 sample spacing, the units and the grid: their offsets must be whole samples. Samples no file covers are voids.
 """
 
+import hashlib
 import math
 import os
 from dataclasses import dataclass
@@ -353,29 +354,76 @@ def _source(info):
     return TiffSource(info.path, layout, info.nodata, info.height_scale, info.height_offset)
 
 
-def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_metres=1.0, progress=None, band=0):
+def read_geotiff(paths, voids="FILL", budget_bytes=0, exaggeration=1.0, unit_metres=1.0, progress=None, band=0,
+                 void_index=None):
     """A terrain `HeightMap` from GeoTIFFs ``paths`` (one DEM, one file or several adjacent ones) and its
     `GeoGrid`: ``(hm, geo)``.
 
     voids: "FILL" (filled from their valid neighbours) or "HOLES" (filled for the analysis, cut from the mesh);
     budget_bytes: the memory budget the void windows must fit; exaggeration: a factor on the heights; unit_metres:
     metres per world unit (Blender's Unit Scale), so texels and heights come out in scene units;
-    progress(done, total): the void scan's bands; band: see `read_geoinfo`. Heights are
-    ``exaggeration * vertical / unit_metres * sample``: a valid sample keeps its value exactly when the factor is 1."""
+    progress(done, total): the void scan's bands; band: see `read_geoinfo`; void_index: the path of a void index
+    `write_void_index` made of the same data (a farm's tasks share one): the voids are taken from it, not scanned, so
+    only the windows asked for are ever read. Heights are ``exaggeration * vertical / unit_metres * sample``: a valid
+    sample keeps its value exactly when the factor is 1."""
     from .heightmap_io import HeightMap
-    from .void_fill import FilledGrid
 
-    if voids not in ("FILL", "HOLES"):
-        raise InvalidInputError(f"Voids must be FILL or HOLES; got {voids!r}")
     if not (np.isfinite(unit_metres) and unit_metres > 0):
         raise InvalidInputError(f"The unit scale must be positive; got {unit_metres!r}")
-    geo = open_geotiffs(paths, band)
-    names = ", ".join(os.path.basename(i.path) for i in geo.files)
-    filled = FilledGrid(geo.grid, cut=voids == "HOLES", budget_bytes=budget_bytes, name=names, progress=progress)
+    geo, filled = _filled_grid(paths, voids, budget_bytes, progress, band, void_index)
     tx, ty = (t / unit_metres for t in geo.texel)
     same = abs(tx - ty) <= GRID_TOLERANCE * tx
     scale = exaggeration * geo.vertical / unit_metres
     quantum = max(info.quantum for info in geo.files) * abs(scale)  # integer files: their step, in world units
-    hm = HeightMap(filled, texel_size=tx, texel_size_y=0.0 if same else ty, scale=scale, source=names,
+    hm = HeightMap(filled, texel_size=tx, texel_size_y=0.0 if same else ty, scale=scale, source=filled.name,
                    quantum=quantum)
     return hm, geo
+
+
+def _filled_grid(paths, voids, budget_bytes, progress, band, void_index=None):
+    """The `GeoGrid` of ``paths`` and its samples with the voids filled (`void_fill.FilledGrid`)."""
+    from .void_fill import FilledGrid, VoidIndex
+
+    if voids not in ("FILL", "HOLES"):
+        raise InvalidInputError(f"Voids must be FILL or HOLES; got {voids!r}")
+    geo = open_geotiffs(paths, band)
+    names = ", ".join(os.path.basename(i.path) for i in geo.files)
+    index = None
+    if void_index is not None:
+        index = VoidIndex(void_index)
+        made_of = index.header.get("source")
+        if made_of != data_fingerprint(geo, band):
+            raise InvalidInputError(f"The void index {os.path.basename(void_index)} was made of other data than "
+                                    f"{names} (a file was changed or replaced since): make the farm plan again")
+    return geo, FilledGrid(geo.grid, cut=voids == "HOLES", budget_bytes=budget_bytes, name=names,
+                           progress=progress, index=index)
+
+
+#: Bytes read from each end of a file for its fingerprint (the TIFF header and tile tables live there).
+FINGERPRINT_BYTES = 64 * 1024
+
+
+def data_fingerprint(geo, band=0):
+    """What identifies the samples of a `GeoGrid` cheaply on every machine of a farm that sees the same files: each
+    file's name, size, modification time (whole seconds: file-sharing protocols keep no finer one alike) and a hash of
+    its first and last `FINGERPRINT_BYTES` (the header and tile tables), its place on the grid, and the band: a hex
+    string. Reading the whole file would defeat the point (a task reads only its block)."""
+    digest = hashlib.sha256(f"band {band}".encode())
+    for (source, col, row), info in zip(geo.grid.placements, geo.files, strict=True):
+        st = os.stat(info.path)
+        size = st.st_size
+        digest.update(f"|{os.path.basename(info.path)} {size} {int(st.st_mtime)} {col} {row} {source.shape}|".encode())
+        with open(info.path, "rb") as f:
+            digest.update(f.read(FINGERPRINT_BYTES))
+            f.seek(max(0, size - FINGERPRINT_BYTES))
+            digest.update(f.read(FINGERPRINT_BYTES))
+    return digest.hexdigest()
+
+
+def write_void_index(paths, path, voids="FILL", budget_bytes=0, progress=None, band=0):
+    """Scan the elevation files ``paths`` for voids once, fill them, and write the result to ``path`` for the tasks
+    of a farm (`read_geotiff`'s ``void_index``): returns the count of void samples. Reads the whole data once; the
+    caller makes the write whole (a temporary name, then a rename)."""
+    geo, filled = _filled_grid(paths, voids, budget_bytes, progress, band)
+    filled.save_index(path, data_fingerprint(geo, band))
+    return filled.void_count

@@ -106,7 +106,12 @@ class HeightMap:
 
     def rows(self, y0, y1):
         """World heights of rows ``[y0, y1)``: (y1 - y0, W) float32 (a copy; the samples are untouched)."""
-        band = np.asarray(self.samples[y0:y1], np.float32)
+        return self.window(y0, y1, 0, self.width)
+
+    def window(self, y0, y1, x0, x1):
+        """World heights of rows ``[y0, y1)``, columns ``[x0, x1)``: (y1 - y0, x1 - x0) float32 (a copy); a map read
+        from a file reads only the blocks the window covers."""
+        band = np.asarray(self.samples[y0:y1, x0:x1], np.float32)
         return (np.float32(self.offset) + np.float32(self.unit) * band).astype(np.float32)
 
     def heights(self):

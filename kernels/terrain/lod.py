@@ -336,31 +336,80 @@ def block_tiles(block, counts):
     return range(ntx * col // cols, ntx * (col + 1) // cols), range(nty * row // rows, nty * (row + 1) // rows)
 
 
-def only_block(selection, block):
-    """``selection`` with every tile outside ``block`` (see `block_tiles`) culled: a new `Selection`. The levels stay
-    those chosen for the whole terrain, so the blocks of a split, meshed apart, weld into the whole mesh."""
-    xs, ys = block_tiles(block, selection.culled.shape[::-1])
-    inside = np.zeros_like(selection.culled)
-    inside[ys.start:ys.stop, xs.start:xs.stop] = True
-    return replace(selection, culled=selection.culled | ~inside)
+def block_region(block, counts):
+    """The tiles a block's levels depend on: the block's own and the ring of tiles around it (each edge level takes the
+    larger T_max and T_min of its two tiles), as (tx0, ty0, tx1, ty1), end exclusive, clipped to the ``counts`` =
+    (ntx, nty) tile grid. `block_tiles` gives the block."""
+    xs, ys = block_tiles(block, counts)
+    ntx, nty = counts
+    return max(0, xs.start - 1), max(0, ys.start - 1), min(ntx, xs.stop + 1), min(nty, ys.stop + 1)
 
 
-def select(hm, table, camera, settings=TerrainLod()):
+def _region_table(table, region):
+    """The tile table of ``region`` (tx0, ty0, tx1, ty1) as a `TileTable` of its own (sample coordinates and the map's
+    shape kept), made once per table and region."""
+    def make():
+        tx0, ty0, tx1, ty1 = region
+        sl = (slice(ty0, ty1), slice(tx0, tx1))
+        return replace(table, ham_max=table.ham_max[sl], h_min=table.h_min[sl], h_max=table.h_max[sl],
+                       peak_x=table.peak_x[sl], peak_y=table.peak_y[sl], derived={})
+    return _cached(table, ("region", tuple(region)), make)
+
+
+def _only_block(sel, region, counts, block):
+    """The selection ``sel`` of the tiles of ``region`` laid on the whole ``counts`` = (ntx, nty) tile grid, every tile
+    outside ``block`` culled (level 1 outside the region: nothing there is meshed)."""
+    tx0, ty0, tx1, ty1 = region
+    ntx, nty = counts
+    sl = (slice(ty0, ty1), slice(tx0, tx1))
+
+    def laid(values, shape, at):
+        out = np.ones(shape, values.dtype)
+        out[at] = values
+        return out
+
+    xs, ys = block_tiles(block, counts)
+    culled = np.ones((nty, ntx), bool)
+    culled[ys.start:ys.stop, xs.start:xs.stop] = sel.culled[ys.start - ty0:ys.stop - ty0, xs.start - tx0:xs.stop - tx0]
+    return Selection(laid(sel.t_max, (nty, ntx), sl), laid(sel.t_min, (nty, ntx), sl),
+                     laid(sel.edge, (nty, ntx, 4), sl), laid(sel.inner, (nty, ntx), sl), culled,
+                     laid(sel.h_edges, (nty + 1, ntx), (slice(ty0, ty1 + 1), slice(tx0, tx1))),
+                     laid(sel.v_edges, (nty, ntx + 1), (slice(ty0, ty1), slice(tx0, tx1 + 1))), sel.spacing,
+                     None if sel.inner_y is None else laid(sel.inner_y, (nty, ntx), sl))
+
+
+def select(hm, table, camera, settings=TerrainLod(), block=None):
     """Edge and inner levels of every tile for ``camera`` (a `camera.Camera` in terrain-local space).
 
     With ``camera=None`` the result is view-independent: every level is its T_max (the terrain as close up
     as it ever needs to be), nothing is culled.
+
+    ``block`` = (column, row, columns, rows), one block of an even split (`block_tiles`): every tile outside it is
+    culled, and only the block and the ring around it (`block_region`) are looked at, so ``table`` needs only those
+    tiles analysed and only their samples are read. Every level is computed per tile from the same inputs as for the
+    whole terrain, so the blocks of a split, meshed apart, weld into exactly the whole terrain's mesh.
     """
     if table.shape != (hm.height, hm.width):
         raise InvalidInputError("The tile table was made for a different height map; analyse the map again")
+    if block is not None:
+        counts = table.counts
+        region = block_region(block, counts)
+        sel = _select(hm, _region_table(table, region), camera, settings, region[:2])
+        return _only_block(sel, region, counts, block)
+    return _select(hm, table, camera, settings, (0, 0))
+
+
+def _select(hm, table, camera, settings, first):
+    """`select` over the tiles of ``table``, whose first tile is tile ``first`` = (tx0, ty0) of the map."""
     ntx, nty = table.counts
+    tx0, ty0 = first
     ts = table.tile_size
     # "a quad always covers a texel" ([Nunes 2011] §5.4.2): no level above the tile's size in texels
     settings = replace(settings, max_level=min(settings.max_level, ts))
     if settings.mode == "UNIFORM":  # the top level everywhere, whole: one quad per texel, partial tiles included
         settings = replace(settings, levels="INTEGER")
-    xb = tile_bounds(np.arange(ntx), ts, hm.width)
-    yb = tile_bounds(np.arange(nty), ts, hm.height)
+    xb = tile_bounds(np.arange(tx0, tx0 + ntx), ts, hm.width)
+    yb = tile_bounds(np.arange(ty0, ty0 + nty), ts, hm.height)
     xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
     ys = tuple(np.broadcast_to(b[:, None].astype(np.float64), (nty, ntx)) for b in yb)
     top = float(settings.max_level)

@@ -128,11 +128,15 @@ def bake(hm, table, selection):
         lmap = np.stack(cols, 1)
         tri_parts.append(lmap[:, tmpl].reshape(-1, 3))
     tris = np.concatenate(tri_parts) if tri_parts else np.zeros((0, 3), np.int64)
-    holes = hm.void_at(samples[:, 0], samples[:, 1])  # no-data cut out: a triangle with a corner on a void goes
-    if holes is not None and holes.any():
-        tris = tris[~holes[tris].any(axis=1)]
     used = np.zeros(samples.shape[0], bool)
     used[tris.ravel()] = True
+    holes = hm.void_at(samples[used, 0], samples[used, 1])  # no-data cut: a triangle with a corner on a void goes
+    if holes is not None and holes.any():  # (asked of the used points only: a block reads only its own samples)
+        on_void = np.zeros(samples.shape[0], bool)
+        on_void[used] = holes
+        tris = tris[~on_void[tris].any(axis=1)]
+        used[:] = False
+        used[tris.ravel()] = True
     remap = np.cumsum(used) - 1
     samples = samples[used]
     z = hm.sample(samples[:, 0], samples[:, 1])

@@ -1,11 +1,12 @@
 """Height samples that are never held whole: TIFF images read block by block, several files on one grid.
 
-A `SampleGrid` answers the two questions the terrain asks of its samples: a band of whole rows (the analysis,
-the GPU preview) and the values at scattered points (the mesh). Rows count from the bottom (row 0 is the
-southern edge, Blender's image order); files store their top row first.
+A `SampleGrid` answers the two questions the terrain asks of its samples: a window of rows and columns (the
+analysis, the GPU preview; a farm task reads only its block's) and the values at scattered points (the mesh). Rows
+count from the bottom (row 0 is the southern edge, Blender's image order); files store their top row first.
 
 `TiffSource` decodes one TIFF's samples through OpenImageIO (every compression and predictor its libtiff
-reads) a block of whole tile rows or strips at a time, keeping the last few blocks; `Mosaic` lays several
+reads) a block at a time (whole tiles of a tiled file, whole-width strips of a striped one), keeping the last few
+blocks; `Mosaic` lays several
 sources on one grid by their sample offsets (a DEM split over adjacent files), where a sample no file covers is a
 void. Values are float32; voids (no file, the file's no-data value, NaN) are NaN here, and the layer above
 (`void_fill.FilledGrid`) fills or cuts them before any height reaches the terrain.
@@ -24,6 +25,8 @@ from ..common.image_io import oiio_module
 CACHE_BYTES = 64 * 2**20
 #: Rows per block of a striped file (tiled files use whole tile rows, at least this many rows).
 BLOCK_ROWS = 256
+#: Columns per block of a tiled file (whole tiles, at least this many columns); striped files decode whole rows.
+BLOCK_COLS = 256
 #: Sample formats read exactly as float32.
 _EXACT = {"int8", "uint8", "int16", "uint16", "half", "float"}
 _NUMERIC = _EXACT | {"int32", "uint32", "double"}
@@ -31,37 +34,45 @@ _NUMERIC = _EXACT | {"int32", "uint32", "double"}
 
 class SampleGrid:
     """Read-only (H, W) float32 samples, row 0 at the bottom, answering ``grid[y0:y1]`` (a band of rows,
-    (y1 - y0, W)) and ``grid[ys, xs]`` (int arrays of equal shape -> values of that shape)."""
+    (y1 - y0, W)), ``grid[y0:y1, x0:x1]`` (a window, (y1 - y0, x1 - x0)) and ``grid[ys, xs]`` (int arrays of equal
+    shape -> values of that shape)."""
 
     ndim = 2
     dtype = np.dtype(np.float32)
     shape = (0, 0)
 
-    def band(self, y0, y1):  # pragma: no cover - the interface
+    def window(self, y0, y1, x0, x1):  # pragma: no cover - the interface
+        """Rows ``[y0, y1)`` (from the bottom), columns ``[x0, x1)``: (y1 - y0, x1 - x0) float32."""
         raise NotImplementedError
 
     def points(self, ys, xs):  # pragma: no cover - the interface
         raise NotImplementedError
+
+    def band(self, y0, y1):
+        """Whole rows ``[y0, y1)``: (y1 - y0, W) float32."""
+        return self.window(y0, y1, 0, self.shape[1])
 
     def __len__(self):
         return self.shape[0]
 
     def __getitem__(self, key):
         if isinstance(key, slice):
-            y0, y1, step = key.indices(self.shape[0])
-            if step != 1:
-                raise IndexError("sample grids give bands of consecutive rows")
-            return self.band(y0, max(y0, y1))
+            key = (key, slice(None))
+        if isinstance(key, tuple) and len(key) == 2 and all(isinstance(k, slice) for k in key):
+            (y0, y1, sy), (x0, x1, sx) = (k.indices(n) for k, n in zip(key, self.shape, strict=True))
+            if sy != 1 or sx != 1:
+                raise IndexError("sample grids give windows of consecutive rows and columns")
+            return self.window(y0, max(y0, y1), x0, max(x0, x1))
         if isinstance(key, tuple) and len(key) == 2:
             ys, xs = np.broadcast_arrays(np.asarray(key[0], np.int64), np.asarray(key[1], np.int64))
             return self.points(ys, xs)
-        raise IndexError(f"sample grids take a row slice or two index arrays, not {key!r}")
+        raise IndexError(f"sample grids take row and column slices or two index arrays, not {key!r}")
 
 
 @dataclass(frozen=True)
 class TiffLayout:
     """What a TIFF's header says about its samples: width, height, channels, format name (OpenImageIO's),
-    block rows (whole tile rows or strips), and whether it is tiled."""
+    block rows (whole tile rows or strips) and columns (whole tiles, or the width), and whether it is tiled."""
 
     width: int
     height: int
@@ -69,6 +80,7 @@ class TiffLayout:
     format: str
     block_rows: int
     tiled: bool
+    block_cols: int = 0
 
 
 def tiff_layout(path):
@@ -81,12 +93,22 @@ def tiff_layout(path):
         spec = inp.spec()
         fmt = str(spec.format)
         tile = int(spec.tile_height) if spec.tile_width else 0
+        tile_w = int(spec.tile_width)
     finally:
         inp.close()
     if fmt not in _NUMERIC:
         raise InvalidInputError(f"{path} stores {fmt} samples; elevation data must be integers or floats")
-    rows = tile * max(1, -(-BLOCK_ROWS // tile)) if tile else BLOCK_ROWS
-    return TiffLayout(int(spec.width), int(spec.height), int(spec.nchannels), fmt, rows, bool(tile))
+    rows, cols = block_shape((tile, tile_w) if tile else None, int(spec.width), int(spec.height))
+    return TiffLayout(int(spec.width), int(spec.height), int(spec.nchannels), fmt, rows, bool(tile), cols)
+
+
+def block_shape(tile, width, height):
+    """Rows and columns of the blocks read from a ``width`` x ``height`` file stored in ``tile`` = (rows, columns)
+    blocks (strips: as wide as the file; None: unknown strips): whole tiles, at least `BLOCK_ROWS` x `BLOCK_COLS`;
+    strips in `BLOCK_ROWS` (or whole strips) of the whole width, since a strip is decoded whole."""
+    rows, cols = tile or (0, width)
+    rows = rows * max(1, -(-BLOCK_ROWS // rows)) if 1 < rows < height else BLOCK_ROWS
+    return rows, width if cols >= width else min(width, cols * max(1, -(-BLOCK_COLS // cols)))
 
 
 def nodata_mask(raw, nodata):
@@ -107,12 +129,14 @@ def nodata_mask(raw, nodata):
 
 
 class BlockSource:
-    """One file's samples decoded a block of whole rows at a time (file order: row 0 at the top), the last few blocks
-    kept (`CACHE_BYTES`). A subclass sets ``shape`` (H, W), ``block_rows``, ``nodata`` (None: none), ``scale`` and
-    ``offset`` (a sample means ``offset + scale * stored``) and decodes one block (`_decode`, through `_heights`)."""
+    """One file's samples decoded a block at a time (file order: row 0 at the top): blocks of ``block_rows`` rows and
+    ``block_cols`` columns (0: the whole width), the last few kept (`CACHE_BYTES`), so a window reads only the blocks
+    it covers. A subclass sets ``shape`` (H, W), the block shape, ``nodata`` (None: none), ``scale`` and ``offset``
+    (a sample means ``offset + scale * stored``) and decodes one block (`_decode`, through `_heights`)."""
 
     shape = (0, 0)
     block_rows = BLOCK_ROWS
+    block_cols = 0
     nodata = None
     scale, offset = 1.0, 0.0
 
@@ -131,44 +155,64 @@ class BlockSource:
         out[bad] = np.nan
         return out
 
-    def _init_cache(self, cache_bytes):
-        self._cache = OrderedDict()  # block index -> (rows, W) float32
-        self._keep = max(2, cache_bytes // max(1, self.block_rows * self.shape[1] * 4))
+    @property
+    def _cols(self):
+        return self.block_cols or self.shape[1]
 
-    def _decode(self, index):  # pragma: no cover - the interface
+    def _init_cache(self, cache_bytes):
+        self._cache = OrderedDict()  # (block row, block column) -> (rows, columns) float32
+        self._keep = max(2, cache_bytes // max(1, self.block_rows * self._cols * 4))
+
+    def _decode(self, r0, r1, c0, c1):  # pragma: no cover - the interface
+        """File rows ``[r0, r1)``, columns ``[c0, c1)`` (one block): float32 heights, voids NaN."""
         raise NotImplementedError
 
-    def block(self, index):
-        """Decoded rows of block ``index``: (rows, W) float32 (file order), voids as NaN."""
-        hit = self._cache.get(index)
+    def block(self, bi, bj=0):
+        """Decoded block ``(bi, bj)`` (block row, block column): (rows, columns) float32 (file order), voids NaN."""
+        key = (bi, bj)
+        hit = self._cache.get(key)
         if hit is not None:
-            self._cache.move_to_end(index)
+            self._cache.move_to_end(key)
             return hit
-        data = self._decode(index)
-        self._cache[index] = data
+        (h, w), b, c = self.shape, self.block_rows, self._cols
+        data = self._decode(bi * b, min(h, (bi + 1) * b), bj * c, min(w, (bj + 1) * c))
+        self._cache[key] = data
         while len(self._cache) > self._keep:
             self._cache.popitem(last=False)
         return data
 
+    def window(self, r0, r1, c0, c1):
+        """File rows ``[r0, r1)``, columns ``[c0, c1)``: (r1 - r0, c1 - c0) float32, voids NaN; only the blocks the
+        window covers are decoded."""
+        b, c = self.block_rows, self._cols
+        if r1 <= r0 or c1 <= c0:
+            return np.empty((max(0, r1 - r0), max(0, c1 - c0)), np.float32)
+        bands = []
+        for bi in range(r0 // b, (r1 - 1) // b + 1):
+            lo = bi * b
+            rs = slice(max(r0, lo) - lo, min(r1, lo + b) - lo)
+            parts = []
+            for bj in range(c0 // c, (c1 - 1) // c + 1):
+                left = bj * c
+                parts.append(self.block(bi, bj)[rs, max(c0, left) - left:min(c1, left + c) - left])
+            bands.append(parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1))
+        return bands[0] if len(bands) == 1 else np.concatenate(bands)
+
     def rows(self, r0, r1):
         """File rows ``[r0, r1)``: (r1 - r0, W) float32, voids NaN."""
-        b = self.block_rows
-        parts = []
-        for index in range(r0 // b, (r1 - 1) // b + 1):
-            lo = index * b
-            parts.append(self.block(index)[max(r0, lo) - lo:min(r1, lo + b) - lo])
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+        return self.window(r0, r1, 0, self.shape[1])
 
     def points(self, rows, cols):
         """Values at file rows and columns (int64 (n,) each, inside the image): (n,) float32."""
         out = np.empty(rows.shape, np.float32)
-        block = rows // self.block_rows
-        order = np.argsort(block, kind="stable")
-        edges = np.flatnonzero(np.diff(block[order])) + 1
+        bi, bj = rows // self.block_rows, cols // self._cols
+        key = bi * (self.shape[1] // self._cols + 1) + bj
+        order = np.argsort(key, kind="stable")
+        edges = np.flatnonzero(np.diff(key[order])) + 1
         for run in np.split(order, edges):
             if run.size:
-                index = int(block[run[0]])
-                out[run] = self.block(index)[rows[run] - index * self.block_rows, cols[run]]
+                i, j = int(bi[run[0]]), int(bj[run[0]])
+                out[run] = self.block(i, j)[rows[run] - i * self.block_rows, cols[run] - j * self._cols]
         return out
 
 
@@ -183,21 +227,20 @@ class TiffSource(BlockSource):
         self.path, self.layout, self.nodata = path, layout, nodata
         self.scale, self.offset = float(scale), float(offset)
         self.shape, self.block_rows = (layout.height, layout.width), layout.block_rows
+        self.block_cols = layout.block_cols if layout.tiled else 0
         self._init_cache(CACHE_BYTES)
 
-    def _decode(self, index):
+    def _decode(self, r0, r1, c0, c1):
         lay = self.layout
-        r0 = index * lay.block_rows
-        r1 = min(lay.height, r0 + lay.block_rows)
         oiio = oiio_module()
         inp = oiio.ImageInput.open(self.path)
         if inp is None:
             raise TesseraError(f"Cannot read {self.path}: {(oiio.geterror() or 'the file is gone').strip()}")
         try:
             # "unknown": the file's own type (OpenImageIO would scale integers into [0, 1] for "float")
-            if lay.tiled:
-                data = inp.read_tiles(0, 0, 0, lay.width, r0, r1, 0, 1, 0, 1, "unknown")
-            else:
+            if lay.tiled:  # whole tiles: the block's columns start and end on tile borders (or the image's edge)
+                data = inp.read_tiles(0, 0, c0, c1, r0, r1, 0, 1, 0, 1, "unknown")
+            else:  # a strip is decoded whole
                 data = inp.read_scanlines(0, 0, r0, r1, 0, 0, 1, "unknown")
             error = inp.geterror()  # a strip it cannot decode still returns an array, with an error set
             if data is None or error:
@@ -205,7 +248,7 @@ class TiffSource(BlockSource):
                 raise InvalidInputError(f"Reading rows {r0}-{r1 - 1} of {self.path} failed: {reason}")
         finally:
             inp.close()
-        return self._heights(np.asarray(data).reshape(r1 - r0, lay.width))
+        return self._heights(np.asarray(data).reshape(r1 - r0, c1 - c0))  # strips: the whole width
 
 
 class Mosaic(SampleGrid):
@@ -216,20 +259,21 @@ class Mosaic(SampleGrid):
         self.placements = list(placements)
         self.shape = (int(height), int(width))
 
-    def band(self, y0, y1):
-        h, w = self.shape
-        out = np.full((y1 - y0, w), np.nan, np.float32)
-        if y1 <= y0:
+    def window(self, y0, y1, x0, x1):
+        h = self.shape[0]
+        out = np.full((y1 - y0, x1 - x0), np.nan, np.float32)
+        if y1 <= y0 or x1 <= x0:
             return out
         filled = np.zeros(out.shape, bool) if len(self.placements) > 1 else None
-        top0, top1 = h - y1, h - y0  # the band in top-first rows [top0, top1)
+        top0, top1 = h - y1, h - y0  # the window in top-first rows [top0, top1)
         for source, col, row in self.placements:
             sh, sw = source.shape
             a, b = max(top0, row), min(top1, row + sh)
-            if a >= b:
+            left, right = max(x0, col), min(x1, col + sw)
+            if a >= b or left >= right:
                 continue
-            rows = source.rows(a - row, b - row)[::-1]  # bottom-first
-            sl = (slice(top1 - b, top1 - a), slice(col, col + sw))
+            rows = source.window(a - row, b - row, left - col, right - col)[::-1]  # bottom-first
+            sl = (slice(top1 - b, top1 - a), slice(left - x0, right - x0))
             if filled is None:
                 out[sl] = rows
             else:

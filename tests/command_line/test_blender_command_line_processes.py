@@ -159,6 +159,10 @@ def test_a_terrain_split_into_farm_tasks_joins_into_the_single_process_mesh(blen
     n_frames = last - first + 1
     assert len(plan["tasks"]) == n_frames * (cols * rows + 1)
     assert all(t["command"][:3] == ["blender", "-c", "tessera"] for t in plan["tasks"])
+    # the lake's voids were found once, when the plan was made, for every block task to read
+    index = tmp_path / "farm" / "terrain.tessera-voids"
+    blocks_argv = [t["argv"] for t in plan["tasks"] if t["step"] == "Blocks"]
+    assert index.is_file() and all(a[a.index("--void-index") + 1] == str(index) for a in blocks_argv)
     _run_plan(blender, plan)
     for frame in range(first, last + 1):
         whole = _mesh_of(bpy, tmp_path / "single" / f"terrain_{frame}.blend")

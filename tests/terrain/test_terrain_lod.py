@@ -1,13 +1,17 @@
 """Terrain levels and meshes: [Nunes 2011]'s rules, crack-free edges from random cameras, holes, culling, peaks."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+from mesh_checks import assert_parts_weld_into
 from tessera.kernels.common.camera import Camera
 from tessera.kernels.common.errors import InvalidInputError
 from tessera.kernels.terrain import analysis as ta
 from tessera.kernels.terrain import heightmap_io as hio
 from tessera.kernels.terrain import lod as tl
 from tessera.kernels.terrain import mesh as tm
+from tessera.kernels.terrain.sample_grid import SampleGrid
 
 
 def _terrain(size=257, seed=0):
@@ -293,36 +297,54 @@ def test_a_mesh_never_outgrows_its_full_grid(size, tile, mode, levels):
     assert cross.min() > 0 and cross.sum() / 2 == pytest.approx((w - 1) * (h - 1))
 
 
-@pytest.mark.parametrize("split", [(2, 2), (3, 2), (4, 4), (9, 1)])
-def test_the_blocks_of_a_split_weld_into_the_whole_mesh(split, monkeypatch):
-    """Farm tasks mesh one block each (`only_block`): their meshes, welded where positions coincide bit for bit, are
-    the whole mesh; every triangle comes from exactly one block. The selection calls no LAPACK (CPU-dependent)."""
-    from tessera.kernels.common.weld import weld_triangles
+class _Reads(SampleGrid):
+    """Float32 samples that mark every sample read, through windows or points."""
 
-    hm = _terrain(size=193, seed=5)
-    table = ta.tile_table(hm, 16, backend="numpy")
+    def __init__(self, a):
+        self.a, self.shape = a, a.shape
+        self.read = np.zeros(a.shape, bool)
+
+    def window(self, y0, y1, x0, x1):
+        self.read[y0:y1, x0:x1] = True
+        return self.a[y0:y1, x0:x1].copy()
+
+    def points(self, ys, xs):
+        self.read[ys, xs] = True
+        return self.a[ys, xs]
+
+
+@pytest.mark.parametrize("split", [(2, 2), (3, 2), (4, 4), (9, 1)])
+def test_the_blocks_of_a_split_weld_into_the_whole_mesh_reading_only_their_region(split, monkeypatch):
+    """Farm tasks mesh one block each (`select` with ``block``) from a table analysed over the block and its ring of
+    tiles only: each reads no sample outside that region and the analysis' halo, and their meshes, welded where
+    positions coincide bit for bit, are the whole mesh; every triangle comes from exactly one block. A map with
+    partial tiles; the selection calls no LAPACK (CPU-dependent)."""
+    full = _terrain(size=201, seed=5)
+    hm = replace(full, samples=np.ascontiguousarray(full.samples[:193]))  # 13 x 12 tiles of 16, the last column partial
+    ts = 16
+    table = ta.tile_table(hm, ts, backend="numpy")
     rng = np.random.default_rng(sum(split))
     monkeypatch.setattr(np.linalg, "inv", None)  # any use would raise: the levels must be the same on every machine
-    for levels in ("FRACTIONAL", "POW2"):
+    for levels, rule in (("FRACTIONAL", "SEARCH"), ("POW2", "LOG2")):
         cam = _random_camera(rng, hm, far=50.0)
-        sel = tl.select(hm, table, cam, tl.TerrainLod(levels=levels))
-        whole = tm.bake(hm, table, sel)
+        settings = tl.TerrainLod(levels=levels, t_min_rule=rule, epsilon=1.0)
+        whole = tm.bake(hm, table, tl.select(hm, table, cam, settings))
         assert len(whole.triangles) > 500
         cols, rows = split
-        parts = [tm.bake(hm, table, tl.only_block(sel, (c, r, cols, rows))) for r in range(rows) for c in range(cols)]
-        assert sum(len(p.triangles) for p in parts) == len(whole.triangles)
-        offsets = np.cumsum([0] + [len(p.positions) for p in parts])
-        pos, tris, _, kept = weld_triangles(np.concatenate([p.positions for p in parts]),
-                                            np.concatenate([p.triangles + o for p, o in zip(parts, offsets[:-1],
-                                                                                            strict=True)]))
-        assert len(kept) == len(whole.triangles) and len(pos) == len(whole.positions)
-        assert np.array_equal(np.unique(pos, axis=0), np.unique(whole.positions, axis=0))
-
-        def triangles(p, t):
-            keys = [tuple(map(tuple, tri)) for tri in p[t]]
-            return {min(k[i:] + k[:i] for i in range(3)) for k in keys}
-
-        assert triangles(pos, tris) == triangles(whole.positions, whole.triangles)
+        parts = []
+        for r in range(rows):
+            for c in range(cols):
+                block = (c, r, cols, rows)
+                reads = _Reads(hm.samples)
+                task = replace(hm, samples=reads)
+                region = tl.block_region(block, table.counts)
+                task_table = ta.tile_table(task, ts, tiles=region)
+                parts.append(tm.bake(task, task_table, tl.select(task, task_table, cam, settings, block=block)))
+                tx0, ty0, tx1, ty1 = region
+                allowed = np.zeros(hm.samples.shape, bool)
+                allowed[max(0, ty0 * ts - 2):ty1 * ts + 3, max(0, tx0 * ts - 2):tx1 * ts + 3] = True
+                assert reads.read.any() and not (reads.read & ~allowed).any(), block
+        assert_parts_weld_into(parts, whole)
 
 
 def test_a_block_outside_its_split_is_refused():
