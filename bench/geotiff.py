@@ -135,7 +135,11 @@ def block_child(path, block, index, out):
     before, t = _rchar(), time.perf_counter()
     part = tuple(int(v) for v in block.split(",")) if block else None
     hm, _ = gt.read_geotiff([path], void_index=index or None)
-    tiles = lod.block_region(part, tile_counts(hm.width, hm.height, 64)) if part else None
+    tiles = None
+    if part:
+        counts = tile_counts(hm.width, hm.height, 64)
+        tiles = lod.block_region(part, counts)
+        hm.hold(lod.block_window(part, counts, 64, (hm.height, hm.width)))  # as the terrain operator does
     table = tile_table(hm, 64, backend="numpy", tiles=tiles)
     half = 0.5 * (SIZE - 1) * hm.texel[0]
     cam = Camera.looking_at((0.0, -1.2 * half, 0.6 * half), (0.0, 0.0, 0.0), width=1920, height=1080, far=1e7)

@@ -14,7 +14,7 @@ from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.mesh_arrays import MeshArrays
 from ...kernels.terrain import geotiff, heightmap_io
 from ...kernels.terrain.analysis import tile_counts, tile_table
-from ...kernels.terrain.lod import block_region
+from ...kernels.terrain.lod import block_region, block_window
 from .. import bridge
 from ..preferences import get_preferences
 from .settings import is_elevation_file, source_key
@@ -104,7 +104,12 @@ def analysis(ob, progress=None, scene=None, block=None, void_index=""):
         hm, geo = hit[1], hit[3]
     else:
         hm, geo = read_source(s, scene, half, void_index)
-    region = None if block is None else block_region(block, tile_counts(hm.width, hm.height, s.tile_size))
+    region = None
+    if block is not None:
+        counts = tile_counts(hm.width, hm.height, s.tile_size)
+        region = block_region(block, counts)
+        # the analysis, the levels and the mesh each read the region: from a file, decode it once
+        hm.hold(block_window(block, counts, s.tile_size, (hm.height, hm.width)), get_preferences().memory_budget_bytes)
     rest = None if progress is None else (lambda done, total: progress(total + done, 2 * total))
     table = tile_table(hm, s.tile_size, progress=rest, tiles=region)
     _cache[ob.session_uid] = (key, hm, table, geo, region)

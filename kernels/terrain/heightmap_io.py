@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..common.errors import InvalidInputError, TesseraError
+from ..common.budget import check_bytes
+from ..common.errors import BudgetError, InvalidInputError, TesseraError
 from ..common.image_io import read_pixels
 from ..common.limits import MAX_WORLD_VALUE
 from .sample_grid import SampleGrid
@@ -84,6 +85,22 @@ class HeightMap:
     def in_memory(self):
         """Whether every sample is held in memory (not a memory map, not a grid read block by block)."""
         return isinstance(self.samples, np.ndarray) and not isinstance(self.samples, np.memmap)
+
+    def hold(self, window, budget_bytes=0):
+        """Keep the samples of ``window`` = (y0, y1, x0, x1) (rows and columns from the bottom, end exclusive) in memory
+        when they are read from a file (a farm task's region: `lod.block_window`), if they fit ``budget_bytes`` (0: no
+        budget) and the memory free; otherwise (and for maps in memory or memory-mapped) nothing changes. Returns
+        whether they are held."""
+        hold = getattr(self.samples, "hold", None)
+        if hold is None:
+            return False
+        y0, y1, x0, x1 = window
+        try:
+            check_bytes((y1 - y0) * (x1 - x0) * 4, budget_bytes, "", "")
+        except BudgetError:
+            return False  # read as it goes: more decoding, the same values
+        hold(y0, y1, x0, x1)
+        return True
 
     def void_at(self, x, y):
         """Whether points at sample coordinates ``x, y`` touch a void that is cut out (a hole): bool array, or

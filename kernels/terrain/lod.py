@@ -29,7 +29,7 @@ import numpy as np
 from ..common.camera import product
 from ..common.errors import InvalidInputError
 from ..common.partition import MAX_LEVEL, segment_counts
-from .analysis import tile_bounds
+from .analysis import HAM_REACH, tile_bounds
 
 MODES = ("OURS", "DISTANCE", "UNIFORM")
 G_FUNCTIONS = ("SQRT", "LOG")
@@ -185,10 +185,14 @@ def _cached(table, key, make):
 
 def _grid_heights_at_peak(hm, table, xs, ys, levels):
     """Height at each tile's peak of a level-``level`` grid over the tile, for each of ``levels``: a list of (nty, ntx)
-    float64, from one read of the height map (a file's blocks decoded once for every level).
+    float64, from one read of the height map (a file's blocks decoded once for every level)."""
+    gx, gy, cells = _peak_grid_points(table, xs, ys, levels)
+    return _heights_at_peak(hm.sample(np.stack(gx), np.stack(gy)).astype(np.float64), cells)
 
-    The grid cell around the peak is split along its (i, j)-(i+1, j+1) diagonal, as the mesh splits it.
-    """
+
+def _peak_grid_points(table, xs, ys, levels):
+    """The corners of the grid cell around each tile's peak for each of ``levels``: x and y lists of 4 (nty, ntx) arrays
+    per level, and per level the peak's place (u, v) in its cell."""
     (x0, x1), (y0, y1) = xs, ys
     px, py = table.peak_x.astype(np.float64), table.peak_y.astype(np.float64)
     cells, gx, gy = [], [], []
@@ -201,7 +205,12 @@ def _grid_heights_at_peak(hm, table, xs, ys, levels):
         gx1, gy1 = x0 + (i + 1) * sx, y0 + (j + 1) * sy
         gx += [gx0, gx1, gx0, gx1]
         gy += [gy0, gy0, gy1, gy1]
-    z = hm.sample(np.stack(gx), np.stack(gy)).astype(np.float64)  # (4 * len(levels), nty, ntx)
+    return gx, gy, cells
+
+
+def _heights_at_peak(z, cells):
+    """The heights at the peaks from the corner heights ``z`` (4 per level, float64) of `_peak_grid_points`. The grid
+    cell around the peak is split along its (i, j)-(i+1, j+1) diagonal, as the mesh splits it."""
     out = []
     for k, (u, v) in enumerate(cells):
         z00, z10, z01, z11 = z[4 * k:4 * k + 4]
@@ -210,12 +219,35 @@ def _grid_heights_at_peak(hm, table, xs, ys, levels):
     return out
 
 
+#: The levels the peak search tries (every power of two up to `MAX_LEVEL`): their grids are read together, once.
+_SEARCHED = [1 << k for k in range(MAX_LEVEL.bit_length())]
+
+
+def _prefetch(hm, table, xs, ys, peaks):
+    """Read every height the selection needs in one pass over the map and keep them in ``table.derived``: each tile's
+    edge midpoints and centre, and with ``peaks`` the grids under its peak (`_peak_base`), so a file's blocks are
+    decoded once for all of them."""
+    levels = [lv for lv in _SEARCHED if peaks and ("peak_dz", lv) not in table.derived]
+    if "centre" in table.derived and not levels:
+        return
+    (x0, x1), (y0, y1) = xs, ys
+    mx, my = (x0 + x1) * 0.5, (y0 + y1) * 0.5
+    points = [(mx, y0), (x1, my), (mx, y1), (x0, my), (mx, my)]
+    gx, gy, cells = _peak_grid_points(table, xs, ys, levels)
+    z = hm.sample(np.stack([p[0] for p in points] + gx), np.stack([p[1] for p in points] + gy))
+    for side, (px, py) in enumerate(points[:4]):
+        table.derived.setdefault(("edge", side), _planes(to_world(hm, px, py, z[side])))
+    table.derived.setdefault("centre", _planes(to_world(hm, mx, my, z[4])))
+    for lv, height in zip(levels, _heights_at_peak(z[5:].astype(np.float64), cells), strict=True):
+        table.derived.setdefault(("peak_dz", lv), (height - table.h_max).ravel())
+
+
 def _peak_base(hm, table, xs, ys, level):
     """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height. The
     powers of two up to `MAX_LEVEL` (what the search tries) are read together, once."""
     key = ("peak_dz", level)
     if key not in table.derived:
-        levels = [level] if level & (level - 1) else [1 << k for k in range(MAX_LEVEL.bit_length())]
+        levels = [level] if level & (level - 1) else _SEARCHED
         for lv, height in zip(levels, _grid_heights_at_peak(hm, table, xs, ys, levels), strict=True):
             table.derived.setdefault(("peak_dz", lv), (height - table.h_max).ravel())
     return table.derived[key]
@@ -345,6 +377,16 @@ def block_region(block, counts):
     return max(0, xs.start - 1), max(0, ys.start - 1), min(ntx, xs.stop + 1), min(nty, ys.stop + 1)
 
 
+def block_window(block, counts, tile_size, shape):
+    """The samples a block's task reads, as (y0, y1, x0, x1) (rows and columns from the bottom, end exclusive, clipped to
+    the map of ``shape`` = (H, W)): its region's tiles (`block_region`) and `analysis.HAM_REACH` samples around them."""
+    tx0, ty0, tx1, ty1 = block_region(block, counts)
+    h, w = shape
+    reach = HAM_REACH
+    return (max(0, ty0 * tile_size - reach), min(h, ty1 * tile_size + 1 + reach),
+            max(0, tx0 * tile_size - reach), min(w, tx1 * tile_size + 1 + reach))
+
+
 def _region_table(table, region):
     """The tile table of ``region`` (tx0, ty0, tx1, ty1) as a `TileTable` of its own (sample coordinates and the map's
     shape kept), made once per table and region."""
@@ -413,6 +455,7 @@ def _select(hm, table, camera, settings, first):
     xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
     ys = tuple(np.broadcast_to(b[:, None].astype(np.float64), (nty, ntx)) for b in yb)
     top = float(settings.max_level)
+    _prefetch(hm, table, xs, ys, peaks=settings.mode == "OURS" and camera is not None)
     if settings.mode == "UNIFORM":
         t_max = np.full((nty, ntx), top)
         t_min = t_max.copy()

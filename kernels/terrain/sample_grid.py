@@ -69,6 +69,31 @@ class SampleGrid:
         raise IndexError(f"sample grids take row and column slices or two index arrays, not {key!r}")
 
 
+class HeldWindow(SampleGrid):
+    """``grid``'s samples with one window, rows ``[y0, y1)`` and columns ``[x0, x1)`` (from the bottom), read once and
+    held in memory: a farm task's region, which its analysis, levels and mesh each read again (a file's blocks are
+    then decoded once, not once per pass). Reads outside the window go to ``grid``."""
+
+    def __init__(self, grid, y0, y1, x0, x1):
+        self.grid, self.shape, self.box = grid, grid.shape, (y0, y1, x0, x1)
+        self.data = grid.window(y0, y1, x0, x1)
+
+    def window(self, y0, y1, x0, x1):
+        a, b, c, d = self.box
+        if a <= y0 and y1 <= b and c <= x0 and x1 <= d:
+            return self.data[y0 - a:y1 - a, x0 - c:x1 - c].copy()
+        return self.grid.window(y0, y1, x0, x1)
+
+    def points(self, ys, xs):
+        a, b, c, d = self.box
+        inside = (ys >= a) & (ys < b) & (xs >= c) & (xs < d)
+        out = np.empty(ys.shape, np.float32)
+        out[inside] = self.data[ys[inside] - a, xs[inside] - c]
+        if not inside.all():
+            out[~inside] = self.grid.points(ys[~inside], xs[~inside])
+        return out
+
+
 @dataclass(frozen=True)
 class TiffLayout:
     """What a TIFF's header says about its samples: width, height, channels, format name (OpenImageIO's),

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..common.budget import check_bytes
 from ..common.errors import BudgetError, InvalidInputError
-from .sample_grid import SampleGrid
+from .sample_grid import HeldWindow, SampleGrid
 
 #: Cell side in samples: voids are found per cell, and a component's window grows by one cell each side.
 CELL = 64
@@ -230,6 +230,11 @@ class FilledGrid(SampleGrid):
             for fx in (np.floor, np.ceil):
                 out |= np.isnan(self.raw.points(fy(y).astype(np.int64), fx(x).astype(np.int64)))
         return out
+
+    def hold(self, y0, y1, x0, x1):
+        """Read the raw samples of rows ``[y0, y1)``, columns ``[x0, x1)`` once and keep them (`HeldWindow`): every later
+        read inside them (windows, points, `void_at`) decodes nothing again."""
+        self.raw = HeldWindow(getattr(self.raw, "grid", self.raw), y0, y1, x0, x1)
 
     def save_index(self, path, source=""):
         """Write this grid's voids and filled values to ``path`` (see `VoidIndex`); ``source`` identifies the data

@@ -88,6 +88,7 @@ def test_farm_blocks_read_only_their_region_and_join_into_the_whole_mesh(dem, tm
             block = (c, r, cols, rows)
             decoded.windows.clear()
             task, _ = gt.read_geotiff([dem], voids=voids, void_index=index)
+            assert task.hold(tl.block_window(block, table.counts, TS, (h, w)))  # as the terrain operator does
             region = tl.block_region(block, table.counts)
             task_table = ta.tile_table(task, TS, tiles=region)
             parts.append(tm.bake(task, task_table, tl.select(task, task_table, cam, settings, block=block)))
@@ -95,7 +96,7 @@ def test_farm_blocks_read_only_their_region_and_join_into_the_whole_mesh(dem, tm
             tx0, ty0, tx1, ty1 = region
             x0, x1 = max(0, tx0 * TS - 2), min(w, tx1 * TS + 3)
             top0, top1 = h - min(h, ty1 * TS + 3), h - max(0, ty0 * TS - 2)
-            assert decoded.windows
+            assert decoded.windows and len(set(decoded.windows)) == len(decoded.windows)  # each block decoded once
             for a, b, left, right in decoded.windows:
                 assert a < top1 and b > top0 and left < x1 and right > x0, (block, (a, b, left, right))
             area = sum((min(b, h) - a) * (min(right, w) - left) for a, b, left, right in set(decoded.windows))
