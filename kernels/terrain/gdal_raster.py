@@ -267,9 +267,13 @@ class GdalSource(BlockSource):
         self.__dict__.update(state)
         self._io = threading.Lock()
 
-    def block(self, bi, bj=0):
-        with self._io:  # one dataset handle: GDAL's are not shared between threads
-            return super().block(bi, bj)
+    def _span(self, bi, bj):
+        with self._io:  # one dataset handle: GDAL's are not shared between threads (nor is the cache)
+            return super()._span(bi, bj)
+
+    def _prefetch(self, bi, columns):
+        with self._io:
+            return super()._prefetch(bi, columns)
 
     def _decode(self, r0, r1, c0, c1):
         from rasterio.errors import RasterioError

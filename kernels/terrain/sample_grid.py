@@ -185,7 +185,9 @@ class BlockSource:
         return self.block_cols or self.shape[1]
 
     def _init_cache(self, cache_bytes):
-        self._cache = OrderedDict()  # (block row, block column) -> (rows, columns) float32
+        # (block row, block column) -> (the decoded span holding it: (rows, columns) float32, the span's first block
+        # column): blocks decoded together stay one array, so a window across them is a slice, not a copy
+        self._cache = OrderedDict()
         self._keep = max(2, cache_bytes // max(1, self.block_rows * self._cols * 4))
 
     def _decode(self, r0, r1, c0, c1):  # pragma: no cover - the interface
@@ -194,17 +196,38 @@ class BlockSource:
 
     def block(self, bi, bj=0):
         """Decoded block ``(bi, bj)`` (block row, block column): (rows, columns) float32 (file order), voids NaN."""
+        span, first = self._span(bi, bj)
+        c = self._cols
+        return span[:, (bj - first) * c:(bj - first + 1) * c]
+
+    def _span(self, bi, bj):
+        """The decoded span holding block ``(bi, bj)`` and the span's first block column (decoded if not kept)."""
         key = (bi, bj)
         hit = self._cache.get(key)
-        if hit is not None:
-            self._cache.move_to_end(key)
-            return hit
+        if hit is None:
+            self._load(bi, bj, bj)
+            hit = self._cache[key]
+        self._cache.move_to_end(key)
+        return hit
+
+    def _load(self, bi, j0, j1):
+        """Decode blocks ``(bi, j0) .. (bi, j1)`` of one block row in one read (a file's reader pays per call) and keep
+        them."""
         (h, w), b, c = self.shape, self.block_rows, self._cols
-        data = self._decode(bi * b, min(h, (bi + 1) * b), bj * c, min(w, (bj + 1) * c))
-        self._cache[key] = data
+        data = self._decode(bi * b, min(h, (bi + 1) * b), j0 * c, min(w, (j1 + 1) * c))
+        data.flags.writeable = False  # windows are slices of it: a reader that writes must copy
+        for bj in range(j0, j1 + 1):
+            self._cache[(bi, bj)] = (data, j0)
+            self._cache.move_to_end((bi, bj))
         while len(self._cache) > self._keep:
             self._cache.popitem(last=False)
-        return data
+
+    def _prefetch(self, bi, columns):
+        """Decode the blocks of block row ``bi`` among block columns ``columns`` (sorted ints) that are not kept, several
+        in one read: from the first missing to the last (at most the cache's size)."""
+        missing = [bj for bj in columns if (bi, bj) not in self._cache]
+        if len(missing) > 1 and missing[-1] - missing[0] < self._keep:
+            self._load(bi, missing[0], missing[-1])
 
     def window(self, r0, r1, c0, c1):
         """File rows ``[r0, r1)``, columns ``[c0, c1)``: (r1 - r0, c1 - c0) float32, voids NaN; only the blocks the
@@ -216,11 +239,18 @@ class BlockSource:
         for bi in range(r0 // b, (r1 - 1) // b + 1):
             lo = bi * b
             rs = slice(max(r0, lo) - lo, min(r1, lo + b) - lo)
+            j0, j1 = c0 // c, (c1 - 1) // c
+            self._prefetch(bi, range(j0, j1 + 1))
+            spans = [self._span(bi, bj) for bj in range(j0, j1 + 1)]
+            span, first = spans[0]
+            if all(s is span for s, _ in spans):  # one decoded span: a slice of it
+                bands.append(span[rs, c0 - first * c:c1 - first * c])
+                continue
             parts = []
-            for bj in range(c0 // c, (c1 - 1) // c + 1):
+            for bj, (span, first) in zip(range(j0, j1 + 1), spans, strict=True):
                 left = bj * c
-                parts.append(self.block(bi, bj)[rs, max(c0, left) - left:min(c1, left + c) - left])
-            bands.append(parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1))
+                parts.append(span[rs, max(c0, left) - first * c:min(c1, left + c) - first * c])
+            bands.append(np.concatenate(parts, axis=1))
         return bands[0] if len(bands) == 1 else np.concatenate(bands)
 
     def rows(self, r0, r1):
@@ -234,9 +264,14 @@ class BlockSource:
         key = bi * (self.shape[1] // self._cols + 1) + bj
         order = np.argsort(key, kind="stable")
         edges = np.flatnonzero(np.diff(key[order])) + 1
-        for run in np.split(order, edges):
+        row, in_rows = None, bi[order]
+        for run in np.split(order, edges):  # block by block, block rows in order
             if run.size:
                 i, j = int(bi[run[0]]), int(bj[run[0]])
+                if i != row and self._cols < self.shape[1]:  # the row's blocks asked for, in one read
+                    row = i
+                    lo, hi = np.searchsorted(in_rows, [i, i + 1])
+                    self._prefetch(i, np.unique(bj[order[lo:hi]]).tolist())
                 out[run] = self.block(i, j)[rows[run] - i * self.block_rows, cols[run] - j * self._cols]
         return out
 

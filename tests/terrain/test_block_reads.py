@@ -47,18 +47,18 @@ def _camera(hm):
 
 
 class _Decoded:
-    """Records the file windows (top-first rows and columns) every source decodes."""
+    """Records the file blocks (top-first rows and columns) every source is asked for, kept or decoded."""
 
     def __init__(self, monkeypatch):
         self.windows = []
-        real = sample_grid.BlockSource.block
+        real = sample_grid.BlockSource._span
 
-        def block(source, bi, bj=0):
+        def span(source, bi, bj):
             rows, cols = source.block_rows, source.block_cols or source.shape[1]
             self.windows.append((bi * rows, (bi + 1) * rows, bj * cols, (bj + 1) * cols))
             return real(source, bi, bj)
 
-        monkeypatch.setattr(sample_grid.BlockSource, "block", block)
+        monkeypatch.setattr(sample_grid.BlockSource, "_span", span)
 
 
 @pytest.mark.parametrize("voids", ["FILL", "HOLES"])
