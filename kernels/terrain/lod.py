@@ -378,8 +378,9 @@ def block_region(block, counts):
 
 
 def block_window(block, counts, tile_size, shape):
-    """The samples a block's task reads, as (y0, y1, x0, x1) (rows and columns from the bottom, end exclusive, clipped to
-    the map of ``shape`` = (H, W)): its region's tiles (`block_region`) and `analysis.HAM_REACH` samples around them."""
+    """The samples a block's task reads, as (y0, y1, x0, x1) (rows and columns from the bottom, end exclusive,
+    clipped to the map of ``shape`` = (H, W)): its region's tiles (`block_region`) and `analysis.HAM_REACH` samples
+    around them."""
     tx0, ty0, tx1, ty1 = block_region(block, counts)
     h, w = shape
     reach = HAM_REACH

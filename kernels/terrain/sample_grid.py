@@ -223,8 +223,8 @@ class BlockSource:
             self._cache.popitem(last=False)
 
     def _prefetch(self, bi, columns):
-        """Decode the blocks of block row ``bi`` among block columns ``columns`` (sorted ints) that are not kept, several
-        in one read: from the first missing to the last (at most the cache's size)."""
+        """Decode the blocks of block row ``bi`` among block columns ``columns`` (sorted ints) that are not kept,
+        several in one read: from the first missing to the last (at most the cache's size)."""
         missing = [bj for bj in columns if (bi, bj) not in self._cache]
         if len(missing) > 1 and missing[-1] - missing[0] < self._keep:
             self._load(bi, missing[0], missing[-1])

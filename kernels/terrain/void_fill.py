@@ -232,8 +232,8 @@ class FilledGrid(SampleGrid):
         return out
 
     def hold(self, y0, y1, x0, x1):
-        """Read the raw samples of rows ``[y0, y1)``, columns ``[x0, x1)`` once and keep them (`HeldWindow`): every later
-        read inside them (windows, points, `void_at`) decodes nothing again."""
+        """Read the raw samples of rows ``[y0, y1)``, columns ``[x0, x1)`` once and keep them (`HeldWindow`): every
+        later read inside them (windows, points, `void_at`) decodes nothing again."""
         self.raw = HeldWindow(getattr(self.raw, "grid", self.raw), y0, y1, x0, x1)
 
     def save_index(self, path, source=""):
