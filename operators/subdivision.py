@@ -14,13 +14,13 @@ from ..addon.render_jobs import render_key
 from ..addon.subdivision.bake import read_bake, start_bake
 from ..addon.subdivision.build import HCE_PROPERTY, subdivide
 from ..addon.subdivision.settings import BAKED_COLOUR, LoopOptions
-from ..kernels.common import workers
 from ..kernels.common.errors import TesseraError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.common.normals import face_unit_normals
 from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
+from .render_job import RenderJobOperator
 from .selection import is_mesh, mesh_poll, place_mesh, read_source
 
 
@@ -97,18 +97,6 @@ _last = {"key": None, "colours": None, "device": "", "what": None}
 _KEEP_BYTES = 256 * 2**20
 
 
-def _bake_key(context, ob, op):
-    """What a lighting bake's render depends on (the object, everything around it that renders, the world, the device:
-    `render_jobs.render_key`) and the settings that change the render."""
-    return render_key(context, ob, surroundings=True), op.depth, op.samples, op.albedo
-
-
-def _keep(key, colours, device, what):
-    small = colours.nbytes <= _KEEP_BYTES
-    _last.update(key=key if small else None, colours=colours if small else None, device=device,
-                 what=what if small else None)
-
-
 def _encode(colours, what, depth, normals, tolerance):
     """The HCE of baked ``colours`` (N·4^depth, 4): ``(trees, packed bytes)``; numpy only (runs on a worker thread)."""
     _, arrays, sub = what
@@ -119,7 +107,11 @@ def _encode(colours, what, depth, normals, tolerance):
     return trees, hce.pack_container(trees, arrays.triangles, 4)
 
 
-class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
+#: The last bake's colours, by what their render depended on: the redo panel's Normals and Colour Tolerance reuse them.
+_last = {"key": None, "rendered": None, "what": None, "device": ""}
+
+
+class TESSERA_OT_bake_lighting_hce(RenderJobOperator, bpy.types.Operator):
     """Bake the active mesh's light with Cycles and store it on the mesh, so Loop Subdivide shows it at any level"""
 
     bl_idname = "tessera.bake_lighting_hce"
@@ -140,6 +132,10 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
     albedo: bpy.props.BoolProperty(name="Surface Colour", default=True,
                                    description="Multiply by the surface colour (off: the light alone)")
 
+    job_label = "Baking lighting with Cycles"
+    cancelled = "Lighting bake cancelled: nothing was changed"
+    _last = _last
+
     @classmethod
     def poll(cls, context):
         return mesh_poll(cls, context, "bake")
@@ -149,8 +145,13 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
         check_editable(context.active_object.data, "baked lighting stored on its mesh",
                        "Make the object and its mesh local (Object › Relations › Make Local) first")
 
+    def _render_key(self, context):
+        """What the bake's render depends on (the object, everything around it that renders, the world, the device:
+        `render_jobs.render_key`) and the settings that change the render."""
+        return render_key(context, context.active_object, surroundings=True), self.depth, self.samples, self.albedo
+
     def _start(self, context):
-        """Subdivide to Depth and start the worker: ``(BakeJob, what _store needs)``; refusals raise."""
+        """Subdivide to Depth and start the worker: ``(BakeJob, (name, arrays, subdivision))``; refusals raise."""
         ob = context.active_object
         self._check(context)
         budget = get_preferences(context).memory_budget_bytes
@@ -164,92 +165,19 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
                         self.albedo, budget)
         return bj, (ob.name, arrays, sub)
 
-    def invoke(self, context, event):
-        """In the UI: start the bake and follow it from a timer (the UI never waits; Esc cancels); elsewhere:
-        `execute`."""
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        self._job, self._encoding = None, None
-        result = self._begin(context)
-        if self._job is None:
-            return result
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(0.25, window=context.window)
-        wm.modal_handler_add(self)
-        context.workspace.status_text_set("Baking lighting with Cycles — Esc to cancel")
-        return {"RUNNING_MODAL"}
-
-    @guarded
-    def _begin(self, context, tx):
-        self._t0 = time.perf_counter()
-        self._key = _bake_key(context, context.active_object, self)
-        self._job, self._what = self._start(context)
-        return {"FINISHED"}
-
-    def _end(self, context):
-        context.window_manager.event_timer_remove(self._timer)
-        context.workspace.status_text_set(None)
-
-    def modal(self, context, event):
-        if event.type == "ESC":
-            self._job.job.cancel()
-            self._end(context)
-            self.report({"WARNING"}, "Lighting bake cancelled: nothing was changed")
-            return {"CANCELLED"}
-        if event.type != "TIMER":
-            return {"PASS_THROUGH"}
-        if self._job.job.running():
-            device = self._job.job.device()
-            on = f" on {device}" if device else ""
-            context.workspace.status_text_set(f"Baking lighting with Cycles{on} — Esc to cancel")
-            return {"RUNNING_MODAL"}
-        if self._encoding is None:  # rendered: read the colours and encode them on a worker thread
-            self._device = self._job.job.device()
-            job, what, settings = self._job, self._what, self._settings()
-
-            def read_and_encode():
-                colours = read_bake(job)
-                return colours, _encode(colours, what, *settings)
-
-            self._encoding = workers.submit(read_and_encode)
-            return {"RUNNING_MODAL"}
-        if not self._encoding.done():
-            return {"RUNNING_MODAL"}
-        self._end(context)
-        return self._finish(context)
+    @staticmethod
+    def _read(handle, what):
+        return read_bake(handle)
 
     def _settings(self):
         return self.depth, self.normals, self.tolerance
 
-    @guarded
-    def _finish(self, context, tx):
-        colours, encoded = self._encoding.result()
-        _keep(self._key, colours, self._device, self._what)
-        return self._store(tx, encoded, self._device, self._what, self._t0)
+    @staticmethod
+    def _prepare(colours, what, depth, normals, tolerance):
+        return _encode(colours, what, depth, normals, tolerance)
 
-    @guarded
-    def execute(self, context, tx):
-        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines. The last bake's colours are
-        reused when nothing the render depends on changed (the redo panel's Normals and Colour Tolerance)."""
-        t0 = time.perf_counter()
-        key = _bake_key(context, context.active_object, self)
-        if _last["key"] == key:
-            self._check(context)
-            colours, device, what = _last["colours"], _last["device"], _last["what"]
-        else:
-            bj, what = self._start(context)
-            try:
-                bj.job.wait(None, "Baking lighting")
-            except BaseException:
-                bj.job.cancel()
-                raise
-            device = bj.job.device()
-            colours = read_bake(bj)
-            _keep(key, colours, device, what)
-        return self._store(tx, _encode(colours, what, *self._settings()), device, what, t0)
-
-    def _store(self, tx, encoded, device, what, t0):
-        """Store the encoded HCE on the mesh (undone if anything fails after)."""
+    def _make_steps(self, context, tx, encoded, what, device):
+        """Store the encoded HCE on the mesh (undone if anything fails after): one step."""
         name, arrays, _ = what
         trees, blob = encoded
         ob = bpy.data.objects.get(name)
@@ -267,8 +195,9 @@ class TESSERA_OT_bake_lighting_hce(bpy.types.Operator):
         on = device or "the CPU"
         self.report({"INFO"}, f"Baked lighting on {on}: {n_f:,} triangles, {nodes / n_f:.1f} nodes and "
                               f"{np.mean([len(t.normals) for t in trees]):.1f} extra normals each, "
-                              f"{len(blob) / 1024:,.0f} KiB, {time.perf_counter() - t0:.1f} s")
+                              f"{len(blob) / 1024:,.0f} KiB, {time.perf_counter() - self._t0:.1f} s")
         return {"FINISHED"}
+        yield  # a generator of one step
 
 
 classes = (TESSERA_OT_loop_subdivide, TESSERA_OT_bake_lighting_hce)

@@ -58,6 +58,8 @@ class UiOperator:
             for attr, fn in vars(klass).items():
                 if callable(fn) and (attr == "modal" or (attr.startswith("_") and not attr.startswith("__"))):
                     setattr(self, attr, fn.__get__(self))
+                elif not callable(fn) and not attr.startswith("__") and not hasattr(self, attr):
+                    setattr(self, attr, fn)  # its class constants (the status bar's words, the last render kept)
 
     def report(self, kind, text):
         self.reports.append((set(kind), text))
