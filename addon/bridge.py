@@ -3,7 +3,7 @@
 Reading uses Blender's loop triangles (quads and n-gons are triangulated the way Blender draws them)
 and typed ``foreach_get``; writing allocates a new mesh's elements once and fills its arrays with
 `mesh_memory.write_items` (a bulk copy where the layout allows, else typed ``foreach_set``; ``from_pydata`` is
-about 10x slower). Arrays are float32 / int32, contiguous.
+many times slower: ``bench/bridge.py``). Arrays are float32 / int32, contiguous.
 """
 
 from contextlib import contextmanager

@@ -1,9 +1,9 @@
 """The OpenCL runtime made and the kernels' programs built on a background thread once Blender's window is up.
 
 Without it, the first tubes, brush stroke, terrain, Loop or Tessellate Surface run of a session waits for the device
-to be chosen and each of its programs (and their variants: `opencl_runtime.program_variants`) to be built (0.2 s for
-the context and 0.06-0.08 s a program from pyopencl's cache; 0.2-1.4 s a program after an install or an update, when
-the cache is cold). Register only schedules the warm-up: a timer starts the thread a second after registration, in
+to be chosen and each of its programs (and their variants: `opencl_runtime.program_variants`) to be built: a
+fraction of a second for the context, and for each program longer still after an install or an update, when
+pyopencl's cache is cold. Register only schedules the warm-up: a timer starts the thread a second after registration, in
 the UI alone (background and `bpy` module runs have no event loop to fire it, and a script's first operator would
 only wait for the same work). The build releases the
 GIL, so the interface does not stall. A thread still building when the add-on is disabled or Blender quits is

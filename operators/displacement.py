@@ -26,9 +26,8 @@ from ..kernels.displacement.map_io import read_map, write_map
 from ..kernels.displacement.map_strokes import Brush
 
 _LIVE_INTERVAL = 0.05  # seconds between image updates while painting, at least
-#: ... and at least this many times the last update's own time: writing a large map's pixels (a 4096² map: ~18 ms
-#: for a stroke's tiles, the whole image ~75 ms; Blender has no partial write) then takes at most a quarter of a
-#: stroke
+#: ... and at least this many times the last update's own time: writing a large map's pixels (tens of milliseconds
+#: for a 4096² map; Blender has no partial write) then takes at most a quarter of a stroke
 _LIVE_WAIT_PER_WRITE = 3.0
 
 

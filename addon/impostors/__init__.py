@@ -1,2 +1,2 @@
-"""Nailboards in Blender: the background worker that renders an object's board with Cycles (`worker`, running
-`worker_script.py` in a separate, niced process)."""
+"""Nailboards and impostors in Blender: their settings, the live board, the Cycles workers that render boards and
+atlases, the baked card and its glTF export."""

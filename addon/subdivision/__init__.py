@@ -1,2 +1,2 @@
-"""Loop subdivision in Blender: `panel` (Tessera > Loop Subdivision); the operator is
-``operators/subdivision.py``."""
+"""Loop subdivision in Blender: its settings, preview and panel, the mesh it builds and the Cycles bake of its light
+(the operators: ``operators/subdivision.py``)."""

@@ -1,1 +1,2 @@
-"""Surfaces in Blender: the parametric-surface settings (`settings`) shared by ``tessera.parametric_surface_add``."""
+"""Surfaces in Blender: parametric surfaces, Tessellate Surface and adaptive curves (their settings, previews, panels,
+the control points they read) and the vector-field texture."""

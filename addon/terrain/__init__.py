@@ -1,2 +1,2 @@
-"""Terrain in Blender: `settings` (``Object.tessera.terrain``), `data` (height maps and analyses cached per
-object, the baked mesh), `preview` (the live GPU preview, [Nunes 2011, §5]) and `panel`."""
+"""Terrain in Blender ([Nunes 2011, §5]): its settings, the height maps and analyses cached per object, the live GPU
+preview, the panel and the Terrain node group."""

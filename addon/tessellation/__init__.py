@@ -1,2 +1,2 @@
-"""Tessellation in Blender: `settings` (the options shared by the operator and ``Object.tessera.tessellate``),
-`preview` (the live GPU preview, [Nellmedin 2014, §5] done with instanced patterns) and `panel`."""
+"""Tessellation in Blender ([Nellmedin 2014, §5]): the settings shared by the operator and
+``Object.tessera.tessellate``, the live GPU preview, the panel and the PN and Phong node groups."""

@@ -1,2 +1,2 @@
-"""Tubes in Blender: `settings` (``Object.tessera.tubes``), `sources` (curves, hair and wire meshes read as
-polylines), `preview` (the live GPU preview, [Nunes 2011, §4]) and `panel`."""
+"""Tubes in Blender ([Nunes 2011, §4]): their settings, the curves, hair and wire meshes read as polylines, the live
+GPU preview, the panel and the Tubes node group."""

@@ -1,19 +1,18 @@
 """Transparent huge pages for large arrays written once, start to end (Linux).
 
-The first write to new memory costs the operating system a page fault for every 4 KiB page: a 1.6 GB tube mesh is
-~400,000 faults, ~0.7 s of CPU on a 2-core machine and most of what ``tessera.tubes`` waits for. Advised with
-``MADV_HUGEPAGE``, a range is backed by 2 MiB pages where the kernel has them: 512 times fewer faults (the same
-1.6 GB is written in 0.08-0.15 s instead of 0.37-0.7 s there). numpy advises every array of 4 MiB and more this
-way; Blender's own arrays are not advised, so `addon.mesh_memory` advises a new mesh's large arrays (`advise`)
-before they are written.
+The first write to new memory costs the operating system a page fault for every 4 KiB page: a tube mesh of a
+gigabyte or more is hundreds of thousands of faults, most of what ``tessera.tubes`` waits for. Advised with
+``MADV_HUGEPAGE``, a range is backed by 2 MiB pages where the kernel has them: 512 times fewer faults. numpy advises
+every array of 4 MiB and more this way; Blender's own arrays are not advised, so `addon.mesh_memory` advises a new
+mesh's large arrays (`advise`) before they are written. ``bench/tubes.py`` (``operator_huge_pages``) measures the
+operator with huge pages on and off; ``docs/performance.md`` keeps the figures.
 
 Where it is not done (`enabled`):
 - ``/sys/kernel/mm/transparent_hugepage/enabled`` says ``[never]``, or the system is not Linux;
 - the machine is a virtual machine that reports free memory to its hypervisor (`reports_free_pages`: a virtio
   balloon with free page reporting, or Hyper-V's balloon driver). Such a guest hands 2 MiB blocks that stayed free
-  for about two seconds back to the host, and the next huge page there costs the host a fault for every 4 KiB in
-  it: 1.6 GB took 1.8-2.1 s against 0.15 s for blocks freed just before, and 0.7 s in 4 KiB pages. Small pages
-  come from the guest's own fragments first, which it keeps.
+  for a few seconds back to the host, and the next huge page there costs the host a fault for every 4 KiB in it:
+  slower than small pages, which come from the guest's own fragments first, which it keeps.
 
 ``TESSERA_HUGE_PAGES`` = ``on`` / ``off`` / ``auto`` (the default) overrides that choice.
 """

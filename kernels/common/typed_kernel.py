@@ -1,9 +1,10 @@
 """OpenCL kernels whose scalar arguments are packed by type, not converted one by one at each launch.
 
-A pyopencl ``Kernel`` called with numpy scalars sets each through the buffer protocol: about 6 µs a scalar
-argument (measured with pyopencl 2026.1 on PoCL; the driver's own ``clSetKernelArg`` takes under 1 µs), so a
-displacement dab's 12 scalars cost ~110 µs a launch, 30 times the launch itself. With the types declared
-(``Kernel.set_scalar_arg_dtypes``) pyopencl packs them in one step: ~3.5 µs for the whole launch.
+A pyopencl ``Kernel`` called with numpy scalars sets each through the buffer protocol, one Python round trip a
+scalar argument, far more than the driver's own ``clSetKernelArg``: a displacement dab's dozen scalars then cost
+many times the launch itself. With the types declared (``Kernel.set_scalar_arg_dtypes``) pyopencl packs them all
+in one step. What a dab costs is measured by ``bench/displacement.py`` (``dab``) and kept in
+``docs/performance.md``.
 
 `TypedKernel` declares them from the call: each distinct signature (the numpy dtype of every scalar argument, None
 for buffers and anything else) gets its own kernel object with those types. A scalar is packed as its own dtype,

@@ -6,8 +6,9 @@ reach it: the same float operations in the same order as one launch per dab, so 
 (``map_dabs.cl``'s ``dabs_batch`` calls each single dab's texel function). The box is cut into square bins a
 quarter of the largest footprint wide (8 to 1024 texels), and each bin lists the dabs whose footprint overlaps it,
 so a texel looks at the ten or so dabs near it rather than at all of them. One launch replaces a launch per dab:
-on PoCL a launch costs its arguments and a wake-up of the worker threads (~25 µs of the Python thread in a
-stroke), which is most of a small dab; large footprints (over `MAX_TEXELS`) keep a launch each. The work-groups
+a launch costs its arguments and a wake-up of the device's worker threads, which is most of a small dab; large
+footprints (over `MAX_TEXELS`) keep a launch each. ``bench/displacement.py`` (``stroke``, ``stroke_kinds``) measures
+strokes; ``docs/performance.md`` keeps the figures. The work-groups
 are one row of up to 64 texels inside one bin, so the texels of a group loop over the same dabs.
 """
 
@@ -18,9 +19,8 @@ from .map_dabs import MAP_PROGRAM
 #: single-dab kernels with a batched form, and their kind code in ``dabs_batch``
 BATCHED = {"draw": 0, "contact": 1, "force": 2, "noise": 3}
 #: Footprints of more texels run a launch each (still read back with the stroke): the batched kernel does more per
-#: texel and dab (parameters loaded, not arguments), and on two PoCL cores that outweighs the launches saved from
-#: a radius of about 32 (65² texels) on: DRAW radius 8 / 16 / 24: 8.9 / 9.6 / 11.2 ms a 200-dab stroke batched
-#: against 14.6 / 15.1 / 14.8 ms a launch each; radius 32: a tie; radius 64 / 256: 17.5 / 55 ms against 13.8 / 35 ms.
+#: texel and dab (parameters loaded, not arguments), which outweighs the launches saved from a radius of about 32
+#: (65² texels) on, where the two tie on PoCL (measured when this limit was chosen; `bench/displacement.py`).
 MAX_TEXELS = 64 * 64
 MIN_BIN, MAX_BIN = 8, 1024
 FLOATS, INTS = 12, 3  # per dab in ``dabs_batch``

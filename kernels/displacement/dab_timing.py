@@ -1,12 +1,12 @@
 """Which side runs a dab, or a stroke, of a map, the host (numpy) or the OpenCL device: the one measured faster.
 
 The two sides give the same bytes (``tests/displacement/test_opencl_maps.py`` compares them), so the choice decides
-speed alone. Where each side wins depends on the device (a launch and a read-back cost a fixed ~0.1 ms on PoCL), on
+speed alone. Where each side wins depends on the device (a launch and a read-back cost a fixed time), on
 this CPU (numpy's cost per texel), on the dab's kind (a SMOOTH texel costs numpy three to four DRAW texels) and on
 the footprint's size. A single dab is timed alone (`map_edit.apply_dab`); a stroke on a device-resident map is timed
 as a whole, per dab (`map_strokes.run_stroke`, `MapBuffer.stroke_times`), because its device dabs are read back
-together and its DRAW dabs run as one launch: there the device won at every radius measured (16 to 256) on two PoCL
-cores, and strokes try it first.
+together and its DRAW dabs run as one launch: there the device usually wins (``bench/displacement.py``,
+``stroke``), and strokes try it first.
 
 `DabTimes` keeps, per (kind, footprint class), the last few times of each side; a class holds the footprints of
 [2^(k-1), 2^k) texels. A new class takes the side a measured class of the kind implies (the device faster at a

@@ -1,7 +1,2 @@
-"""Nailboards: relief-mapped, depth-correct impostors ([Clua et al.]).
-
-`prewarp` is the relief-texture pre-warp (eq. 7 in the convention of [Clua et al., correction 1]) with the
-occlusion-compatible traversal, the offset map and two-pass 1-D hole filling; `validity` the sprite resolution
-(eq. 8) and the tests that say when a board must be regenerated ([Clua et al., §5.1]: approach, parallax, resolution eq.
-9).
-"""
+"""Nailboards and impostors ([Clua et al.]): the relief pre-warp, when a board must be made again, where it stands, and
+the octahedral views of a baked impostor. The module map: ``docs/architecture.md``."""
