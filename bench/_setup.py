@@ -1,42 +1,30 @@
-"""Make the source tree importable as the package ``tessera`` (a symlink in a temporary folder), and
-enable it in Blender the way an installed extension is (a local extension repository on that folder)."""
+"""What the benches share: the source tree importable as the package ``tessera`` and enabled in Blender the way an
+installed extension is (`tools.source_tree`, the one bootstrap), and timing helpers."""
 
 import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tools"))
+from source_tree import as_package  # noqa: E402
+from source_tree import enable_extension as _enable  # noqa: E402
+
 _FOLDER = None
 
 
 def import_path():
     global _FOLDER
     if _FOLDER is None:
-        _FOLDER = Path(tempfile.mkdtemp(prefix="tessera-bench-"))
-        (_FOLDER / "tessera").symlink_to(ROOT, target_is_directory=True)
-        sys.path.insert(0, str(_FOLDER))
-        from tessera.tools.temp_folders import remove_at_exit
-
-        remove_at_exit(_FOLDER)  # Blender writes its user folder here as it exits
+        _FOLDER = as_package("tessera-bench-")
         os.environ.setdefault("BLENDER_USER_RESOURCES", str(_FOLDER / "blender_user"))
     return _FOLDER
 
 
 def enable_extension():
     """Enable Tessera in the bpy module; returns the add-on's package name (``bl_ext.tessera_bench.tessera``)."""
-    folder = import_path()
-    import addon_utils
-    import bpy
-
-    repos = bpy.context.preferences.extensions.repos
-    if "tessera_bench" not in {r.module for r in repos}:
-        repos.new(name="tessera_bench", module="tessera_bench", custom_directory=str(folder), source="USER")
-    name = "bl_ext.tessera_bench.tessera"
-    if addon_utils.enable(name, default_set=True, handle_error=None) is None:
-        raise RuntimeError("Tessera failed to enable")
-    return name
+    return _enable(import_path(), "tessera_bench")
 
 
 def best_of(fn, repeat=5):

@@ -34,11 +34,8 @@ Run with ``make demo`` (or ``.venv/bin/python samples/demo.py`` after ``make set
 - ``out/demo.glb``, ``out/demo.obj`` (+ .mtl): the PN result through Blender's own exporters.
 """
 
-import atexit
 import os
-import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -52,15 +49,13 @@ LEVEL = 4
 
 def enable_addon():
     """Enable the source tree as an extension (a dev repo holding a link named after the package id)."""
-    import addon_utils
+    sys.path.insert(0, str(ROOT / "tools"))
+    from source_tree import as_package, enable_extension
 
-    repo = Path(tempfile.mkdtemp(prefix="tessera-demo-repo-"))
-    atexit.register(shutil.rmtree, repo, ignore_errors=True)
-    (repo / "tessera").symlink_to(ROOT, target_is_directory=True)
-    bpy.context.preferences.extensions.repos.new(name="tessera_demo", module="tessera_demo",
-                                                 custom_directory=str(repo), source="USER")
-    if addon_utils.enable("bl_ext.tessera_demo.tessera", default_set=True, handle_error=None) is None:
-        sys.exit("demo: the Tessera add-on failed to enable")
+    try:
+        enable_extension(as_package("tessera-demo-repo-"), "tessera_demo")
+    except RuntimeError as err:
+        sys.exit(f"demo: {err}")
 
 
 def material(name, rgba):

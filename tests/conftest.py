@@ -23,11 +23,10 @@ ROOT = Path(__file__).resolve().parents[1]
 CI = os.environ.get("CI", "").strip().lower() in ("1", "true", "yes")
 #: The GPU backend the gpu tier runs on: OPENGL (llvmpipe), or VULKAN (lavapipe, `tools/gpu_backend.py`).
 GPU_BACKEND = os.environ.get("TESSERA_GPU_BACKEND", "OPENGL").strip().upper()
+from tools.source_tree import as_package, enable_extension  # noqa: E402 (``python -m pytest``: the root is on the path)
+
 _TMP = Path(tempfile.mkdtemp(prefix="tessera-tests-"))
-REPO_DIR = _TMP / "repo"  # holds the symlink "tessera" -> source tree
-REPO_DIR.mkdir()
-(REPO_DIR / "tessera").symlink_to(ROOT, target_is_directory=True)
-sys.path.insert(0, str(REPO_DIR))
+REPO_DIR = as_package(folder=_TMP / "repo")  # holds the symlink "tessera" -> source tree
 from tessera.tools.temp_folders import remove_at_exit  # noqa: E402
 
 remove_at_exit(_TMP)  # nothing left in the temp folder, Blender's caches included
@@ -104,14 +103,8 @@ def addon(bpy_module):
     """The Tessera package as Blender loads it (dev extension repo on the source tree), enabled."""
     import addon_utils
 
-    prefs = bpy_module.context.preferences
-    if DEV_REPO_MODULE not in {r.module for r in prefs.extensions.repos}:
-        prefs.extensions.repos.new(
-            name=DEV_REPO_MODULE, module=DEV_REPO_MODULE, custom_directory=str(REPO_DIR), source="USER"
-        )
-    mod = addon_utils.enable(ADDON_MODULE, default_set=True, handle_error=None)
-    assert mod is not None, "the add-on failed to enable"
-    yield mod
+    assert enable_extension(REPO_DIR, DEV_REPO_MODULE) == ADDON_MODULE
+    yield sys.modules[ADDON_MODULE]
     addon_utils.disable(ADDON_MODULE, default_set=True)
 
 

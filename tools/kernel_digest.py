@@ -6,25 +6,11 @@ when two environments disagree: the kernels must give the same bytes whatever Nu
 Usage: python tools/kernel_digest.py   (prints one JSON object: family -> hex digest)
 """
 
-import atexit
 import hashlib
 import json
-import shutil
-import sys
-import tempfile
-from pathlib import Path
 
 import numpy as np
-
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _import_tessera():
-    """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
-    folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
-    atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(folder))
+from source_tree import as_package  # tools/ is first on sys.path
 
 
 def _digest(*arrays):
@@ -104,7 +90,7 @@ def subdivision():
 
 
 def main():
-    _import_tessera()
+    as_package("tessera-digest-")
     print(json.dumps({"numpy": np.__version__, "tessellation": tessellation(), "tubes": tubes(),
                       "terrain": terrain(), "subdivision": subdivision()}))
 

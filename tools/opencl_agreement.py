@@ -9,24 +9,10 @@ Usage: TESSERA_OPENCL=require [TESSERA_OPENCL_DEVICE=name] python tools/opencl_a
 Prints one JSON object per (build, path): differing values, values compared, the largest difference in ulps.
 """
 
-import atexit
 import json
-import shutil
-import sys
-import tempfile
-from pathlib import Path
 
 import numpy as np
-
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _import_tessera():
-    """The source tree as the package ``tessera`` (with the shared generators, ``tessera.tools.generators``)."""
-    folder = Path(tempfile.mkdtemp(prefix="tessera-agreement-"))
-    atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(folder))
+from source_tree import as_package  # tools/ is first on sys.path
 
 
 def ulp_distance(a, b):
@@ -68,7 +54,7 @@ def ham_row(runtime):
 
 
 def main():
-    _import_tessera()
+    as_package("tessera-agreement-")
     from tessera.kernels.common import opencl_runtime
 
     with_options = opencl_runtime.Runtime.base_options

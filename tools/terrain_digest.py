@@ -9,20 +9,10 @@ Usage: python tools/terrain_digest.py [--cameras N]
 import argparse
 import hashlib
 import json
-import os
 import platform
-import sys
-import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _import_tessera():
-    folder = Path(tempfile.mkdtemp(prefix="tessera-digest-"))
-    (folder / "tessera").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(folder))
-    return folder
+from source_tree import as_package  # tools/ is first on sys.path
 
 
 def digest(cameras=8):
@@ -56,24 +46,20 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cameras", type=int, default=8)
     args = parser.parse_args()
-    folder = _import_tessera()
-    try:
-        import numpy as np
+    as_package("tessera-digest-")
+    import numpy as np
 
-        out = digest(args.cameras)
-        out.update(machine=platform.processor() or platform.machine(), python=platform.python_version(),
-                   numpy=np.__version__)
-        try:
-            for line in Path("/proc/cpuinfo").read_text().splitlines():
-                if line.startswith("model name"):
-                    out["machine"] = line.split(":", 1)[1].strip()
-                    break
-        except OSError:
-            pass
-        print(json.dumps(out))
-    finally:
-        os.unlink(folder / "tessera")
-        os.rmdir(folder)
+    out = digest(args.cameras)
+    out.update(machine=platform.processor() or platform.machine(), python=platform.python_version(),
+               numpy=np.__version__)
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                out["machine"] = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    print(json.dumps(out))
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ Usage: python bad_file_case.py REPO_DIR FILE
 
 import json
 import sys
+from pathlib import Path
 
 import bpy
 import numpy as np
@@ -43,11 +44,10 @@ def finite():
 
 
 def main(repo_dir, path):
-    import addon_utils  # importable once bpy is
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
+    from source_tree import enable_extension
 
-    prefs = bpy.context.preferences
-    prefs.extensions.repos.new(name="tessera_dev", module="tessera_dev", custom_directory=repo_dir, source="USER")
-    assert addon_utils.enable("bl_ext.tessera_dev.tessera", default_set=True, handle_error=None) is not None
+    enable_extension(repo_dir, "tessera_dev")
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
     terrain = run(bpy.ops.tessera.terrain_add, source="FILE", filepath=path, tile_size=16, culling=False)

@@ -154,15 +154,14 @@ def test_a_run_larger_than_the_free_memory_is_refused_before_it_allocates(tmp_pa
     import subprocess
     import sys
 
-    from conftest import REPO_DIR
+    from conftest import REPO_DIR, ROOT
 
     script = f"""
 import resource, sys
-sys.path.insert(0, {str(REPO_DIR)!r})
+sys.path[:0] = [{str(REPO_DIR)!r}, {str(ROOT / "tools")!r}]
 import bpy
-bpy.context.preferences.extensions.repos.new(name="lim", module="lim", custom_directory={str(REPO_DIR)!r},
-                                             source="USER")
-bpy.ops.preferences.addon_enable(module="bl_ext.lim.tessera")
+from source_tree import enable_extension
+enable_extension({str(REPO_DIR)!r}, "lim")
 bpy.context.preferences.addons["bl_ext.lim.tessera"].preferences.memory_budget_mb = 0
 bpy.ops.mesh.primitive_grid_add(x_subdivisions=400, y_subdivisions=400)
 from tessera.kernels.common.budget import _proc_kib

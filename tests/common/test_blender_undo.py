@@ -7,16 +7,16 @@ import subprocess
 import sys
 
 import pytest
-from conftest import REPO_DIR
+from conftest import REPO_DIR, ROOT
 
 pytestmark = pytest.mark.blender
 
 SCRIPT = r"""
 import json, sys
-sys.path.insert(0, REPO)
+sys.path[:0] = [REPO, TOOLS]
 import bpy
-bpy.context.preferences.extensions.repos.new(name="undo", module="undo", custom_directory=REPO, source="USER")
-bpy.ops.preferences.addon_enable(module="bl_ext.undo.tessera")
+from source_tree import enable_extension
+enable_extension(REPO, "undo")
 ops = bpy.ops.tessera
 
 def counts():
@@ -76,8 +76,9 @@ print("RESULT" + json.dumps(results), flush=True)
 
 
 def test_every_creating_operator_undoes_and_redoes(tmp_path):
-    proc = subprocess.run([sys.executable, "-c", f"REPO = {str(REPO_DIR)!r}\n" + SCRIPT], capture_output=True,
-                          text=True, timeout=600, cwd=str(tmp_path))
+    head = f"REPO = {str(REPO_DIR)!r}\nTOOLS = {str(ROOT / 'tools')!r}\n"
+    proc = subprocess.run([sys.executable, "-c", head + SCRIPT], capture_output=True, text=True, timeout=600,
+                          cwd=str(tmp_path))
     lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT")]
     assert proc.returncode == 0 and lines, proc.stdout[-3000:] + proc.stderr[-3000:]
     for name, r in json.loads(lines[-1][len("RESULT"):]).items():

@@ -15,7 +15,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 import traceback
 from pathlib import Path
@@ -32,16 +31,10 @@ ADDON = f"bl_ext.{REPO_MODULE}.tessera"
 
 def enable_addon():
     """The add-on as Blender loads an extension: a dev repository whose ``tessera`` is the working tree."""
-    import addon_utils
+    sys.path.insert(0, str(SRC / "tools"))
+    from source_tree import as_package, enable_extension
 
-    repo = Path(tempfile.mkdtemp(prefix="tessera-repo-"))
-    (repo / "tessera").symlink_to(SRC, target_is_directory=True)
-    prefs = bpy.context.preferences
-    prefs.extensions.repos.new(name=REPO_MODULE, module=REPO_MODULE, custom_directory=str(repo), source="USER")
-    mod = addon_utils.enable(ADDON, default_set=True, handle_error=None)
-    if mod is None:
-        raise RuntimeError("the add-on did not enable")
-    return mod
+    return sys.modules[enable_extension(as_package("tessera-repo-", root=SRC), REPO_MODULE)]
 
 
 class Window:
