@@ -36,8 +36,8 @@ import_path()
 from tessera.kernels.terrain import geotiff as gt  # noqa: E402
 from tessera.kernels.terrain import heightmap_io as hio  # noqa: E402
 from tessera.kernels.terrain.analysis import tile_counts, tile_table  # noqa: E402
-from tessera.kernels.terrain.synth import ridged_terrain  # noqa: E402
 from tessera.tools.geotiff_files import write_geotiff  # noqa: E402
+from tessera.tools.ridged_terrain import ridged_terrain  # noqa: E402
 
 SIZE = 16385
 TILE = 256

@@ -75,7 +75,7 @@ def main():
     bpy.data.objects.remove(ob)
     spec = importlib.import_module(f"{name}.addon.tubes.nodes").SPEC
     run_tubes(bpy, groups, spec, random_walks(bpy, CURVES, POINTS))
-    synth = importlib.import_module(f"{name}.kernels.terrain.synth")
+    synth = importlib.import_module("tessera.tools.ridged_terrain")
     run_terrain(bpy, groups, importlib.import_module(f"{name}.addon.terrain.nodes").SPEC, synth)
 
 

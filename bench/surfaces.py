@@ -242,8 +242,11 @@ def surface_models(bpy, mod):
         return make
 
     def teapot():
-        nets, _ = mod("kernels.surfaces.utah_teapot").teapot_patches()
-        return mod("addon.curve_bridge").write_surface_patches(nets)
+        from tessera.tools.surface_objects import write_surface_patches
+        from tessera.tools.utah_teapot import teapot_patches
+
+        nets, _ = teapot_patches()
+        return write_surface_patches(nets)
 
     return (("sphere", primitive("sphere")), ("torus", primitive("torus")), ("teapot", teapot))
 

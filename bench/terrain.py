@@ -32,7 +32,7 @@ from tessera.kernels.terrain import opencl_path as terrain_opencl  # noqa: E402
 from tessera.kernels.terrain.analysis import ham, tile_table  # noqa: E402
 from tessera.kernels.terrain.lod import TerrainLod, select  # noqa: E402
 from tessera.kernels.terrain.mesh import triangle_count  # noqa: E402
-from tessera.kernels.terrain.synth import ridged_terrain  # noqa: E402
+from tessera.tools.ridged_terrain import ridged_terrain  # noqa: E402
 
 SIZE = 4097
 MODES = {"uniform_64": TerrainLod(mode="UNIFORM", culling=False),

@@ -327,7 +327,7 @@ def build_geotiff_scene(size=513):
 def _synth():
     import importlib
 
-    return importlib.import_module("bl_ext.tessera_demo.tessera.kernels.terrain.synth")
+    return importlib.import_module("tessera.tools.ridged_terrain")
 
 
 def build_gpu_preview_picture(name="demo_gpu_preview.png", size=(1280, 620)):
@@ -646,8 +646,11 @@ def build_teapot_scene():
     Returns the three triangle counts."""
     clear_scene()
     clay, wire_mat = material("Clay", (0.8, 0.55, 0.35, 1.0)), material("Wire", (0.05, 0.05, 0.08, 1.0))
-    nets, _ = _addon_module("kernels.surfaces.utah_teapot").teapot_patches()
-    surface = _addon_module("addon.curve_bridge").write_surface_patches(nets)
+    from tessera.tools.surface_objects import write_surface_patches
+    from tessera.tools.utah_teapot import teapot_patches
+
+    nets, _ = teapot_patches()
+    surface = write_surface_patches(nets)
     bpy.ops.surface.primitive_nurbs_surface_torus_add(location=(0.0, -3.0, -0.2))
     torus = bpy.context.active_object
     torus.rotation_euler = (0.35, 0.0, 0.0)

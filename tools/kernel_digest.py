@@ -61,7 +61,7 @@ def terrain():
     from tessera.kernels.terrain.analysis import tile_table
     from tessera.kernels.terrain.lod import TerrainLod, select
     from tessera.kernels.terrain.mesh import bake
-    from tessera.kernels.terrain.synth import ridged_terrain
+    from tessera.tools.ridged_terrain import ridged_terrain
 
     hm = hio.from_array(ridged_terrain(129, seed=2), texel_size=2.0, scale=60.0)
     table = tile_table(hm, 16, backend="numpy")

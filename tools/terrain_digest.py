@@ -19,9 +19,10 @@ def digest(cameras=8):
     """{"levels": sha256 of every selection's levels, "meshes": sha256 of every block's mesh} for the fixed cases."""
     import numpy as np
     from tessera.kernels.common.camera import Camera
-    from tessera.kernels.terrain import analysis, heightmap_io, lod, mesh, synth
+    from tessera.kernels.terrain import analysis, heightmap_io, lod, mesh
+    from tessera.tools.ridged_terrain import ridged_terrain
 
-    hm = heightmap_io.from_array((synth.ridged_terrain(257, seed=11) * 120.0).astype(np.float32), texel_size=3.0)
+    hm = heightmap_io.from_array((ridged_terrain(257, seed=11) * 120.0).astype(np.float32), texel_size=3.0)
     table = analysis.tile_table(hm, 16, backend="numpy")
     rng = np.random.default_rng(2026)
     levels, meshes = hashlib.sha256(), hashlib.sha256()

@@ -7,7 +7,8 @@ import pytest
 from tessera.kernels.common import camera
 from tessera.kernels.common.errors import InvalidInputError, OpenCLUnavailableError
 from tessera.kernels.surfaces import bezier_patches as bp
-from tessera.kernels.surfaces.revolved_teapot import teapot_patches
+
+from tools.revolved_teapot import teapot_patches
 
 pytestmark = pytest.mark.usefixtures("numpy_reference")  # the numpy reference; OpenCL: test_opencl_surfaces.py
 
@@ -131,7 +132,7 @@ def test_both_sides_of_an_edge_get_one_level_and_bad_input_is_refused():
 
 
 def full_teapot():
-    from tessera.kernels.surfaces.utah_teapot import teapot_patches as full
+    from tools.utah_teapot import teapot_patches as full
 
     return full()
 

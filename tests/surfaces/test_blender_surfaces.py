@@ -189,8 +189,11 @@ def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module)
     bpy = bpy_module
     bp = addon_module("kernels.surfaces.bezier_patches")
     nurbs = addon_module("kernels.common.nurbs")
-    patches, names = addon_module("kernels.surfaces.revolved_teapot").teapot_patches()
-    ob = addon_module("addon.curve_bridge").write_surface_patches(patches)
+    from tools.revolved_teapot import teapot_patches
+    from tools.surface_objects import write_surface_patches
+
+    patches, names = teapot_patches()
+    ob = write_surface_patches(patches)
     assert len(ob.data.splines) == 24
     surfaces, rows = addon_module("addon.curve_bridge").read_surface_splines(ob.data)
     assert rows == [] and len(surfaces) == 24

@@ -7,7 +7,8 @@ import pytest
 from tessera.kernels.common import nurbs, step_spacing
 from tessera.kernels.surfaces import bezier_patches as bp
 from tessera.kernels.surfaces import patch_deviation_opencl as pd
-from tessera.kernels.surfaces.utah_teapot import teapot_patches
+
+from tools.utah_teapot import teapot_patches
 
 pytestmark = pytest.mark.opencl
 

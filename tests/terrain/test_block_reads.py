@@ -13,10 +13,10 @@ from tessera.kernels.terrain import geotiff as gt
 from tessera.kernels.terrain import lod as tl
 from tessera.kernels.terrain import mesh as tm
 from tessera.kernels.terrain import sample_grid
-from tessera.kernels.terrain.synth import ridged_terrain
 from tessera.kernels.terrain.void_fill import CELL
 
 from tools.geotiff_files import write_geotiff
+from tools.ridged_terrain import ridged_terrain
 
 TS = 32  # tile size of the terrain (samples)
 FILE_TILE = 64  # tile size of the file

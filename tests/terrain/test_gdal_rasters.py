@@ -13,8 +13,9 @@ from tessera.kernels.common.errors import InvalidInputError  # noqa: E402
 from tessera.kernels.terrain import analysis as ta  # noqa: E402
 from tessera.kernels.terrain import gdal_raster  # noqa: E402
 from tessera.kernels.terrain import geotiff as gt  # noqa: E402
-from tessera.kernels.terrain.synth import ridged_terrain  # noqa: E402
 from tessera.tools.geotiff_files import write_raster  # noqa: E402
+
+from tools.ridged_terrain import ridged_terrain  # noqa: E402
 
 US_FOOT = 1200.0 / 3937.0
 

@@ -12,9 +12,10 @@ from tessera.kernels.terrain import gdal_raster, sample_grid, void_fill
 from tessera.kernels.terrain import geotiff as gt
 from tessera.kernels.terrain import lod as tl
 from tessera.kernels.terrain import mesh as tm
-from tessera.kernels.terrain.synth import ridged_terrain
 from tessera.tools.geotiff_files import write_geotiff
 from test_terrain_lod import _random_camera
+
+from tools.ridged_terrain import ridged_terrain
 
 NODATA = -32768
 

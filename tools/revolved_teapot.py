@@ -1,7 +1,8 @@
-"""A test and demo model of bicubic patches: the body of revolution of Newell's Utah teapot (rim, body, lid and
-bottom: 24 of its 32 patches; the handle and the spout are left out), made from his profile curves, each revolved
-as four quadrant patches (the around-direction control points at r, 0.56 r as in his data). The lid's top and the
-bottom's centre collapse to a point on the axis, as in the original, and the lid's knob folds back on itself."""
+"""A model of bicubic patches for the tests, benches and demo (not shipped): the body of revolution of Newell's Utah
+teapot (rim, body, lid and bottom: 24 of its 32 patches; the handle and the spout are left out), made from his
+profile curves, each revolved as four quadrant patches (the around-direction control points at r, 0.56 r as in his
+data). The lid's top and the bottom's centre collapse to a point on the axis, as in the original, and the lid's
+knob folds back on itself."""
 
 import numpy as np
 

@@ -1,4 +1,5 @@
-"""A synthetic terrain for demos and benchmarks: ridged multi-octave value noise with a plain and a plateau.
+"""A synthetic terrain for the tests, benches and demo (not shipped): ridged multi-octave value noise with a plain
+and a plateau.
 
 Deterministic for a seed; vectorised (one bilinear upsample of a random lattice per octave).
 """
