@@ -1,7 +1,7 @@
 """How far Tessellate Surface's triangles stray from their patches, measured on an OpenCL device
 (``patch_deviation.cl``): the same sample points, the same parameters and double precision as the numpy references
-`bezier_patches.grid_deviation` (the cells of each patch's inner grid) and `bezier_patches._deviation` (triangles
-given one by one), which the tests compare them with.
+`bezier_patches.grid_deviation` (the cells of each patch's inner grid) and `bezier_patches.deviation._deviation`
+(triangles given one by one), which the tests compare them with.
 
 One work-item a cell or a triangle: the patch's net, its corners and every sample point are evaluated in it (no
 arrays of sample points are made on the host). Taken on a device with double precision (`supports`).
@@ -96,7 +96,7 @@ def grid_deviation(runtime, h, n_in, tu, tv, points):
 
 def triangle_deviation(runtime, h, corners, uv, patch, points):
     """The largest distance of each triangle from its patch at barycentric ``points`` (S, 3), as
-    `bezier_patches._deviation` measures it: nets h (P, k, k, 4) float64, corners (T, 3, 3), their (u, v)
+    `bezier_patches.deviation._deviation` measures it: nets h (P, k, k, 4) float64, corners (T, 3, 3), their (u, v)
     (T, 3, 2), patch (T,) -> (T,) float64."""
     return _per_item(runtime, "triangles", h, np.empty(len(corners)),
                      [(corners, np.float64), (uv, np.float64), (patch, np.int64)],

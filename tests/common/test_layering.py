@@ -103,6 +103,11 @@ def cycles(graph):
     return found
 
 
+#: The operator modules every operator may use: not a capability's, the plumbing operators share (what they select
+#: and place; the skeleton of the operators that render in a worker).
+SHARED_OPERATOR_MODULES = {"operators.selection", "operators.render_job"}
+
+
 def capability(name):
     """The capability package a module belongs to (``addon.tubes.preview`` -> ``tubes``), or None if shared."""
     parts = name.split(".")
@@ -117,7 +122,7 @@ def violations(graph):
             s_layer, t_layer = source.split(".")[0], target.split(".")[0]
             if LAYERS.index(t_layer) > LAYERS.index(s_layer):
                 out.append(f"{source} imports {target}: upward ({s_layer} -> {t_layer})")
-            elif t_layer == "operators" and s_layer == "operators" and target != "operators.selection":
+            elif t_layer == "operators" and s_layer == "operators" and target not in SHARED_OPERATOR_MODULES:
                 out.append(f"{source} imports the operator module {target}")
             s_cap, t_cap = capability(source), capability(target)
             if t_cap is not None and s_cap is not None and s_cap != t_cap:

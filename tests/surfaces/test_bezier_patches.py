@@ -7,6 +7,7 @@ import pytest
 from tessera.kernels.common import camera
 from tessera.kernels.common.errors import InvalidInputError, OpenCLUnavailableError
 from tessera.kernels.surfaces import bezier_patches as bp
+from tessera.kernels.surfaces.bezier_patches import deviation
 
 from tools.revolved_teapot import teapot_patches
 
@@ -279,7 +280,7 @@ def test_the_sides_measured_without_a_mesh_are_the_meshes_and_the_deviation_is_t
     rim = np.flatnonzero(((mesh.corner_uv == 0) | (mesh.corner_uv == 1)).any(axis=(1, 2)))
     assert len(rim) == len(patch)
     on_mesh = np.sort(bp.triangle_deviation(h, mesh, rim))
-    assert np.abs(np.sort(bp._deviation(h, corners, uv, patch)) - on_mesh).max() < 1e-12
+    assert np.abs(np.sort(deviation._deviation(h, corners, uv, patch)) - on_mesh).max() < 1e-12
     # every triangle of the mesh measured again: within the tolerance and within each patch's recorded deviation
     every = bp.triangle_deviation(h, mesh)
     worst = np.zeros(len(h))

@@ -7,6 +7,7 @@ import pytest
 from tessera.kernels.common import nurbs, step_spacing
 from tessera.kernels.surfaces import bezier_patches as bp
 from tessera.kernels.surfaces import patch_deviation_opencl as pd
+from tessera.kernels.surfaces.bezier_patches import deviation
 
 from tools.utah_teapot import teapot_patches
 
@@ -44,7 +45,7 @@ def test_grids_triangles_and_points_equal_the_numpy_reference(opencl, k):
     n_in[0] = (2, 7)  # fewer than 3 steps one way: no grid measured
     edges = bp.patch_edges(h)
     spacing = bp.patch_spacing(h, edges)
-    for points in (bp._B, bp._B[:4]):
+    for points in (deviation._B, deviation._B[:4]):
         for sp in (None, spacing):
             ref = bp.grid_deviation(h, n_in, sp, points=points)
             got = bp.grid_deviation(h, n_in, sp, points=points, runtime=opencl)
@@ -55,8 +56,8 @@ def test_grids_triangles_and_points_equal_the_numpy_reference(opencl, k):
     patch = rng.integers(0, len(h), t)
     uv = rng.uniform(0, 1, (t, 3, 2))
     corners = bp.evaluate(h[patch], uv[..., 0], uv[..., 1]) + rng.normal(0, 1e-3, (t, 3, 3))
-    ref = bp._deviation(h, corners, uv, patch)
-    assert np.abs(bp._deviation(h, corners, uv, patch, opencl) - ref).max() <= 1e-12 * scale
+    ref = deviation._deviation(h, corners, uv, patch)
+    assert np.abs(deviation._deviation(h, corners, uv, patch, opencl) - ref).max() <= 1e-12 * scale
     flat = uv.reshape(-1, 2)
     on = bp.evaluate(h[np.repeat(patch, 3)], flat[:, :1], flat[:, 1:])[:, 0]
     assert np.abs(pd.points(opencl, h, flat, np.repeat(patch, 3)) - on).max() <= 1e-12 * scale
@@ -67,9 +68,9 @@ def test_launches_split_into_chunks_give_the_same_grids(opencl, monkeypatch):
     h = random_nets(rng, 12, 4)
     n_in = rng.integers(3, 30, (12, 2))
     t = [step_spacing.padded_params(np.array([[0.0, 1.0]]).repeat(12, 0), n_in[:, a]) for a in (0, 1)]
-    whole = pd.grid_deviation(opencl, h, n_in, *t, bp._B)
+    whole = pd.grid_deviation(opencl, h, n_in, *t, deviation._B)
     monkeypatch.setattr(pd, "CHUNK", 50)  # smaller than some patches' grids: those launch alone
-    assert np.array_equal(pd.grid_deviation(opencl, h, n_in, *t, bp._B), whole)
+    assert np.array_equal(pd.grid_deviation(opencl, h, n_in, *t, deviation._B), whole)
 
 
 @pytest.mark.parametrize("model", ["teapot", "sphere", "random"])
