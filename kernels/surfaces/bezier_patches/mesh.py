@@ -91,19 +91,46 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     parameters)."""
     h = check_patches(control)
     edges = edges if edges is not None and edges.collapsed is not None else patch_edges(h)
-    k = h.shape[1]
-    deg = k - 1
     n_p = len(h)
     el = np.asarray(edge_levels, np.int64)
-    # vertices: corners (4 per patch, merged below), edge interior points (canonical order), inner grids
-    corners = cartesian(h[:, [0, deg, deg, 0], [0, 0, deg, deg]])  # (P, 4, 3): (0,0) (1,0) (1,1) (0,1)
-    # a corner on a collapsed side is that side's point (the poles of all patches around it are one point)
+    corners, side = _side_points(h, edges, el, spacing)
+    side_counts = el[edges.edge]  # (P, 4)
+    n_in = _pattern_counts(inner_pairs(inner_levels, n_p), side_counts)  # (P, 2): steps along u and along v
+    inner = _inner_points(h, n_in, spacing)
+    corner_uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
+    n_c = 4 * n_p
+    positions = np.concatenate([corners.reshape(-1, 3), side.points, inner.points])
+    uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side.uv, inner.uv])
+    patch = np.concatenate([np.repeat(np.arange(n_p), 4), side.patch, inner.patch])
+    tris, tri_patch, strip_uv = _pattern_triangles(edges, side, inner, side_counts, n_in, n_c, spacing)
+    return _welded(h, edges, positions, uv, patch, corners, inner, tris, tri_patch, strip_uv, n_c + len(side.points))
+
+
+@dataclass
+class _Points:
+    """Vertices of one kind, before welding: points (n, 3), uv (n, 2) and patch (n,) (the patch whose (u, v) they
+    are given in); ``first`` per side (E,) or per patch (P,): where its points start; for inner points ``normals``
+    (n, 3) (unnormalised) and ``counts`` (P,); for side points ``params`` (E, max level + 1) when spaced."""
+
+    points: np.ndarray
+    uv: np.ndarray
+    patch: np.ndarray
+    first: np.ndarray
+    normals: np.ndarray | None = None
+    params: np.ndarray | None = None
+
+
+def _side_points(h, edges, el, spacing):
+    """The patches' corners (P, 4, 3): (0,0) (1,0) (1,1) (0,1), each on a collapsed side moved to that side's point
+    (the poles of all patches around it are one point); and the sides' interior points (`_Points`, canonical order:
+    every side evaluated once, its (u, v) in the first patch side that uses it)."""
+    deg = h.shape[1] - 1
+    corners = cartesian(h[:, [0, deg, deg, 0], [0, 0, deg, deg]])
     side_corners = ((0, 1), (1, 2), (3, 2), (0, 3))  # BOTTOM, RIGHT, TOP, LEFT: their corners in side direction
     for side, (a, b) in enumerate(side_corners):
         col = edges.collapsed[edges.edge[:, side]]
         corners[col, a] = edges.point[edges.edge[col, side]]
         corners[col, b] = edges.point[edges.edge[col, side]]
-    corner_uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
     counts = el - 1
     e_first = np.concatenate([[0], np.cumsum(counts)])[:-1]
     e_of = np.repeat(np.arange(len(el)), counts)
@@ -114,7 +141,7 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     edge_pts = cartesian(np.matmul(b[:, None], edges.control[e_of])[:, 0])
     edge_pts[edges.collapsed[e_of]] = edges.point[e_of[edges.collapsed[e_of]]]  # exactly the one point
     # each edge's (patch, uv) for the vertex record: the first patch side that uses it
-    sides = np.arange(n_p * 4)
+    sides = np.arange(len(h) * 4)
     first_side = np.full(len(el), len(sides), np.int64)
     np.minimum.at(first_side, edges.edge.ravel(), sides)
     fp, fs = first_side // 4, first_side % 4
@@ -122,15 +149,20 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     tl = np.where(fr[e_of], 1.0 - t, t)
     side_uv = np.stack([np.select([fs[e_of] == 1, fs[e_of] == 3], [1.0, 0.0], tl),
                         np.select([fs[e_of] == 0, fs[e_of] == 2], [0.0, 1.0], tl)], 1)
-    side_counts = el[edges.edge]  # (P, 4)
-    n_in = _pattern_counts(inner_pairs(inner_levels, n_p), side_counts)  # (P, 2): steps along u and along v
+    return corners, _Points(edge_pts, side_uv, fp[e_of], e_first, params=side_t)
+
+
+def _inner_points(h, n_in, spacing):
+    """Every patch's inner grid (`_Points` with normals): n_in (P, 2) steps along u and v, rows j of columns i; one
+    tensor product per pair of inner counts."""
+    deg = h.shape[1] - 1
     mu, mv = n_in[:, 0] - 1, n_in[:, 1] - 1
     count = mu * mv
     in_first = np.concatenate([[0], np.cumsum(count)])[:-1]
     inner_pts = np.empty((int(count.sum()), 3))
     inner_uv = np.empty((len(inner_pts), 2))
     inner_nrm = np.empty((len(inner_pts), 3))
-    p_of = np.repeat(np.arange(n_p), count)
+    p_of = np.repeat(np.arange(len(h)), count)
     pairs, pair_of = np.unique(n_in, axis=0, return_inverse=True)
     for q, (nu, nv) in enumerate(pairs):  # one tensor product per pair of inner counts: rows j, columns i
         ps = np.flatnonzero((pair_of.ravel() == q) & (count > 0))
@@ -159,26 +191,27 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
         inner_nrm[rows] = _plane_points(cross / w2[:, None])
         jj, ii = np.divmod(np.arange((nu - 1) * (nv - 1)), nu - 1)
         inner_uv[rows] = np.stack(np.broadcast_arrays(t_u[:, ii], t_v[:, jj]), -1)
+    return _Points(inner_pts, inner_uv, p_of, in_first, normals=inner_nrm)
 
-    n_c = 4 * n_p
-    base_e, base_i = n_c, n_c + len(edge_pts)
-    positions = np.concatenate([corners.reshape(-1, 3), edge_pts, inner_pts])
-    uv = np.concatenate([np.tile(corner_uv, (n_p, 1)), side_uv, inner_uv])
-    patch = np.concatenate([np.repeat(np.arange(n_p), 4), fp[e_of], p_of])
 
-    tris, tri_patch, strip_uv = [], [], []  # the strips' corner (u, v); the cells' are their inner points'
+def _pattern_triangles(edges, side, inner, side_counts, n_in, n_c, spacing):
+    """Each patch's pattern over its vertices (corners from 0, side points from ``n_c``, inner points after them),
+    one pattern class at a time: triangles (T, 3), their patch (T,), and the (u, v) of the strips' triangles (S, 3, 2)
+    (a cell's are its inner points')."""
+    base_e, base_i = n_c, n_c + len(side.points)
+    tris, tri_patch, strip_uv = [], [], []
     keys = np.concatenate([side_counts, n_in], axis=1)
     classes, inverse = np.unique(keys, axis=0, return_inverse=True)
     for cls, key in enumerate(classes):
         ps = np.flatnonzero(inverse.ravel() == cls)
         tmpl = pattern(*(int(x) for x in key))
         cols = [4 * ps[:, None] + np.arange(4)[None]]
-        for side in range(4):
-            e, r = edges.edge[ps, side], edges.reversed[ps, side]
-            q = np.arange(int(key[side]) - 1)[None]  # the side's interior points in the patch's direction
-            cols.append(base_e + e_first[e][:, None] + np.where(r[:, None], q.shape[1] - 1 - q, q))
+        for s in range(4):
+            e, r = edges.edge[ps, s], edges.reversed[ps, s]
+            q = np.arange(int(key[s]) - 1)[None]  # the side's interior points in the patch's direction
+            cols.append(base_e + side.first[e][:, None] + np.where(r[:, None], q.shape[1] - 1 - q, q))
         cells = (int(key[4]) - 1) * (int(key[5]) - 1) if key[4] > 1 and key[5] > 1 else 0
-        cols.append(base_i + in_first[ps][:, None] + np.arange(cells)[None])
+        cols.append(base_i + inner.first[ps][:, None] + np.arange(cells)[None])
         lmap = np.concatenate(cols, 1)
         tri_patch.append(np.repeat(ps, len(tmpl)))
         if spacing is None:
@@ -187,19 +220,24 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
             strip_uv.append(np.broadcast_to(_pattern_uv(tuple(int(x) for x in key))[on_rim],
                                             (len(ps),) + on_rim.shape + (2,)).reshape(-1, 3, 2))
         else:
-            local_uv = _spaced_pattern_uv(ps, key, edges, side_t, inner_uv[cols[-1] - base_i])
-            strip, cells = _spaced_template(key, local_uv)
+            local_uv = _spaced_pattern_uv(ps, key, edges, side.params, inner.uv[cols[-1] - base_i])
+            strip, cell_tris = _spaced_template(key, local_uv)
             own = strip.reshape(len(ps), -1)  # (p, 3S)
             tris.append(np.concatenate([np.take_along_axis(lmap, own, axis=1).reshape(len(ps), -1, 3),
-                                        lmap[:, cells]], axis=1).reshape(-1, 3))
+                                        lmap[:, cell_tris]], axis=1).reshape(-1, 3))
             strip_uv.append(np.take_along_axis(local_uv, own[..., None], axis=1).reshape(-1, 3, 2))
-    tris, tri_patch, strip_uv = np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(strip_uv)
+    return np.concatenate(tris), np.concatenate(tri_patch), np.concatenate(strip_uv)
+
+
+def _welded(h, edges, positions, uv, patch, corners, inner, tris, tri_patch, strip_uv, shared):
+    """The `PatchMesh`: corners shared by patches and the points of collapsed sides merged where their positions are
+    exactly equal (the first ``shared`` vertices; inner points are never merged), the triangles they flatten dropped,
+    the strips' (u, v) at a pole moved, and the normals from the surface (a merged vertex takes the mean of its
+    patches')."""
+    base_i = shared
     # a cell's corners are all inner points (a strip's triangle has a corner or a side's point), which are never
     # merged: its corners' (u, v) are theirs, taken once the triangles are known
     is_cell = (tris >= base_i).all(axis=1)
-    # corners shared by patches, and points of collapsed sides, are the same point: merge exactly equal positions
-    # of corners and side points (inner points are never merged)
-    shared = n_c + len(edge_pts)
     _, first, inv = np.unique(positions[:shared], axis=0, return_index=True, return_inverse=True)
     remap = np.concatenate([first[inv.ravel()], np.arange(shared, len(positions))])
     merged = remap[tris]
@@ -220,10 +258,11 @@ def tessellate_patches(control, edge_levels, inner_levels, edges=None, spacing=N
     # normals from the surface (corners and sides from their first patch, a vanishing one a little inside it); a
     # merged vertex (a pole) gets the mean of its patches' normals there
     _, normals = _point_and_normal(h[patch[:shared]], uv[:shared, 0], uv[:shared, 1])
+    inner_nrm = inner.normals
     length = np.linalg.norm(inner_nrm, axis=1)
     weak = np.flatnonzero(length <= 1e-12 * (1.0 + np.abs(corners).max()) ** 2)
     if len(weak):
-        inner_nrm[weak] = _point_and_normal(h[p_of[weak]], inner_uv[weak, 0], inner_uv[weak, 1])[1]
+        inner_nrm[weak] = _point_and_normal(h[inner.patch[weak]], inner.uv[weak, 0], inner.uv[weak, 1])[1]
         length[weak] = 1.0
     summed = np.zeros_like(normals)  # inner points are never merged: only the shared ones are summed
     np.add.at(summed, remap[:shared], normals)
