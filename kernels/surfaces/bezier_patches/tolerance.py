@@ -93,57 +93,7 @@ def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower, runt
     for _round in range(TOLERANCE_ROUNDS):
         check_budget(estimate(el, inner), budget_bytes, lower)
         dev = measure(el, inner, changed, changed_sides)
-        rim_uv, rim_patch, rim_dev = rim
-        # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
-        # inside has along it raises that side (its long edge lies along it)
-        over = rim_dev > tol
-        uv, tp, td = rim_uv[over], rim_patch[over], rim_dev[over]
-        on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
-                            (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
-        side_need = side_dev.copy()
-        side_need[edges.collapsed] = 0.0  # a pole has no length to split
-        # a triangle over the tolerance along a side with more segments than the inside has along it (a finer
-        # patch beside it): the inside takes the side's count that way, so the strip between them is regular
-        coarse_side, fine_side = np.zeros(len(tp), bool), np.zeros(len(tp), bool)
-        new_inner = inner.copy()
-        for side in range(4):
-            e = edges.edge[tp, side]
-            along = inner[tp, side % 2]
-            use = on_side[:, side] & (el[e] < along) & ~edges.collapsed[e]
-            np.maximum.at(side_need, e[use], td[use])
-            finer = on_side[:, side] & (el[e] > along) & ~edges.collapsed[e] & ~use
-            np.maximum.at(new_inner[:, side % 2], tp[finer], el[e[finer]])
-            coarse_side |= use
-            fine_side |= finer
-        new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, top)), el)
-        # a grid over the tolerance: refitted (`fitted_inner`), at least one step more; any other triangle along
-        # a side: both directions
-        rim_need = np.zeros(len(h))
-        other = ~coarse_side & ~fine_side
-        np.maximum.at(rim_need, tp[other], td[other])
-        grid_over = grid_dev[:, 0] > tol
-        refit = np.maximum(new_inner, fitted_inner(grid_dev, inner, tol, top))
-        new_inner[grid_over] = refit[grid_over]
-        stuck = grid_over & (new_inner == inner).all(axis=1)
-        new_inner[stuck] += 1
-        # a triangle along a side over it: the grid's model scaled up to what was measured there, refitted (the
-        # directions keep the grid's best ratio), at least one step more the way that strays most
-        rim_over = np.flatnonzero(rim_need > tol)
-        if len(rim_over):
-            scaled = grid_dev[rim_over] * (rim_need[rim_over] / np.maximum(grid_dev[rim_over, 0], 1e-300))[:, None]
-            unmeasured = grid_dev[rim_over, 0] <= 0
-            scaled[unmeasured] = rim_need[rim_over][unmeasured, None] * [1.0, 0.5, 0.5]
-            want = np.maximum(new_inner[rim_over], fitted_inner(scaled, inner[rim_over], tol, top))
-            # no step more from the model: one more the way that strays most (unmeasured: the way with fewer
-            # steps), or the other way where that one is at Max Level
-            same = (want <= inner[rim_over]).all(axis=1)
-            was = inner[rim_over]
-            axis = np.where(unmeasured, was[:, 1] < was[:, 0], scaled[:, 2] > scaled[:, 1]).astype(np.int64)
-            axis = np.where(was[np.arange(len(axis)), axis] >= top, 1 - axis, axis)
-            want[same, axis[same]] = was[same, axis[same]] + 1
-            new_inner[rim_over] = want
-        new_inner = np.minimum(new_inner, top)
-        new_el = np.minimum(_sides_keep_up(new_el, new_inner, edges), top)
+        new_el, new_inner = _raised(el, inner, edges, rim, side_dev, grid_dev, tol, top)
         changed_sides = new_el != el
         changed = (new_inner != inner).any(axis=1) | changed_sides[edges.edge].any(axis=1)
         if not changed.any():
@@ -151,3 +101,60 @@ def _meet_tolerance(h, el, inner, edges, spacing, lod, budget_bytes, lower, runt
         el, inner = new_el, new_inner
     check_budget(estimate(el, inner), budget_bytes, lower)
     return el, inner, measure(el, inner, changed, changed_sides)
+
+
+def _raised(el, inner, edges, rim, side_dev, grid_dev, tol, top):
+    """One round's new levels from what it measured: edge levels (E,) and inner levels (P, 2), at most ``top``.
+    rim: the strips' triangles ((u, v) (T, 3, 2), patch (T,), deviation (T,)); side_dev (E,): each side's chords;
+    grid_dev (P, 3): each inner grid's deviation and its parts along u and v (`grid_deviation`)."""
+    rim_uv, rim_patch, rim_dev = rim
+    # a triangle over the tolerance with a corner on a side of its patch that has fewer segments than the
+    # inside has along it raises that side (its long edge lies along it)
+    over = rim_dev > tol
+    uv, tp, td = rim_uv[over], rim_patch[over], rim_dev[over]
+    on_side = np.stack([(uv[..., 1] == 0).any(1), (uv[..., 0] == 1).any(1), (uv[..., 1] == 1).any(1),
+                        (uv[..., 0] == 0).any(1)], 1)  # BOTTOM, RIGHT, TOP, LEFT
+    side_need = side_dev.copy()
+    side_need[edges.collapsed] = 0.0  # a pole has no length to split
+    # a triangle over the tolerance along a side with more segments than the inside has along it (a finer
+    # patch beside it): the inside takes the side's count that way, so the strip between them is regular
+    coarse_side, fine_side = np.zeros(len(tp), bool), np.zeros(len(tp), bool)
+    new_inner = inner.copy()
+    for side in range(4):
+        e = edges.edge[tp, side]
+        along = inner[tp, side % 2]
+        use = on_side[:, side] & (el[e] < along) & ~edges.collapsed[e]
+        np.maximum.at(side_need, e[use], td[use])
+        finer = on_side[:, side] & (el[e] > along) & ~edges.collapsed[e] & ~use
+        np.maximum.at(new_inner[:, side % 2], tp[finer], el[e[finer]])
+        coarse_side |= use
+        fine_side |= finer
+    new_el = np.where(side_need > tol, np.maximum(el + 1, steps_for(side_need, el, tol, top)), el)
+    # a grid over the tolerance: refitted (`fitted_inner`), at least one step more; any other triangle along
+    # a side: both directions
+    rim_need = np.zeros(len(inner))
+    other = ~coarse_side & ~fine_side
+    np.maximum.at(rim_need, tp[other], td[other])
+    grid_over = grid_dev[:, 0] > tol
+    refit = np.maximum(new_inner, fitted_inner(grid_dev, inner, tol, top))
+    new_inner[grid_over] = refit[grid_over]
+    stuck = grid_over & (new_inner == inner).all(axis=1)
+    new_inner[stuck] += 1
+    # a triangle along a side over it: the grid's model scaled up to what was measured there, refitted (the
+    # directions keep the grid's best ratio), at least one step more the way that strays most
+    rim_over = np.flatnonzero(rim_need > tol)
+    if len(rim_over):
+        scaled = grid_dev[rim_over] * (rim_need[rim_over] / np.maximum(grid_dev[rim_over, 0], 1e-300))[:, None]
+        unmeasured = grid_dev[rim_over, 0] <= 0
+        scaled[unmeasured] = rim_need[rim_over][unmeasured, None] * [1.0, 0.5, 0.5]
+        want = np.maximum(new_inner[rim_over], fitted_inner(scaled, inner[rim_over], tol, top))
+        # no step more from the model: one more the way that strays most (unmeasured: the way with fewer
+        # steps), or the other way where that one is at Max Level
+        same = (want <= inner[rim_over]).all(axis=1)
+        was = inner[rim_over]
+        axis = np.where(unmeasured, was[:, 1] < was[:, 0], scaled[:, 2] > scaled[:, 1]).astype(np.int64)
+        axis = np.where(was[np.arange(len(axis)), axis] >= top, 1 - axis, axis)
+        want[same, axis[same]] = was[same, axis[same]] + 1
+        new_inner[rim_over] = want
+    new_inner = np.minimum(new_inner, top)
+    return np.minimum(_sides_keep_up(new_el, new_inner, edges), top), new_inner
