@@ -35,9 +35,10 @@ def enable_extension(folder, repo):
     """Enable Tessera in the running Blender from ``folder`` (from `as_package`), registered as the local extension
     repository ``repo`` as Blender loads an extension: returns the add-on's package name ``bl_ext.<repo>.tessera``.
     Raises RuntimeError when the add-on does not enable."""
-    import addon_utils
-    import bpy
+    import importlib
 
+    bpy = importlib.import_module("bpy")  # first: Blender's own modules (addon_utils) are importable once bpy is
+    addon_utils = importlib.import_module("addon_utils")
     repos = bpy.context.preferences.extensions.repos
     if repo not in {r.module for r in repos}:
         repos.new(name=repo, module=repo, custom_directory=str(folder), source="USER")

@@ -129,7 +129,7 @@ def add_options(parser, props):
         elif p.type == "ENUM":
             kw.update(type=_enum(p), metavar="A,B" if p.is_enum_flag else "CHOICE")
         else:
-            kw.update(metavar="TEXT")
+            kw.update(metavar="FILE" if p.subtype == "FILE_PATH" else "TEXT")
         group.add_argument(flag(p.identifier), **kw)
 
 
