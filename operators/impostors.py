@@ -23,7 +23,7 @@ from ..addon.impostors.export import export_card, impostor_info
 from ..addon.preferences import get_preferences
 from ..addon.render_jobs import render_device, render_key
 from ..kernels.common.errors import TesseraError
-from .render_job import KEEP_BYTES, RenderJobOperator
+from .render_job import RenderJobOperator
 from .selection import object_poll, select_only
 
 #: The last views rendered (before dilation), by what their render depended on: the redo panel reuses them.
@@ -96,9 +96,9 @@ class TESSERA_OT_impostor_bake(RenderJobOperator, bpy.types.Operator):
     def _prepare(atlas, what, dilation):
         return dilated(atlas, dilation)
 
-    def _keep(self, key, atlas, what, device):
-        small = atlas.colour.nbytes * 3 <= KEEP_BYTES  # colour, normal and depth
-        _last.update(key=key if small else None, rendered=atlas if small else None, what=what, device=device)
+    @staticmethod
+    def _render_bytes(atlas):
+        return atlas.colour.nbytes * 3  # colour, normal and depth
 
     def _make_steps(self, context, tx, atlas, what, device):
         """The card and its images from a dilated atlas, one step at a time (each image, the parts of the card's

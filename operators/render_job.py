@@ -51,9 +51,14 @@ class RenderJobOperator:
                     "Esc to cancel")
         return f"{self.job_label}{on} — Esc to cancel"
 
+    @staticmethod
+    def _render_bytes(rendered):
+        """What keeping ``rendered`` for the redo panel costs, in bytes."""
+        return rendered.nbytes
+
     def _keep(self, key, rendered, what, device):
         """Keep the last render for the redo panel (when small enough)."""
-        small = rendered.nbytes <= KEEP_BYTES
+        small = self._render_bytes(rendered) <= KEEP_BYTES
         self._last.update(key=key if small else None, rendered=rendered if small else None,
                           what=what if small else None, device=device)
 

@@ -99,10 +99,9 @@ def analysis(ob, progress=None, scene=None, block=None, void_index=""):
         region = None if block is None else block_region(block, hit[2].counts)
         if hit[4] is None or hit[4] == region:  # a whole table serves every block
             return hit[1], hit[2]
-    half = None if progress is None else (lambda done, total: progress(done, 2 * total))
-    if hit is not None and hit[0] == key:
-        hm, geo = hit[1], hit[3]
+        hm, geo = hit[1], hit[3]  # the same data: analysed again for another part
     else:
+        half = None if progress is None else (lambda done, total: progress(done, 2 * total))
         hm, geo = read_source(s, scene, half, void_index)
     region = None
     if block is not None:

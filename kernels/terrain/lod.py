@@ -183,13 +183,6 @@ def _cached(table, key, make):
     return table.derived[key]
 
 
-def _grid_heights_at_peak(hm, table, xs, ys, levels):
-    """Height at each tile's peak of a level-``level`` grid over the tile, for each of ``levels``: a list of (nty, ntx)
-    float64, from one read of the height map (a file's blocks decoded once for every level)."""
-    gx, gy, cells = _peak_grid_points(table, xs, ys, levels)
-    return _heights_at_peak(hm.sample(np.stack(gx), np.stack(gy)).astype(np.float64), cells)
-
-
 def _peak_grid_points(table, xs, ys, levels):
     """The corners of the grid cell around each tile's peak for each of ``levels``: x and y lists of 4 (nty, ntx) arrays
     per level, and per level the peak's place (u, v) in its cell."""
@@ -223,34 +216,30 @@ def _heights_at_peak(z, cells):
 _SEARCHED = [1 << k for k in range(MAX_LEVEL.bit_length())]
 
 
-def _prefetch(hm, table, xs, ys, peaks):
-    """Read every height the selection needs in one pass over the map and keep them in ``table.derived``: each tile's
-    edge midpoints and centre, and with ``peaks`` the grids under its peak (`_peak_base`), so a file's blocks are
-    decoded once for all of them."""
-    levels = [lv for lv in _SEARCHED if peaks and ("peak_dz", lv) not in table.derived]
-    if "centre" in table.derived and not levels:
-        return
+def _heights(hm, table, xs, ys):
+    """Every height the selection reads, in one pass over the map (a file's blocks decoded once for all of them), kept
+    in ``table.derived``: each tile's edge midpoints ``("edge", side)`` and centre ``"centre"`` as world coordinate
+    planes (3, nty, ntx), and for every searched level the grid under its peak minus the peak ``("peak_dz", level)``
+    (`_peak_base`). Returns ``table.derived``."""
+    if "centre" in table.derived:
+        return table.derived
     (x0, x1), (y0, y1) = xs, ys
     mx, my = (x0 + x1) * 0.5, (y0 + y1) * 0.5
     points = [(mx, y0), (x1, my), (mx, y1), (x0, my), (mx, my)]
-    gx, gy, cells = _peak_grid_points(table, xs, ys, levels)
+    gx, gy, cells = _peak_grid_points(table, xs, ys, _SEARCHED)
     z = hm.sample(np.stack([p[0] for p in points] + gx), np.stack([p[1] for p in points] + gy))
     for side, (px, py) in enumerate(points[:4]):
-        table.derived.setdefault(("edge", side), _planes(to_world(hm, px, py, z[side])))
-    table.derived.setdefault("centre", _planes(to_world(hm, mx, my, z[4])))
-    for lv, height in zip(levels, _heights_at_peak(z[5:].astype(np.float64), cells), strict=True):
-        table.derived.setdefault(("peak_dz", lv), (height - table.h_max).ravel())
+        table.derived[("edge", side)] = _planes(to_world(hm, px, py, z[side]))
+    for lv, height in zip(_SEARCHED, _heights_at_peak(z[5:].astype(np.float64), cells), strict=True):
+        table.derived[("peak_dz", lv)] = (height - table.h_max).ravel()
+    table.derived["centre"] = _planes(to_world(hm, mx, my, z[4]))  # last: it marks them all read
+    return table.derived
 
 
 def _peak_base(hm, table, xs, ys, level):
-    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height. The
-    powers of two up to `MAX_LEVEL` (what the search tries) are read together, once."""
-    key = ("peak_dz", level)
-    if key not in table.derived:
-        levels = [level] if level & (level - 1) else _SEARCHED
-        for lv, height in zip(levels, _grid_heights_at_peak(hm, table, xs, ys, levels), strict=True):
-            table.derived.setdefault(("peak_dz", lv), (height - table.h_max).ravel())
-    return table.derived[key]
+    """Flat (nty * ntx,) heights of each tile's level-``level`` grid below its peak, minus the peak height: ``level`` a
+    power of two up to `MAX_LEVEL` (what the search tries; read with the others by `_heights`)."""
+    return _heights(hm, table, xs, ys)[("peak_dz", level)]
 
 
 def _peak_clip(hm, table, m):
@@ -456,7 +445,7 @@ def _select(hm, table, camera, settings, first):
     xs = tuple(np.broadcast_to(b[None, :].astype(np.float64), (nty, ntx)) for b in xb)
     ys = tuple(np.broadcast_to(b[:, None].astype(np.float64), (nty, ntx)) for b in yb)
     top = float(settings.max_level)
-    _prefetch(hm, table, xs, ys, peaks=settings.mode == "OURS" and camera is not None)
+    heights = _heights(hm, table, xs, ys)
     if settings.mode == "UNIFORM":
         t_max = np.full((nty, ntx), top)
         t_min = t_max.copy()
@@ -473,16 +462,13 @@ def _select(hm, table, camera, settings, first):
     else:
         eye, d_max = camera.eye, auto_d_max(hm, camera, settings)
     (x0, x1), (y0, y1) = xs, ys
-    mx, my = (x0 + x1) * 0.5, (y0 + y1) * 0.5
-    points = ((mx, y0), (x1, my), (mx, y1), (x0, my))
     edge = np.empty((nty, ntx, 4))
-    for side, (px, py) in enumerate(points):
-        p = _cached(table, ("edge", side), lambda px=px, py=py: _planes(to_world(hm, px, py, hm.sample(px, py))))
+    for side in range(4):
+        p = heights[("edge", side)]
         e_max = np.maximum(t_max, _neighbour(t_max, side, 0.0))
         e_min = np.maximum(t_min, _neighbour(t_min, side, 0.0))
         edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
-    centre = _cached(table, "centre", lambda: _planes(to_world(hm, mx, my, hm.sample(mx, my))))
-    inner = distance_level(_distance(eye, centre), t_max, t_min, d_max)
+    inner = distance_level(_distance(eye, heights["centre"]), t_max, t_min, d_max)
     if settings.culling and camera is not None:
         culled = _culled(hm, table, camera, xs, ys)
     else:
