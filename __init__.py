@@ -21,6 +21,7 @@ _modules = (
     "operators.terrain",
     "operators.subdivision",
     "operators.surfaces",
+    "operators.vector_field",
     "operators.impostors",
     "operators.node_groups",
     "addon.node_library",

@@ -9,15 +9,15 @@ SHADERS = (
     ("nailboard", "impostors.draw", "_describe"),
     ("loop_mesh", "subdivision.draw", "_describe"),
     ("loop_stencils", "subdivision.draw", "_describe_stencils"),
-    ("lic_advect", "surfaces.lic", "_describe_advect"),
-    ("lic_splat", "surfaces.lic", "_describe_splat"),
-    ("surface_preview", "surfaces.draw", "_describe_preview"),
+        ("surface_preview", "surfaces.draw", "_describe_preview"),
     ("surface_compute", "surfaces.draw", "_describe_compute"),
     ("tube_preview", "tubes.draw", "_describe"),
     ("patch_preview", "tessellation.draw", "_describe_preview"),
     ("patch_compute", "tessellation.draw", "_describe_compute"),
     ("terrain_preview", "terrain.draw", "_describe"),
     ("texture_copy", "textures", "_describe_copy"),
+    ("vector_field_advect", "vector_field.streaks", "_describe_advect"),
+    ("vector_field_splat", "vector_field.streaks", "_describe_splat"),
 )
 
 

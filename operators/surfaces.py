@@ -1,7 +1,6 @@
 """``tessera.parametric_surface_add``: a one-point parametric surface ([Nunes 2011, §2.3]) baked into a mesh at the 3D
 cursor: welded where it closes, with its domain coordinates as UVs. ``tessera.curve_adaptive``: a curve's Bézier
-splines as polylines sampled where they bend ([Nellmedin 2014, §5.5.2]). ``tessera.vector_field_texture``: a steady
-field's line-integral-convolution image ([Nellmedin 2014, §5.5.4])."""
+splines as polylines sampled where they bend ([Nellmedin 2014, §5.5.2])."""
 
 import dataclasses
 
@@ -10,19 +9,16 @@ import numpy as np
 
 from ..addon import bridge, curve_bridge
 from ..addon.cameras import camera_for, object_camera
-from ..addon.gpu_context import ensure_gpu_context
 from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
-    FieldOptions,
     PatchOptions,
     SurfaceOptions,
     copy_surface_options,
     curve_sampling,
     draw_curve_options,
-    draw_field_options,
     draw_patch_options,
     draw_surface_options,
     patch_lod,
@@ -38,19 +34,15 @@ from ..kernels.common.bezier_curves import (
     offset_copies,
 )
 from ..kernels.common.budget import check_bytes
-from ..kernels.common.errors import GPUContextError, GPUShaderError, InvalidInputError
+from ..kernels.common.errors import InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp
-from ..kernels.surfaces import vector_field as vf
 from ..kernels.surfaces.domain_mesh import surface_mesh
 from .selection import object_poll, place_mesh, select_only
 
 #: Memory per point of an adaptive polyline: Blender's curve point (position and weight, radius, tilt, flags) and the
 #: float64 arrays it is written from.
 _BYTES_PER_CURVE_POINT = 96
-#: Memory per pixel of a vector-field texture: the splat sums and counts (float64), the RGBA pixels written, and
-#: Blender's float image with its packed copy.
-_BYTES_PER_FIELD_PIXEL = 96
 
 
 class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
@@ -210,83 +202,6 @@ class TESSERA_OT_curve_adaptive(CurveOptions, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class TESSERA_OT_vector_field_texture(FieldOptions, bpy.types.Operator):
-    """Make an image of streaks that follow a flow (a preset, or vectors on a grid mesh), for materials"""
-
-    bl_idname = "tessera.vector_field_texture"
-    bl_label = "Vector Field Texture"
-    bl_options = {"REGISTER", "UNDO"}
-
-    def draw(self, context):
-        draw_field_options(self.layout, self)
-
-    def _field(self, context):
-        if self.field != "MESH":
-            return vf.AnalyticField(self.field, slice_z=self.slice_z, speed=self.speed)
-        if self.field_object and self.field_object not in bpy.data.objects:
-            raise InvalidInputError(f"No object named {self.field_object!r} (Grid Object): pick the grid mesh")
-        ob = bpy.data.objects.get(self.field_object) if self.field_object else context.active_object
-        if ob is None or ob.type != "MESH":
-            raise InvalidInputError("Choose a grid mesh object holding the field (Grid Object), or make one active")
-        n = len(ob.data.vertices)
-        if n == 0:
-            raise InvalidInputError(f"The Grid Object {ob.name!r} has no vertices: give it the grid of the field")
-        positions, _ = bridge.read_wire_mesh(ob.data)
-        vectors = bridge.point_vector_attribute(ob.data, self.attribute, n) * self.speed
-        return vf.grid_field_from_points(positions, vectors)
-
-    def _camera_distance(self, context):
-        cam, ob = context.scene.camera, context.active_object
-        if cam is None:
-            return self.far  # no camera: the sparsest lattice
-        eye = np.array(cam.matrix_world.translation)
-        target = np.array(ob.matrix_world.translation) if ob is not None else np.zeros(3)
-        return float(np.linalg.norm(eye - target))
-
-    @guarded
-    def execute(self, context, tx):
-        if self.near >= self.far:
-            raise InvalidInputError(f"Near ({self.near:g}) must be less than Far ({self.far:g})")
-        check_bytes(self.width * self.height * _BYTES_PER_FIELD_PIXEL, get_preferences(context).memory_budget_bytes,
-                    f"A {self.width} x {self.height} texture would be made", "a smaller Width and Height")
-        field = self._field(context)
-        per_side = vf.seeds_per_side(self.seeds, self._camera_distance(context), self.near, self.far)
-        points, values = vf.seed_points(per_side, self.noise_seed)
-        backend = self.backend
-        if backend != "CPU":
-            try:
-                ensure_gpu_context()
-                from ..gpu_shaders.surfaces.lic import lic_on_gpu, lic_shaders
-
-                lic_shaders()
-                backend = "GPU"
-            except GPUShaderError as err:  # the driver cannot compile it: the numpy reference makes the same image
-                self.report({"WARNING"}, f"{err}; computed on the CPU with numpy")
-                backend = "CPU"
-            except GPUContextError as err:
-                if backend == "GPU":
-                    raise
-                self.report({"INFO"}, f"{err}; using numpy")
-                backend = "CPU"
-        if backend == "GPU":
-            total, count = lic_on_gpu(field, points, values, self.width, self.height, self.step, self.steps)
-        else:
-            total, count = vf.splat(vf.advect(points, field, self.step, self.steps), values, self.width,
-                                    self.height)
-        grey = np.where(count > 0, total / np.maximum(count, 1), 0.5).astype(np.float32)
-        if not np.all(np.isfinite(grey)):
-            raise InvalidInputError("The field gave points that are not finite numbers: lower the Step or Speed")
-        image = tx.track(bpy.data.images.new("Vector Field", self.width, self.height, float_buffer=True,
-                                             is_data=True))
-        rgba = np.ones((self.height, self.width, 4), np.float32)
-        rgba[..., :3] = grey[..., None]
-        bridge.write_image_pixels(image, rgba)
-        bridge.pack_float_image(image)
-        image.use_fake_user = True  # made to be used: kept in the file until the user deletes it
-        self.report({"INFO"}, f"{image.name}: {per_side}² seeds x {self.steps} steps on the {backend}")
-        return {"FINISHED"}
-
-
 class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
     """Turn the active surface object into a mesh with detail where it bends or near the camera, without cracks"""
 
@@ -379,5 +294,5 @@ def _row_lines(rows, tolerance):
 
 
 classes = (TESSERA_OT_parametric_surface_add, TESSERA_OT_parametric_surface_bake, TESSERA_OT_curve_adaptive,
-           TESSERA_OT_vector_field_texture, TESSERA_OT_surface_tessellate)
+           TESSERA_OT_surface_tessellate)
 register, unregister = bpy.utils.register_classes_factory(classes)

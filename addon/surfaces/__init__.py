@@ -1,2 +1,2 @@
 """Surfaces in Blender: parametric surfaces, Tessellate Surface and adaptive curves (their settings, previews, panels,
-the control points they read) and the vector-field texture."""
+the control points they read)."""

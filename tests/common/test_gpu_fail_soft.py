@@ -84,7 +84,7 @@ def _pixels(image):
 def test_operators_fall_back_to_numpy_with_a_warning(failing, bpy_module, clean_scene, capfd):
     bpy = bpy_module
     _, names, _ = failing
-    names.update({"patch_compute", "lic_advect", "lic_splat"})
+    names.update({"patch_compute", "vector_field_advect", "vector_field_splat"})
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1)
     source = bpy.context.active_object
     results = []

@@ -17,7 +17,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = ("kernels", "gpu_shaders", "addon", "operators")  # lowest first
-CAPABILITIES = ("tessellation", "tubes", "terrain", "displacement", "subdivision", "surfaces", "impostors")
+CAPABILITIES = ("tessellation", "tubes", "terrain", "displacement", "subdivision", "surfaces", "impostors",
+                "vector_field")
 
 BLOCKER = r"""
 import importlib, importlib.abc, pkgutil, sys

@@ -1,11 +1,11 @@
 """Vector-field textures on the GPU ([Nellmedin 2014, §5.5.4]): the seed points advected by a compute shader (explicit
 Euler, one dispatch a step, ping-pong between two RGBA32F textures) and splatted after every step as one-pixel
 points with additive blending into a float offscreen (red: the sum of values, green: how many), the numpy
-reference being `kernels.surfaces.vector_field` (`advect`, `splat`)."""
+reference being `kernels.vector_field.streaks` (`advect`, `splat`)."""
 
 import numpy as np
 
-from ...kernels.surfaces.vector_field import AnalyticField, GridField
+from ...kernels.vector_field.fields import AnalyticField, GridField
 from .. import loader
 from ..textures import TEX_WIDTH, image_texture, read_after_compute, rgba_texture
 
@@ -31,14 +31,14 @@ def _describe_advect():
     info.sampler(1, "FLOAT_2D", "grid")
     info.image(0, "RGBA32F", "FLOAT_2D", "points_out", qualifiers={"WRITE"})
     info.local_group_size(64, 1, 1)
-    info.compute_source(loader.sources("surfaces/lic_field.glsl", "surfaces/lic_advect_comp.glsl"))
+    info.compute_source(loader.sources("vector_field/field.glsl", "vector_field/advect_comp.glsl"))
     return info
 
 
 def _describe_splat():
     import gpu
 
-    iface = gpu.types.GPUStageInterfaceInfo("tessera_lic_iface")
+    iface = gpu.types.GPUStageInterfaceInfo("tessera_streak_iface")
     iface.flat("FLOAT", "value")
     info = gpu.types.GPUShaderCreateInfo()
     info.push_constant("INT", "tex_width")
@@ -46,8 +46,8 @@ def _describe_splat():
     info.vertex_in(0, "FLOAT", "id")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(loader.source("surfaces/lic_splat_vert.glsl"))
-    info.fragment_source(loader.source("surfaces/lic_splat_frag.glsl"))
+    info.vertex_source(loader.source("vector_field/splat_vert.glsl"))
+    info.fragment_source(loader.source("vector_field/splat_frag.glsl"))
     return info
 
 
@@ -82,13 +82,13 @@ def _read_points(texture, n):
     return read_after_compute(texture, n)
 
 
-def lic_shaders():
-    """The advection and splat shaders of `lic_on_gpu`, compiled (a `GPUShaderError` when this backend cannot)."""
-    return loader.shader("lic_advect", _describe_advect), loader.shader("lic_splat", _describe_splat)
+def streak_shaders():
+    """The advection and splat shaders of `streaks_on_gpu`, compiled (a `GPUShaderError` when this backend cannot)."""
+    return loader.shader("vector_field_advect", _describe_advect), loader.shader("vector_field_splat", _describe_splat)
 
 
-def lic_on_gpu(field, points, values, width, height, step, steps, keep_points=False):
-    """The texture of `kernels.surfaces.vector_field.lic_image`'s splats, on the GPU: ``(total (H, W), count
+def streaks_on_gpu(field, points, values, width, height, step, steps, keep_points=False):
+    """The texture of `kernels.vector_field.streaks.streak_image`'s splats, on the GPU: ``(total (H, W), count
     (H, W))`` float32 sums and counts, and with ``keep_points`` the points after the last step (N, 2). points (N, 2),
     values (N,). Needs a GPU context."""
     import gpu
@@ -101,7 +101,7 @@ def lic_on_gpu(field, points, values, width, height, step, steps, keep_points=Fa
     ping = rgba_texture(rows)
     pong = gpu.types.GPUTexture((TEX_WIDTH, tex_h), format="RGBA32F")
     grid = _grid_texture(field)
-    advect, splat = lic_shaders()
+    advect, splat = streak_shaders()
     batch = batch_for_shader(splat, "POINTS", {"id": np.arange(n, dtype=np.float32)})
     offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA32F")
     try:

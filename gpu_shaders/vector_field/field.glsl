@@ -1,4 +1,4 @@
-/* The steady fields of kernels/surfaces/vector_field.py in float32: field_kind 0 ABC (slice_z, speed), 1 VORTEX
+/* The steady fields of kernels/vector_field/fields.py in float32: field_kind 0 ABC (slice_z, speed), 1 VORTEX
  * (speed), 2 GRID (vectors in the rg of `grid`, grid_size texels, bilinear, clamped). Domain: the unit square. */
 
 vec2 field_at(vec2 p)

@@ -1,0 +1,1 @@
+"""Vector-field textures in Blender: the operator's settings."""

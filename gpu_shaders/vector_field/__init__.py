@@ -1,0 +1,1 @@
+"""Vector-field textures on the GPU: the streaks advected by a compute shader and splatted into an offscreen."""
