@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..kernels.common import nurbs
+from ..kernels.common.curves import nurbs
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.common.limits import MAX_WORLD_VALUE
 from .bridge import _get
@@ -69,7 +69,7 @@ def read_curve_object(ob, radius_scale=1.0):
 class SplineArrays:
     """One spline of a Curve data-block: kind ``BEZIER``, ``POLY`` or ``NURBS``; co (n, 3) float64; handle_left and
     handle_right (n, 3) float64 (Bézier) or None; radius and tilt (n,) float64; cyclic; material_index; weight (n,)
-    float64, order and knot_mode (one of `kernels.common.nurbs.KNOT_MODES`) for NURBS, else None, 0, ""."""
+    float64, order and knot_mode (one of `kernels.common.curves.nurbs.KNOT_MODES`) for NURBS, else None, 0, ""."""
 
     kind: str
     co: np.ndarray
@@ -124,9 +124,10 @@ def read_splines(curve, name=None):
 
 def read_surface_splines(curve, name=None):
     """The NURBS splines of a SURFACE curve, in object space: ``(surfaces, rows)``. surfaces: (index,
-    `kernels.common.nurbs.SurfaceSpline`) for each spline with more than one point in both directions (points (nv,
-    nu, 4), u fastest in Blender's list); rows: (index, points (n, 4), `Direction`) for each spline that is a single
-    row (Add > Surface > NURBS Curve or Circle), a curve drawn as edges. ``name``: the object's, for messages."""
+    `kernels.common.curves.nurbs.SurfaceSpline`) for each spline with more than one point in both directions
+    (points (nv, nu, 4), u fastest in Blender's list); rows: (index, points (n, 4), `Direction`) for each spline
+    that is a single row (Add > Surface > NURBS Curve or Circle), a curve drawn as edges. ``name``: the object's, for
+    messages."""
     surfaces, rows = [], []
     for k, s in enumerate(curve.splines):
         nu, nv = s.point_count_u, s.point_count_v

@@ -116,7 +116,7 @@ def blender_deviation(mod, surface, me):
     meshes are (each triangle at 7 barycentric points against the surface at the same point of its corners'
     parameters): Blender evaluates each spline on a grid of resolution x points equal steps a direction (v fastest);
     each grid quad is taken at its better diagonal, a quad with two corners at one point (a pole) as a triangle."""
-    nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
+    nurbs, bp = mod("kernels.common.curves.nurbs"), mod("kernels.surfaces.bezier_patches")
     pos = np.array([v.co[:] for v in me.vertices], np.float64)
     worst, start = 0.0, 0
     surfaces, _ = mod("addon.curve_bridge").read_surface_splines(surface.data)
@@ -193,7 +193,7 @@ def run_tessellate_surface(bpy, mod, name, make):
         return n
 
     n_ours = ours()
-    nurbs, bp = mod("kernels.common.nurbs"), mod("kernels.surfaces.bezier_patches")
+    nurbs, bp = mod("kernels.common.curves.nurbs"), mod("kernels.surfaces.bezier_patches")
     surfaces, _ = mod("addon.curve_bridge").read_surface_splines(surface.data)
     result = bp.tessellate(nurbs.patches_of([s for _, s in surfaces]).patches,
                            bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))

@@ -25,15 +25,15 @@ from ..addon.surfaces.settings import (
     surface_from,
 )
 from ..addon.surfaces.sources import control_points
-from ..kernels.common import nurbs
-from ..kernels.common.bezier_curves import (
+from ..kernels.common.budget import check_bytes
+from ..kernels.common.curves import nurbs
+from ..kernels.common.curves.bezier_curves import (
     MAX_TOLERANCE_SEGMENTS,
     CurveSampling,
     adaptive_nurbs,
     adaptive_spline,
     offset_copies,
 )
-from ..kernels.common.budget import check_bytes
 from ..kernels.common.errors import InvalidInputError
 from ..kernels.common.mesh_arrays import MeshArrays
 from ..kernels.surfaces import bezier_patches as bp

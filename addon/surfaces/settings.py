@@ -11,7 +11,7 @@ import dataclasses
 
 import bpy
 
-from ...kernels.common.bezier_curves import CurveSampling
+from ...kernels.common.curves.bezier_curves import CurveSampling
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.surfaces.bezier_patches import PatchLod
@@ -125,7 +125,7 @@ CURVE_MODE_ITEMS = (
 
 
 class CurveOptions:
-    """The options of ``tessera.curve_adaptive`` (`kernels.common.bezier_curves.CurveSampling`)."""
+    """The options of ``tessera.curve_adaptive`` (`kernels.common.curves.bezier_curves.CurveSampling`)."""
 
     mode: bpy.props.EnumProperty(name="Sampling", items=CURVE_MODE_ITEMS, default="CURVATURE",
                                  description="What decides how many segments each Bézier segment gets")

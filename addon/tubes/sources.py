@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ...kernels.common import nurbs
-from ...kernels.common.bezier_curves import CurveSampling, adaptive_nurbs, adaptive_spline
+from ...kernels.common.curves import nurbs
+from ...kernels.common.curves.bezier_curves import CurveSampling, adaptive_nurbs, adaptive_spline
 from ...kernels.common.errors import InvalidInputError
 from ...kernels.tubes.edge_chains import chains_from_edges
 from ...kernels.tubes.polylines import Polylines

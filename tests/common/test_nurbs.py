@@ -1,4 +1,4 @@
-"""NURBS splines as Blender holds them, split into rational Bézier pieces and patches (`kernels.common.nurbs`),
+"""NURBS splines as Blender holds them, split into rational Bézier pieces and patches (`kernels.common.curves.nurbs`),
 checked against an independent evaluator (geomdl, NURBS-Python) on random splines of every order, knot mode, weights
 and cyclic setting; Blender's own knots and evaluation are checked in `tests/surfaces/test_blender_nurbs.py`."""
 
@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 from geomdl import NURBS
-from tessera.kernels.common import nurbs as nb
-from tessera.kernels.common import rational_bezier as rb
+from tessera.kernels.common.curves import nurbs as nb
+from tessera.kernels.common.curves import rational_bezier as rb
 from tessera.kernels.common.errors import InvalidInputError
 
 MODES = ("UNIFORM", "ENDPOINT", "BEZIER", "ENDPOINT_BEZIER")

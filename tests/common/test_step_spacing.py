@@ -1,11 +1,11 @@
-"""Steps spaced where a curve bends (`kernels.common.step_spacing`): tables from 0 to 1, steps within 1 / FLOOR of
-each other, equal steps where nothing bends, chord deviations evened out, and NURBS curves meeting a tolerance with
-fewer points than equal steps need (measured independently, at 64 points a step)."""
+"""Steps spaced where a curve bends (`kernels.common.curves.step_spacing`): tables from 0 to 1, steps within
+1 / FLOOR of each other, equal steps where nothing bends, chord deviations evened out, and NURBS curves meeting a
+tolerance with fewer points than equal steps need (measured independently, at 64 points a step)."""
 
 import numpy as np
-from tessera.kernels.common import nurbs
-from tessera.kernels.common import rational_bezier as rb
-from tessera.kernels.common import step_spacing as ss
+from tessera.kernels.common.curves import nurbs
+from tessera.kernels.common.curves import rational_bezier as rb
+from tessera.kernels.common.curves import step_spacing as ss
 
 
 def test_steps_run_from_zero_to_one_within_the_floor_of_each_other():

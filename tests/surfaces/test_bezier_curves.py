@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-from tessera.kernels.common import bezier_curves as bz
 from tessera.kernels.common import camera
+from tessera.kernels.common.curves import bezier_curves as bz
 from tessera.kernels.common.errors import InvalidInputError
 
 
@@ -93,7 +93,7 @@ def test_six_offset_copies():
 
 
 def test_adaptive_spline_interpolates_radius_and_tilt_and_copies():
-    from tessera.kernels.common.bezier_curves import CurveSampling, adaptive_spline
+    from tessera.kernels.common.curves.bezier_curves import CurveSampling, adaptive_spline
 
     co = np.array([[0, 0, 0], [3, 0, 0], [3, 3, 0.5]], float)
     hl, hr = co - [0.5, 1, 0], co + [0.5, 1, 0]

@@ -77,7 +77,7 @@ def variants(ob, rng):
 @pytest.mark.parametrize("name", PRIMITIVES)
 def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_module, addon_module, name):
     bpy = bpy_module
-    nurbs = addon_module("kernels.common.nurbs")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     bp = addon_module("kernels.surfaces.bezier_patches")
     curve_bridge = addon_module("addon.curve_bridge")
     rng = np.random.default_rng(len(name))
@@ -201,7 +201,7 @@ def test_blenders_own_conversion_lies_on_the_same_surface(clean_scene, bpy_modul
     """Blender evaluates its surfaces at resolution x points equal steps of each direction's domain: those points
     are the kernel's patches' points at the same parameters (so the knots are Blender's)."""
     bpy = bpy_module
-    nurbs = addon_module("kernels.common.nurbs")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     bp = addon_module("kernels.surfaces.bezier_patches")
     ob = add_primitive(bpy, name)
     s = ob.data.splines[0]
@@ -249,7 +249,7 @@ def test_blenders_curve_evaluation_lies_on_the_pieces(clean_scene, bpy_module, a
     """Blender evaluates a NURBS curve at resolution equal steps of each span of its domain: its points are the
     pieces' points at the same parameters, for every knot mode, cyclic or not, with weights."""
     bpy = bpy_module
-    nurbs = addon_module("kernels.common.nurbs")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     rng = np.random.default_rng(order)
     for mode in CURVE_MODES:
         for cyclic in (False, True):
@@ -287,7 +287,7 @@ def test_blenders_curve_evaluation_lies_on_the_pieces(clean_scene, bpy_module, a
 @pytest.mark.parametrize("primitive", ("nurbs_circle", "nurbs_path", "bezier_circle"))
 def test_curve_to_adaptive_polyline_meets_the_tolerance_on_nurbs(clean_scene, bpy_module, addon_module, primitive):
     bpy = bpy_module
-    nurbs = addon_module("kernels.common.nurbs")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     getattr(bpy.ops.curve, f"primitive_{primitive}_add")()
     source = bpy.context.active_object
     rng = np.random.default_rng(5)
@@ -333,8 +333,8 @@ def test_curve_to_adaptive_polyline_meets_the_tolerance_on_nurbs(clean_scene, bp
 
 def test_tubes_sample_nurbs_curves_by_curvature(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
-    bz = addon_module("kernels.common.bezier_curves")
-    nurbs = addon_module("kernels.common.nurbs")
+    bz = addon_module("kernels.common.curves.bezier_curves")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     bpy.ops.curve.primitive_nurbs_path_add()
     ob = bpy.context.active_object
     s = ob.data.splines[0]

@@ -109,7 +109,7 @@ def poly_points(ob):
 @pytest.mark.parametrize("cyclic", [False, True])
 def test_curve_to_adaptive_polyline_samples_where_it_bends(clean_scene, bpy_module, addon_module, cyclic):
     bpy = bpy_module
-    bz = addon_module("kernels.common.bezier_curves")
+    bz = addon_module("kernels.common.curves.bezier_curves")
     co = np.array([[0, 0, 0], [4, 0, 0], [4.2, 0.3, 0], [8, 3, 1]], np.float32)  # straight, then a sharp bend
     hl = co - np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0], [1, 1, 0]], np.float32)
     hr = co + np.array([[1, 0, 0], [1, 0, 0], [0, -3, 0], [1, 1, 0]], np.float32)
@@ -154,7 +154,7 @@ def test_curve_copies_and_bad_splines(clean_scene, bpy_module):
 def test_tessellate_surface_on_the_teapot(clean_scene, bpy_module, addon_module):
     bpy = bpy_module
     bp = addon_module("kernels.surfaces.bezier_patches")
-    nurbs = addon_module("kernels.common.nurbs")
+    nurbs = addon_module("kernels.common.curves.nurbs")
     from tools.revolved_teapot import teapot_patches
     from tools.surface_objects import write_surface_patches
 

@@ -4,7 +4,7 @@ rational patches of every degree, and whole tessellations at a Tolerance give th
 
 import numpy as np
 import pytest
-from tessera.kernels.common import nurbs, step_spacing
+from tessera.kernels.common.curves import nurbs, step_spacing
 from tessera.kernels.surfaces import bezier_patches as bp
 from tessera.kernels.surfaces import patch_deviation_opencl as pd
 from tessera.kernels.surfaces.bezier_patches import deviation

@@ -145,7 +145,7 @@ def test_curvature_sampling_puts_rings_where_the_curve_bends(clean_scene, bpy_mo
     """Curve Sampling Curvature: each Bézier segment gets its eq. 4.5 count of rings (6 straight, up to 32 in a
     bend), the ring centres on the Bézier, the radius along each segment."""
     bpy = bpy_module
-    bz = addon_module("kernels.common.bezier_curves")
+    bz = addon_module("kernels.common.curves.bezier_curves")
     data = bpy.data.curves.new("Bend", "CURVE")
     data.dimensions = "3D"
     s = data.splines.new("BEZIER")

@@ -1,9 +1,9 @@
 """Rational Bézier patches of any degree tessellated with per-patch, per-boundary levels, welded with no
 T-junction ([Nellmedin 2014, §4.3, §5.5.3]; the Utah teapot's kind of model, and every NURBS surface Blender holds once
-`kernels.common.nurbs` has split it into patches).
+`kernels.common.curves.nurbs` has split it into patches).
 
 A patch is its k x k homogeneous control net ``H[i, j] = (w x, w y, w z, w)`` (i along u, j along v; degree k - 1
-in both directions: a direction of lower degree is raised exactly, `kernels.common.nurbs.degree_elevate`), and
+in both directions: a direction of lower degree is raised exactly, `kernels.common.curves.nurbs.degree_elevate`), and
 ``S(u, v) = Σ B_i(u) B_j(v) H[i, j]`` divided by its last coordinate. Polynomial patches may be given as (P, k, k, 3)
 Cartesian nets (weights 1). Sides, in the pattern's order (`kernels.common.quad_pattern.pattern`): BOTTOM v = 0 (u
 from 0 to 1), RIGHT u = 1 (v up), TOP v = 1 (u up), LEFT u = 0 (v up). A side is a rational curve of its k control
@@ -25,13 +25,13 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
 - projected edge length (§4.4): a side as a sphere as wide as its control polygon is long, at its centroid, over
   Edge Pixels; the inside from the net's longest row or column at its centroid;
 - tolerance (chordal deviation, scene units): the steps are spaced where the surface bends (`patch_spacing`:
-  `kernels.common.step_spacing`, one table for every direction linked through shared sides, `direction_chains`); a
-  side's level from the deviation of its chords at 16 steps, a direction's from its iso-lines', both scaled as the
-  square root (the deviation of a chord falls with the square of its length); each inner grid is then fitted to a
-  model measured on a 12 x 12 probe (`fitted_inner`), and every triangle is measured against the surface, before the
-  mesh is made (the inner grids by `grid_deviation`, the strips along the sides by `rim_triangles`), raising the
-  levels where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is met or the patches that
-  cannot meet it within Max Level are named (and split, `tessellate`);
+  `kernels.common.curves.step_spacing`, one table for every direction linked through shared sides,
+  `direction_chains`); a side's level from the deviation of its chords at 16 steps, a direction's from its
+  iso-lines', both scaled as the square root (the deviation of a chord falls with the square of its length); each inner
+  grid is then fitted to a model measured on a 12 x 12 probe (`fitted_inner`), and every triangle is measured against
+  the surface, before the mesh is made (the inner grids by `grid_deviation`, the strips along the sides by
+  `rim_triangles`), raising the levels where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is
+  met or the patches that cannot meet it within Max Level are named (and split, `tessellate`);
 - any of these together: the largest. Levels are whole segment counts. The inside of a patch has a count of steps
   along u and one along v: the same (the larger) for curvature, distance and edge length, each its own for the
   tolerance."""
@@ -43,9 +43,9 @@ from functools import cache
 import numpy as np
 
 from ...common.budget import check_budget
+from ...common.curves.rational_bezier import cartesian
 from ...common.errors import OpenCLUnavailableError, TesseraError
 from ...common.opencl_runtime import backend_runtime
-from ...common.rational_bezier import cartesian
 from .. import patch_deviation_opencl, patch_split
 from .deviation import _B, grid_deviation, rim_triangles, triangle_deviation
 from .levels import METRICS, PatchLod, Spacing, _sides_keep_up, direction_chains, patch_levels, patch_spacing
@@ -66,7 +66,7 @@ SPLIT_ROUNDS = 3
 def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
     """Levels from ``lod`` and the welded mesh at them: a `Tessellation`. With TOLERANCE among the metrics, every
     triangle is measured against the surface (`triangle_deviation`) and each side
-    (`kernels.common.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
+    (`kernels.common.curves.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
     within the tolerance or at Max Level; a patch still over it at Max Level is split in two along each direction at
     Max Level (`kernels.surfaces.patch_split`, with every patch that shares those sides) and the whole is made again,
     up to SPLIT_ROUNDS times. Every mesh is checked against ``budget_bytes`` (`kernels.common.budget.check_budget`)

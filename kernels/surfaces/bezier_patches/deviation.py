@@ -5,11 +5,12 @@ triangle."""
 
 import numpy as np
 
-from ...common import step_spacing, workers
-from ...common.quad_pattern import pattern
-from ...common.rational_bezier import (
+from ...common import workers
+from ...common.curves import step_spacing
+from ...common.curves.rational_bezier import (
     bernstein,
 )
+from ...common.quad_pattern import pattern
 from .. import patch_deviation_opencl
 from .nets import _contract_u_basis, _contract_v_basis, _grid_at, check_patches, evaluate, inner_pairs
 from .pattern_uv import _pattern_counts, _pattern_uv, _pole_corners, _spaced_pattern_uv, _spaced_template

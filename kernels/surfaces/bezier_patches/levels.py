@@ -5,16 +5,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...common import step_spacing
-from ...common.errors import InvalidInputError
-from ...common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
-from ...common.partition import MAX_LEVEL
-from ...common.rational_bezier import (
+from ...common.curves import step_spacing
+from ...common.curves.rational_bezier import (
     bernstein,
     cartesian,
     chord_deviation,
     steps_for,
 )
+from ...common.errors import InvalidInputError
+from ...common.level_metrics import curvature_level, curve_kappa, distance_level, projected_sphere_levels
+from ...common.partition import MAX_LEVEL
 from .nets import COLLAPSED, check_patches, tensor_grid
 
 METRICS = ("CURVATURE", "DISTANCE", "EDGE_LENGTH", "TOLERANCE")
@@ -54,7 +54,7 @@ class PatchLod:
 
 @dataclass
 class Spacing:
-    """Where the steps fall, for the tolerance (`kernels.common.step_spacing`, made by `patch_spacing`): edge
+    """Where the steps fall, for the tolerance (`kernels.common.curves.step_spacing`, made by `patch_spacing`): edge
     (E, M + 1) each shared side's table in its canonical direction; inner (P, 2, M + 1) each patch's tables along u
     and along v. A side's table is its chain's, as are the inner tables of the patches beside it along it, so they
     put their points at the same parameters."""
@@ -77,7 +77,7 @@ class Spacing:
 
 def patch_spacing(h, edges, lines=9):
     """`Spacing` of nets h (P, k, k, 4) and their `PatchEdges`. A direction's density is the largest of its
-    ``lines`` iso-lines' (`kernels.common.step_spacing.bend_density`), boundaries included. Patches that share a
+    ``lines`` iso-lines' (`kernels.common.curves.step_spacing.bend_density`), boundaries included. Patches that share a
     side share their steps along it: the directions linked through shared sides (`direction_chains`) take the
     largest density of the chain, each read in its own direction, and each side its chain's, so a side's points
     are where the inner grids beside it put theirs."""
@@ -164,7 +164,7 @@ def _polygon_length(points):
 
 def _direction_deviation(h, steps=16, lines=9, spacing=None):
     """How far each patch's iso-lines stray from their chords at ``steps`` steps
-    (`kernels.common.rational_bezier.chord_deviation`; equal, or by the patches' `Spacing`): along u (``lines``
+    (`kernels.common.curves.rational_bezier.chord_deviation`; equal, or by the patches' `Spacing`): along u (``lines``
     lines of constant v) and along v: (P, 2) float64."""
     k = h.shape[1]
     b = bernstein(np.linspace(0.0, 1.0, lines), k - 1)  # (lines, k)

@@ -7,12 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...common.budget import Estimate
-from ...common.quad_pattern import pattern
-from ...common.rational_bezier import (
+from ...common.curves.rational_bezier import (
     bernstein,
     bernstein_derivative,
     cartesian,
 )
+from ...common.quad_pattern import pattern
 from .nets import (
     PatchEdges,
     _contract_u,
@@ -64,7 +64,7 @@ class Tessellation:
 
     def patch_uv(self, outer=None):
         """Each triangle's corners' (u, v) in its patch (not its part): (T, 3, 2) float64. outer (P, 2, 2): each
-        patch's ((u0, u1), (v0, v1)) in something larger (its spline: `kernels.common.nurbs.PatchSet.box`): the
+        patch's ((u0, u1), (v0, v1)) in something larger (its spline: `kernels.common.curves.nurbs.PatchSet.box`): the
         corners' (u, v) there instead, (T, 3, 2) float32, each part's two boxes composed first."""
         if outer is None:
             b = self.box[self.mesh.triangle_patch][:, None]

@@ -6,12 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...common.errors import InvalidInputError
-from ...common.rational_bezier import (
+from ...common.curves.rational_bezier import (
     bernstein,
     bernstein_derivative,
     cartesian,
 )
+from ...common.errors import InvalidInputError
 
 #: A side whose control points are all within this fraction of the model's size of its first is one point (a pole).
 COLLAPSED = 1e-12

@@ -5,7 +5,7 @@ measured against the surface and the levels raised where it is still over (`_mee
 import numpy as np
 
 from ...common.budget import check_budget
-from ...common.rational_bezier import (
+from ...common.curves.rational_bezier import (
     cartesian,
     chord_deviation,
     steps_for,

@@ -10,18 +10,18 @@ of consecutive segments share their end points, so the polyline is continuous an
 `adaptive_spline` samples a whole spline by a `CurveSampling` (curvature, world tolerance or pixels), with radius and
 tilt interpolated along each segment and [Nellmedin 2014]'s "copies" (OL0, §5.5.2): N offset copies, for hair.
 `adaptive_nurbs` does the same for a NURBS spline of any order, weights and knots, split exactly into rational Bézier
-pieces (`kernels.common.nurbs`): the curvature of each piece's control polygon, or a tolerance met by measuring the
-chords (`kernels.common.rational_bezier.tolerance_steps`).
+pieces (`kernels.common.curves.nurbs`): the curvature of each piece's control polygon, or a tolerance met by
+measuring the chords (`kernels.common.curves.rational_bezier.tolerance_steps`).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InvalidInputError
+from ..level_metrics import curvature_level, curve_kappa
 from . import nurbs, step_spacing
 from . import rational_bezier as rb
-from .errors import InvalidInputError
-from .level_metrics import curvature_level, curve_kappa
 
 #: The curvature metric's cap on segments (eq. 4.5's t_tessmax) and its gain (one point per tenth of height).
 MAX_SEGMENTS = 32
@@ -212,7 +212,7 @@ def adaptive_spline(co, handle_left, handle_right, radius, tilt, cyclic, setting
 
 
 def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, what="NURBS spline"):
-    """Sample one NURBS spline (points (n, 3), weights (n,), a `kernels.common.nurbs.Direction`, radius and tilt
+    """Sample one NURBS spline (points (n, 3), weights (n,), a `kernels.common.curves.nurbs.Direction`, radius and tilt
     (n,)) by ``settings`` (`CurveSampling`), through its exact rational Bézier pieces. CURVATURE: eq. 4.5 on each
     piece's control polygon (a straight piece of order 2: one step); TOLERANCE and SCREEN: steps spaced where each
     piece bends, their count measured to meet the tolerance (up to Max Segments; the deviation left is in the
@@ -230,7 +230,7 @@ def adaptive_nurbs(co, weight, direction, radius, tilt, settings, camera=None, w
             counts = np.ceil(curvature_level(curve_kappa(control), n_control=direction.order, gain=GAIN,
                                              t_max=settings.max_segments)).astype(np.int64)
         segment, t = steps(counts, direction.cyclic)
-    else:  # steps where each piece bends (`kernels.common.step_spacing`)
+    else:  # steps where each piece bends (`kernels.common.curves.step_spacing`)
         spacing = rb.curve_spacing(geo)
         counts, deviation = rb.tolerance_steps(geo, _world_tolerance(control, settings, camera), settings.max_segments,
                                                spacing=spacing)

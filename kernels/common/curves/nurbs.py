@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InvalidInputError
+from ..errors import InvalidInputError
 
 KNOT_MODES = ("UNIFORM", "ENDPOINT", "BEZIER", "ENDPOINT_BEZIER", "CUSTOM")
 MIN_ORDER, MAX_ORDER = 2, 6

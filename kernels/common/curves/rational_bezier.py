@@ -66,7 +66,7 @@ def steps_for(deviation, steps, tolerance, most):
 def chord_deviation(control, steps, spacing=None):
     """The largest distance between each rational curve and its chords at ``steps`` steps of its parameter,
     measured at each chord's quarter points: control (S, k, 4) homogeneous, steps (S,) -> (S,) float64. The steps
-    are equal, or spaced by each curve's table spacing (S, M + 1) (`kernels.common.step_spacing`)."""
+    are equal, or spaced by each curve's table spacing (S, M + 1) (`kernels.common.curves.step_spacing`)."""
     h = np.asarray(control, np.float64)[..., :4]
     lv = np.broadcast_to(np.asarray(steps, np.int64), (len(h),))
     out = np.zeros(len(h))
@@ -104,7 +104,7 @@ def tolerance_steps(control, tolerance, most, rounds=8, spacing=None):
 
 
 def curve_spacing(control):
-    """Spacing tables (S, SAMPLES + 1) (`kernels.common.step_spacing`) of rational curves with homogeneous control
-    points (S, k, 4): their steps where they bend."""
+    """Spacing tables (S, SAMPLES + 1) (`kernels.common.curves.step_spacing`) of rational curves with homogeneous
+    control points (S, k, 4): their steps where they bend."""
     t = np.linspace(0.0, 1.0, 2 * step_spacing.SAMPLES + 1)
     return step_spacing.cumulative(step_spacing.bend_density(cartesian(curve_points(control, t))))
