@@ -195,7 +195,7 @@ def run_tessellate_surface(bpy, mod, name, make):
     n_ours = ours()
     nurbs, bp = mod("kernels.common.curves.nurbs"), mod("kernels.surfaces.bezier_patches")
     surfaces, _ = mod("addon.curve_bridge").read_surface_splines(surface.data)
-    result = bp.tessellate(nurbs.patches_of([s for _, s in surfaces]).patches,
+    result = bp.tessellate_surface(nurbs.patches_of([s for _, s in surfaces]).patches,
                            bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
     ours_dev = float(result.deviation.max())
     res, dev = 0, np.inf

@@ -14,8 +14,8 @@ from ..addon.preferences import get_preferences
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
+    ParametricOptions,
     PatchOptions,
-    SurfaceOptions,
     copy_surface_options,
     curve_sampling,
     draw_curve_options,
@@ -45,7 +45,7 @@ from .selection import object_poll, place_mesh, select_only
 _BYTES_PER_CURVE_POINT = 96
 
 
-class TESSERA_OT_parametric_surface_add(SurfaceOptions, bpy.types.Operator):
+class TESSERA_OT_parametric_surface_add(ParametricOptions, bpy.types.Operator):
     """Add a mathematical surface (torus, Klein bottle, Möbius band and more) as a mesh or as a live GPU object"""
 
     bl_idname = "tessera.parametric_surface_add"
@@ -233,7 +233,7 @@ class TESSERA_OT_surface_tessellate(PatchOptions, bpy.types.Operator):
         words, warn = [], False
         if surfaces:
             patch_set = nurbs.patches_of([s for _, s in surfaces], [k for k, _ in surfaces])
-            result = bp.tessellate(patch_set.patches, lod, cam, budget)
+            result = bp.tessellate_surface(patch_set.patches, lod, cam, budget)
             mesh = result.mesh
             corner_uv = result.patch_uv(patch_set.box)  # each spline's own (u, v)
             arrays = MeshArrays(positions=mesh.positions, triangles=mesh.triangles, point_normals=mesh.normals,

@@ -60,7 +60,7 @@ def _annotations():
     return out
 
 
-class SurfaceOptions:
+class ParametricOptions:
     """The parametric-surface options (``tessera.parametric_surface_add`` inherits them)."""
 
     __annotations__ = _annotations()
@@ -76,7 +76,7 @@ class TESSERA_PG_surfaces(bpy.types.PropertyGroup):
     one instance per control point) and baked on demand."""
 
     __annotations__ = {
-        **with_update(SurfaceOptions, _changed),
+        **with_update(ParametricOptions, _changed),
         "is_surface": bpy.props.BoolProperty(name="Parametric Surface", default=False, update=_changed,
                                              description="Draw this object as its parametric surface"),
         "instance_object": bpy.props.PointerProperty(
@@ -94,7 +94,7 @@ class TESSERA_PG_surfaces(bpy.types.PropertyGroup):
 
 
 def copy_surface_options(source, target):
-    for name in SurfaceOptions.__annotations__:
+    for name in ParametricOptions.__annotations__:
         setattr(target, name, getattr(source, name))
 
 

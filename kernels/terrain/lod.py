@@ -121,7 +121,7 @@ def g_of_ham(ham_max, settings):
     return np.clip(g, 1.0, settings.max_level)
 
 
-def distance_level(d, t_max, t_min, d_max):
+def inverse_square_level(d, t_max, t_min, d_max):
     """Seed (5-5..5-7): T_max below d_max, T_max·d_max²/d² between, T_min beyond d_min. (...) float64."""
     d = np.asarray(d, np.float64)
     with np.errstate(divide="ignore"):
@@ -467,8 +467,8 @@ def _select(hm, table, camera, settings, first):
         p = heights[("edge", side)]
         e_max = np.maximum(t_max, _neighbour(t_max, side, 0.0))
         e_min = np.maximum(t_min, _neighbour(t_min, side, 0.0))
-        edge[..., side] = distance_level(_distance(eye, p), e_max, e_min, d_max)
-    inner = distance_level(_distance(eye, heights["centre"]), t_max, t_min, d_max)
+        edge[..., side] = inverse_square_level(_distance(eye, p), e_max, e_min, d_max)
+    inner = inverse_square_level(_distance(eye, heights["centre"]), t_max, t_min, d_max)
     if settings.culling and camera is not None:
         culled = _culled(hm, table, camera, xs, ys)
     else:

@@ -160,7 +160,7 @@ def test_anisotropic_levels_and_splitting_meet_the_tolerance_and_stay_welded():
     tol = 2e-3
     # Max Level 6 cannot reach the tolerance on whole patches: patches over it are split (with their neighbours
     # along the split sides) until it is met
-    r = bp.tessellate(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=6))
+    r = bp.tessellate_surface(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=6))
     assert len(r.parent) > len(patches) and len(r.unmet) == 0 and r.deviation.max() <= tol
     _, counts = edge_uses(r.mesh.triangles)
     assert counts.max() == 2
@@ -169,7 +169,7 @@ def test_anisotropic_levels_and_splitting_meet_the_tolerance_and_stay_welded():
     want = bp.evaluate(patches[r.parent[r.mesh.triangle_patch]], uv[..., 0], uv[..., 1])
     assert np.abs(want - r.mesh.positions[r.mesh.triangles]).max() < 1e-5
     # the inside of a patch steps each way on its own: the spout's patches are long and thin
-    whole = bp.tessellate(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+    whole = bp.tessellate_surface(patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
     assert (whole.inner_levels[:, 0] != whole.inner_levels[:, 1]).any() and len(whole.parent) == len(patches)
     assert whole.deviation.max() <= tol and len(whole.unmet) == 0
 
@@ -272,7 +272,7 @@ def test_the_sides_measured_without_a_mesh_are_the_meshes_and_the_deviation_is_t
     patches, _ = full_teapot()
     h = bp.check_patches(patches)
     tol = 1e-3
-    r = bp.tessellate(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+    r = bp.tessellate_surface(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
     assert len(r.parent) == len(h)  # whole patches
     spacing = bp.patch_spacing(h, r.edges)
     corners, uv, patch = bp.rim_triangles(h, r.edge_levels, r.inner_levels, r.edges, spacing, np.arange(len(h)))
@@ -293,9 +293,9 @@ def test_tessellating_on_a_worker_thread_measures_in_place_and_gives_the_same_me
 
     patches, _ = full_teapot()
     lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=2e-3, max_level=64)
-    here = bp.tessellate(patches, lod)
+    here = bp.tessellate_surface(patches, lod)
     # every worker busy with a tessellation that would hand its measuring to the pool: none waits on the others
-    there = [workers.submit(bp.tessellate, patches, lod) for _ in range(workers.WORKERS)]
+    there = [workers.submit(bp.tessellate_surface, patches, lod) for _ in range(workers.WORKERS)]
     for future in there:
         mesh = future.result(timeout=120).mesh
         assert np.array_equal(mesh.positions, here.mesh.positions)
@@ -306,10 +306,10 @@ def test_backends_are_checked():
     h = bp.check_patches(full_teapot()[0][:2])
     lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-2)
     with pytest.raises(InvalidInputError, match="backend"):
-        bp.tessellate(h, lod, backend="cuda")
+        bp.tessellate_surface(h, lod, backend="cuda")
 
 
 def test_opencl_asked_for_without_a_device_is_an_error():
     h = bp.check_patches(full_teapot()[0][:2])
     with pytest.raises(OpenCLUnavailableError, match="Tessellate Surface"):
-        bp.tessellate(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-2), backend="opencl")
+        bp.tessellate_surface(h, bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-2), backend="opencl")

@@ -128,7 +128,7 @@ def test_every_surface_primitive_at_every_order_and_weight(clean_scene, bpy_modu
         # within the tolerance: a dense lattice in every triangle against the surface at the same UVs, except in
         # the patches the kernel names as over it at Max Level (the operator then warns)
         ps = nurbs.patches_of([nurbs.SurfaceSpline(co, u, v)])
-        result = bp.tessellate(ps.patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
+        result = bp.tessellate_surface(ps.patches, bp.PatchLod(metrics=("TOLERANCE",), tolerance=tol, max_level=64))
         assert len(result.mesh.triangles) == len(tris), label
         dev, patch = lattice_deviation(bp, ps, pos, tris, uv)
         assert dev[~np.isin(patch, result.parent[result.unmet])].max() <= tol, label

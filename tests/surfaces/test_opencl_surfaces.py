@@ -80,7 +80,7 @@ def test_tessellations_measured_on_the_device_equal_the_numpy_ones(opencl, model
          "random": lambda: random_nets(rng, 6, 5)}[model]()
     size = float(np.abs(bp.cartesian(h)).max())
     lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=5e-4 * size, max_level=64)
-    a, b = bp.tessellate(h, lod, backend="numpy"), bp.tessellate(h, lod, backend="opencl")
+    a, b = bp.tessellate_surface(h, lod, backend="numpy"), bp.tessellate_surface(h, lod, backend="opencl")
     assert np.array_equal(a.edge_levels, b.edge_levels) and np.array_equal(a.inner_levels, b.inner_levels)
     assert np.array_equal(a.mesh.triangles, b.mesh.triangles)
     assert np.array_equal(a.mesh.positions, b.mesh.positions)
@@ -94,9 +94,9 @@ def test_tessellations_on_many_threads_share_the_device(opencl):
 
     h = bp.check_patches(teapot_patches()[0])
     lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=2e-3, max_level=64)
-    here = bp.tessellate(h, lod, backend="opencl")
+    here = bp.tessellate_surface(h, lod, backend="opencl")
     # the same kernel objects launched from every worker at once: each launch's arguments are its own
-    there = [workers.submit(bp.tessellate, h, lod, None, None, "opencl") for _ in range(workers.WORKERS + 1)]
+    there = [workers.submit(bp.tessellate_surface, h, lod, None, None, "opencl") for _ in range(workers.WORKERS + 1)]
     for future in there:
         r = future.result(timeout=120)
         assert np.array_equal(r.mesh.positions, here.mesh.positions)
@@ -114,9 +114,9 @@ def test_a_program_the_device_refuses_leaves_the_measuring_to_numpy(opencl, monk
     h = bp.check_patches(teapot_patches()[0][:4])
     lod = bp.PatchLod(metrics=("TOLERANCE",), tolerance=1e-3)
     with caplog.at_level("WARNING"):
-        r = bp.tessellate(h, lod)  # auto: numpy, said once
-        bp.tessellate(h, lod)
+        r = bp.tessellate_surface(h, lod)  # auto: numpy, said once
+        bp.tessellate_surface(h, lod)
     assert sum("with numpy" in m for m in caplog.messages) == 1
-    assert np.array_equal(r.mesh.positions, bp.tessellate(h, lod, backend="numpy").mesh.positions)
+    assert np.array_equal(r.mesh.positions, bp.tessellate_surface(h, lod, backend="numpy").mesh.positions)
     with pytest.raises(TesseraError, match="failed to build"):
-        bp.tessellate(h, lod, backend="opencl")
+        bp.tessellate_surface(h, lod, backend="opencl")

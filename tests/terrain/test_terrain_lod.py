@@ -51,15 +51,15 @@ def test_g_and_the_distance_law_follow_the_seed():
         d_max = rng.uniform(1, 100)
         d_min = d_max * np.sqrt(t_max / t_min)  # (5-7)
         d = np.sort(rng.uniform(0, 5 * d_min, 400))
-        t = tl.distance_level(d, t_max, t_min, d_max)
+        t = tl.inverse_square_level(d, t_max, t_min, d_max)
         assert np.all(np.diff(t) <= 0) and t.max() <= t_max and t.min() >= t_min
-        assert tl.distance_level(d_max * 0.999, t_max, t_min, d_max) == t_max
+        assert tl.inverse_square_level(d_max * 0.999, t_max, t_min, d_max) == t_max
         eps = 1e-7 * d_max
         for at in (d_max, d_min):  # continuous at both ends of the interval
-            assert abs(tl.distance_level(at - eps, t_max, t_min, d_max)
-                       - tl.distance_level(at + eps, t_max, t_min, d_max)) < 1e-4 * t_max
+            assert abs(tl.inverse_square_level(at - eps, t_max, t_min, d_max)
+                       - tl.inverse_square_level(at + eps, t_max, t_min, d_max)) < 1e-4 * t_max
         mid = 0.5 * (d_max + d_min)
-        assert tl.distance_level(mid, t_max, t_min, d_max) == pytest.approx(t_max * d_max**2 / mid**2)
+        assert tl.inverse_square_level(mid, t_max, t_min, d_max) == pytest.approx(t_max * d_max**2 / mid**2)
 
 
 def test_a_flat_tile_gets_level_one_at_every_distance():

@@ -31,7 +31,7 @@ Levels (`patch_levels`), on the control points' Cartesian positions:
   grid is then fitted to a model measured on a 12 x 12 probe (`fitted_inner`), and every triangle is measured against
   the surface, before the mesh is made (the inner grids by `grid_deviation`, the strips along the sides by
   `rim_triangles`), raising the levels where it is still over (`TOLERANCE_ROUNDS` times at most), so the tolerance is
-  met or the patches that cannot meet it within Max Level are named (and split, `tessellate`);
+  met or the patches that cannot meet it within Max Level are named (and split, `tessellate_surface`);
 - any of these together: the largest. Levels are whole segment counts. The inside of a patch has a count of steps
   along u and one along v: the same (the larger) for curvature, distance and edge length, each its own for the
   tolerance."""
@@ -49,22 +49,22 @@ from ...common.opencl_runtime import backend_runtime
 from .. import patch_deviation_opencl, patch_split
 from .deviation import _B, grid_deviation, rim_triangles, triangle_deviation
 from .levels import METRICS, PatchLod, Spacing, _sides_keep_up, direction_chains, patch_levels, patch_spacing
-from .mesh import PatchMesh, Tessellation, estimate, tessellate_patches
+from .mesh import PatchMesh, SurfaceTessellation, estimate, tessellate_patches
 from .nets import PatchEdges, check_patches, evaluate, patch_edges
 from .tolerance import FIT_AIM, FIT_PROBE, _meet_tolerance, fitted_inner, stored_error
 
-#: The entry (`tessellate`) and what the operator, the tests and the benches use of the modules behind it.
-__all__ = ["METRICS", "FIT_AIM", "PatchEdges", "PatchLod", "PatchMesh", "Spacing", "Tessellation", "cartesian",
+#: The entry (`tessellate_surface`) and what the operator, the tests and the benches use of the modules behind it.
+__all__ = ["METRICS", "FIT_AIM", "PatchEdges", "PatchLod", "PatchMesh", "Spacing", "SurfaceTessellation", "cartesian",
            "check_patches", "direction_chains", "estimate", "evaluate", "fitted_inner", "grid_deviation",
-           "patch_edges", "patch_levels", "patch_spacing", "rim_triangles", "stored_error", "tessellate",
+           "patch_edges", "patch_levels", "patch_spacing", "rim_triangles", "stored_error", "tessellate_surface",
            "tessellate_patches", "triangle_deviation"]
 
 
 #: With the tolerance, how many times patches still over it at Max Level are split and the whole made again.
 SPLIT_ROUNDS = 3
 
-def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
-    """Levels from ``lod`` and the welded mesh at them: a `Tessellation`. With TOLERANCE among the metrics, every
+def tessellate_surface(control, lod, camera=None, budget_bytes=None, backend="auto"):
+    """Levels from ``lod`` and the welded mesh at them: a `SurfaceTessellation`. With TOLERANCE among the metrics, every
     triangle is measured against the surface (`triangle_deviation`) and each side
     (`kernels.common.curves.rational_bezier.chord_deviation`), and the levels of what is over are raised, until all is
     within the tolerance or at Max Level; a patch still over it at Max Level is split in two along each direction at
@@ -93,8 +93,8 @@ def tessellate(control, lod, camera=None, budget_bytes=None, backend="auto"):
     return result
 
 def _measuring_runtime(backend, k):
-    """The OpenCL runtime that measures for `tessellate`'s ``backend`` nets of k x k points, its program built, or
-    None (numpy). With "auto", a device without double precision, or whose compiler refuses the program, leaves the
+    """The OpenCL runtime that measures for `tessellate_surface`'s ``backend`` nets of k x k points, its program built,
+    or None (numpy). With "auto", a device without double precision, or whose compiler refuses the program, leaves the
     measuring to numpy (the refusal logged once); with "opencl", either is an error."""
     runtime = backend_runtime(backend, "measuring Tessellate Surface's triangles")
     if runtime is None:
@@ -118,7 +118,8 @@ def _log_once(message):
     logging.getLogger(__name__).warning(message)
 
 def _tessellate_once(h, lod, camera, budget_bytes, runtime=None):
-    """`tessellate` without splitting: a `Tessellation` of these patches (parent and box left to the caller)."""
+    """`tessellate_surface` without splitting: a `SurfaceTessellation` of these patches (parent and box left to the
+    caller)."""
     edges = patch_edges(h)
     spacing = patch_spacing(h, edges) if "TOLERANCE" in lod.metrics else None
     el, inner = patch_levels(h, edges, lod, camera, spacing)
@@ -138,5 +139,5 @@ def _tessellate_once(h, lod, camera, budget_bytes, runtime=None):
     check_budget(estimate(el, inner), budget_bytes, lower)
     mesh = tessellate_patches(h, el, inner, edges, spacing)
     if "TOLERANCE" not in lod.metrics:
-        return Tessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
-    return Tessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > lod.tolerance))
+        return SurfaceTessellation(mesh, el, inner, edges, np.full(len(h), np.nan), np.zeros(0, np.int64))
+    return SurfaceTessellation(mesh, el, inner, edges, dev, np.flatnonzero(dev > lod.tolerance))

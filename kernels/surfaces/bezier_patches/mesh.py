@@ -45,8 +45,8 @@ class PatchMesh:
     normals: np.ndarray = None
 
 @dataclass
-class Tessellation:
-    """What `tessellate` made: mesh (`PatchMesh`); edge_levels (E,) and inner_levels (P, 2) int64; edges
+class SurfaceTessellation:
+    """What `tessellate_surface` made: mesh (`PatchMesh`); edge_levels (E,) and inner_levels (P, 2) int64; edges
     (`PatchEdges`); deviation (P,) float64: the largest distance measured between each patch's triangles and the
     surface (NaN when the tolerance was not asked for); unmet (K,) int64: the patches still over the tolerance at Max
     Level. With the tolerance a patch may have been split into parts (`kernels.surfaces.patch_split`): then the mesh,
