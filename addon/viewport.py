@@ -70,15 +70,6 @@ def invalidator(topic):
     return update
 
 
-def with_update(options, update):
-    """The property definitions of the options class ``options`` (its annotations), each with ``update=`` added:
-    for a property group whose changes must reach the previews. The class itself keeps its update-free
-    definitions for operators (an operator's properties are set while panels draw, where an update that
-    redraws would loop)."""
-    return {name: prop.function(**{**prop.keywords, "update": update})
-            for name, prop in options.__annotations__.items()}
-
-
 # --- caches --------------------------------------------------------------------------------------------------
 
 @dataclass

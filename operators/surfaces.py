@@ -11,12 +11,12 @@ from ..addon import bridge, curve_bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
+from ..addon.settings_scaffold import copy_options
 from ..addon.surfaces.settings import (
     SURFACE_ITEMS,
     CurveOptions,
     ParametricOptions,
     PatchOptions,
-    copy_surface_options,
     curve_sampling,
     draw_curve_options,
     draw_patch_options,
@@ -73,7 +73,7 @@ class TESSERA_OT_parametric_surface_add(ParametricOptions, bpy.types.Operator):
         if self.output == "LIVE":
             surface_from(self).point(np.zeros(1), np.zeros(1))  # refuse bad parameters now, not in the viewport
             ob = tx.new_object(label, None)
-            copy_surface_options(self, ob.tessera.surface)
+            copy_options(ParametricOptions, self, ob.tessera.surface)
             ob.tessera.surface.is_surface = True
             ob.empty_display_size = 0.25
             words = "drawn live from one point"

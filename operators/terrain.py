@@ -9,8 +9,9 @@ import bpy
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
+from ..addon.settings_scaffold import copy_options
 from ..addon.terrain import data as terrain_data
-from ..addon.terrain.settings import TerrainOptions, copy_terrain_settings, draw_terrain_settings, lod_settings
+from ..addon.terrain.settings import TerrainOptions, draw_terrain_settings, lod_settings
 from ..kernels.common.budget import check_bytes
 from ..kernels.common.errors import EmptyResultError, InvalidInputError
 from ..kernels.terrain.lod import box_distance, select
@@ -165,7 +166,7 @@ class TESSERA_OT_terrain_add(TerrainOptions, bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            copy_terrain_settings(self, ob.tessera.terrain)
+            copy_options(TerrainOptions, self, ob.tessera.terrain)
             ob.tessera.terrain.is_terrain = True
             ob.location = context.scene.cursor.location
             context.collection.objects.link(ob)

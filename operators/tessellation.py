@@ -8,10 +8,10 @@ from ..addon.cameras import camera_for
 from ..addon.gpu_context import ensure_gpu_context
 from ..addon.guarded import check_numbers, each_selected, guarded
 from ..addon.preferences import get_preferences
+from ..addon.settings_scaffold import copy_options
 from ..addon.tessellation.settings import (
     TessellateOptions,
     adaptive_settings,
-    copy_settings,
     draw_settings,
     needs_camera,
     surface_options,
@@ -47,7 +47,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
     def invoke(self, context, event):
         stored = context.active_object.tessera.tessellate
         if stored.stored and not self.use_object_settings:
-            copy_settings(stored, self)  # start from what was used last time on this object
+            copy_options(TessellateOptions, stored, self)  # start from what was used last time on this object
         return self.execute(context)
 
     def draw(self, context):
@@ -58,7 +58,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
     def execute(self, context, tx):
         ob = context.active_object
         if self.use_object_settings:
-            copy_settings(ob.tessera.tessellate, self)
+            copy_options(TessellateOptions, ob.tessera.tessellate, self)
             check_numbers(self)  # the object's settings, as the operator's own were checked
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -73,7 +73,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
             self.report({"WARNING"}, note)
         target = place_mesh(context, tx, ob, new_mesh, self.output, "tessellated")
         for holder in {ob, target}:
-            copy_settings(self, holder.tessera.tessellate)
+            copy_options(TessellateOptions, self, holder.tessera.tessellate)
             holder.tessera.tessellate.stored = True
         return {"FINISHED"}
 

@@ -6,7 +6,8 @@ from ..addon import bridge
 from ..addon.cameras import camera_for, object_camera
 from ..addon.guarded import guarded
 from ..addon.preferences import get_preferences
-from ..addon.tubes.settings import TubeOptions, copy_tubes_settings, draw_tubes_settings, kernel_settings
+from ..addon.settings_scaffold import copy_options
+from ..addon.tubes.settings import TubeOptions, draw_tubes_settings, kernel_settings
 from ..addon.tubes.sources import SOURCE_TYPES, read_lines
 from ..kernels.common.budget import check_bytes
 from ..kernels.common.errors import EmptyResultError
@@ -74,7 +75,7 @@ class TESSERA_OT_tubes(TubeOptions, bpy.types.Operator):
             raise EmptyResultError(empty[0] if len(empty) == 1 else f"No tubes from {len(empty)} sources. {empty[0]}")
         made = [self._place(tx, ob, mesh) for ob, mesh, _ in results]  # every source built before any is placed
         for ob, _, notes in results:
-            copy_tubes_settings(self, ob.tessera.tubes)  # a batch script can re-run them
+            copy_options(TubeOptions, self, ob.tessera.tubes)  # a batch script can re-run them
             for note in notes:
                 self.report({"WARNING"}, note)
         for note in empty:

@@ -3,9 +3,10 @@
 
 import bpy
 
+from ..settings_scaffold import copy_options
 from ..sidebar import Sidebar, active_object, panel_order, preview_notice
 from .build import HCE_PROPERTY
-from .settings import copy_subdivision_settings, draw_subdivision_settings
+from .settings import LoopOptions, draw_subdivision_settings
 
 
 class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
@@ -34,7 +35,7 @@ class TESSERA_PT_subdivision(Sidebar, bpy.types.Panel):
         row = layout.row()
         row.scale_y = 1.4
         op = row.operator("tessera.loop_subdivide", icon="MOD_SUBSURF", text="Make Loop Mesh")
-        copy_subdivision_settings(settings, op)
+        copy_options(LoopOptions, settings, op)
 
 
 classes = (TESSERA_PT_subdivision,)

@@ -4,7 +4,8 @@
 import bpy
 
 from ...kernels.subdivision.loop import MAX_LEVELS
-from ..viewport import invalidator, with_update
+from ..settings_scaffold import option_names, stored_options
+from ..viewport import invalidator
 
 BOUNDARY_ITEMS = (
     ("EDGE_ONLY", "Smooth", "Open borders are smoothed along the border, like a curve through its vertices"),
@@ -16,7 +17,7 @@ BAKED_COLOUR = "BakedLight"  # the point colour attribute written from the mesh'
 
 class LoopOptions:
     """The Loop options, declared once: the operator inherits them as they are, `TESSERA_PG_subdivision` with the
-    preview's invalidation added (`with_update`)."""
+    preview's invalidation added (`addon.settings_scaffold`)."""
 
     levels: bpy.props.IntProperty(
         name="Levels", description="Times every triangle is split in four (faces grow by 4^levels; 0: the "
@@ -36,28 +37,19 @@ class LoopOptions:
 #: The invalidation topic of these settings (`addon.viewport`).
 TOPIC = "subdivision"
 _changed = invalidator(TOPIC)
-LOOP_SETTING_NAMES = tuple(LoopOptions.__annotations__)
 
 
 class TESSERA_PG_subdivision(bpy.types.PropertyGroup):
-    __annotations__ = {
-        **with_update(LoopOptions, _changed),
-        "preview": bpy.props.BoolProperty(name="Preview Loop Subdivision", update=_changed, default=False,
-                                          description="Draw this mesh Loop-subdivided in the 3D viewport, with its "
-                                                      "baked lighting (no mesh is made)"),
-    }
-
-
-def copy_subdivision_settings(source, target):
-    for name in LOOP_SETTING_NAMES:
-        setattr(target, name, getattr(source, name))
+    __annotations__ = stored_options(LoopOptions, _changed, preview=bpy.props.BoolProperty(
+        name="Preview Loop Subdivision", update=_changed, default=False,
+        description="Draw this mesh Loop-subdivided in the 3D viewport, with its baked lighting (no mesh is made)"))
 
 
 def draw_subdivision_settings(layout, s):
     layout.use_property_split = True
     layout.use_property_decorate = False
     col = layout.column()
-    for name in LOOP_SETTING_NAMES:
+    for name in option_names(LoopOptions):
         col.prop(s, name)
 
 

@@ -18,7 +18,8 @@ from ...kernels.surfaces.bezier_patches import PatchLod
 from ...kernels.surfaces.domain_mesh import MAX_FACTOR
 from ...kernels.surfaces.parametric import SURFACES
 from ..cameras import CAMERA_ITEMS
-from ..viewport import invalidator, with_update
+from ..settings_scaffold import stored_options
+from ..viewport import invalidator
 
 #: (identifier, label, description) of each surface, in menu order.
 SURFACE_ITEMS = (
@@ -75,27 +76,21 @@ class TESSERA_PG_surfaces(bpy.types.PropertyGroup):
     """``Object.tessera.surface``: an object with no mesh of its own drawn as a one-point surface (the GPU path:
     one instance per control point) and baked on demand."""
 
-    __annotations__ = {
-        **with_update(ParametricOptions, _changed),
-        "is_surface": bpy.props.BoolProperty(name="Parametric Surface", default=False, update=_changed,
-                                             description="Draw this object as its parametric surface"),
-        "instance_object": bpy.props.PointerProperty(
+    __annotations__ = stored_options(
+        ParametricOptions, _changed,
+        is_surface=bpy.props.BoolProperty(name="Parametric Surface", default=False, update=_changed,
+                                          description="Draw this object as its parametric surface"),
+        instance_object=bpy.props.PointerProperty(
             name="Control Points", type=bpy.types.Object, update=_changed,
             description="A mesh whose vertices are control points: one surface at each (none: one surface at this "
                         "object's origin)"),
-        "factor_mode": bpy.props.EnumProperty(name="Factor From", default="FIXED", update=_changed, items=(
+        factor_mode=bpy.props.EnumProperty(name="Factor From", default="FIXED", update=_changed, items=(
             ("FIXED", "Fixed", "Every copy at Factor"),
             ("CAMERA", "Camera", "Each copy's factor from its size on screen (Edge Pixels a segment)")),
             description="A fixed factor, or a factor per copy from how large it looks"),
-        "edge_pixels": bpy.props.FloatProperty(name="Edge Pixels", default=8.0, min=0.5, max=MAX_PIXELS,
-                                               soft_max=100.0, subtype="PIXEL", update=_changed,
-                                               description="Target segment length on screen"),
-    }
-
-
-def copy_surface_options(source, target):
-    for name in ParametricOptions.__annotations__:
-        setattr(target, name, getattr(source, name))
+        edge_pixels=bpy.props.FloatProperty(name="Edge Pixels", default=8.0, min=0.5, max=MAX_PIXELS,
+                                            soft_max=100.0, subtype="PIXEL", update=_changed,
+                                            description="Target segment length on screen"))
 
 
 def surface_from(options):

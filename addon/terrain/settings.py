@@ -8,7 +8,8 @@ from ...kernels.common.limits import MAX_FACTOR, MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.terrain import geotiff
 from ...kernels.terrain.lod import TerrainLod
 from ..cameras import CAMERA_ITEMS
-from ..viewport import invalidator, with_update
+from ..settings_scaffold import stored_options
+from ..viewport import invalidator
 
 SOURCE_ITEMS = (
     ("FILE", "File", "Elevation data (GeoTIFF, SRTM .hgt, ESRI .asc, ERDAS .img, GDAL .vrt...), PNG/TIFF (8 or 16 "
@@ -43,7 +44,8 @@ LEVEL_ITEMS = (
 class TerrainOptions:
     """The terrain options, declared once: ``tessera.terrain_add`` inherits them as they are, and
     `TESSERA_PG_terrain` (``Object.tessera.terrain``) takes them with the preview's invalidation added
-    (`with_update`). The identifiers ``g`` and ``ham_scale`` (the roughness curve and scale) are stored in files."""
+    (`addon.settings_scaffold`). The identifiers ``g`` and ``ham_scale`` (the roughness curve and scale) are stored in
+    files."""
 
     source: bpy.props.EnumProperty(name="Source", items=SOURCE_ITEMS, default="FILE",
                                    description="Read the heights from a file or from an image in this Blender file")
@@ -113,29 +115,22 @@ class TerrainOptions:
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
 TOPIC = "terrain"
 _changed = invalidator(TOPIC)
-TERRAIN_SETTING_NAMES = tuple(TerrainOptions.__annotations__)
 SOURCE_NAMES = ("source", "filepath", "tile_files", "georeferenced", "band", "exaggeration", "voids", "image_name",
                 "raw_width", "raw_height", "texel_size", "height_scale", "height_offset", "tile_size")
 
 
 class TESSERA_PG_terrain(bpy.types.PropertyGroup):
-    __annotations__ = {
-        **with_update(TerrainOptions, _changed),
-        "preview": bpy.props.BoolProperty(name="Preview Terrain", update=_changed, default=False,
-                                          description="Draw this terrain in the 3D viewport on the GPU, "
-                                                      "re-selecting levels as the view moves"),
-        "is_terrain": bpy.props.BoolProperty(name="Terrain", default=False, options={"HIDDEN"}),
-    }
+    __annotations__ = stored_options(
+        TerrainOptions, _changed,
+        preview=bpy.props.BoolProperty(name="Preview Terrain", update=_changed, default=False,
+                                       description="Draw this terrain in the 3D viewport on the GPU, re-selecting "
+                                                   "levels as the view moves"),
+        is_terrain=bpy.props.BoolProperty(name="Terrain", default=False, options={"HIDDEN"}))
 
 
 def is_elevation_file(path):
     """Whether a height-map path names an elevation file (which may carry its placement)."""
     return geotiff.is_elevation_file(path)
-
-
-def copy_terrain_settings(source, target):
-    for name in TERRAIN_SETTING_NAMES:
-        setattr(target, name, getattr(source, name))
 
 
 def source_key(s):

@@ -18,9 +18,10 @@ from ...kernels.common.camera import Camera
 from ...kernels.tessellation.adaptive import adaptive_levels
 from ...kernels.tessellation.tessellate import surface_inputs, uniform_levels
 from .. import bridge
+from ..settings_scaffold import option_names
 from ..viewport import Preview, PreviewEntry, previewed_objects, source_mesh
 from ..viewport_lighting import draw_as_object
-from .settings import SETTING_NAMES, TOPIC, adaptive_settings, surface_options
+from .settings import TOPIC, TessellateOptions, adaptive_settings, surface_options
 
 #: Settings that change what is uploaded per mesh (the rest only change levels).
 SURFACE_NAMES = ("method", "alpha", "alpha_attribute", "normal_mode", "pn_normals")
@@ -86,7 +87,7 @@ def update_levels(ob, entry, view, projection, width, height):
     """Recompute levels when the view, the transform or a level setting changed; returns True when it did."""
     s = ob.tessera.tessellate
     model = np.array(ob.matrix_world)
-    key = _key(s, SETTING_NAMES)
+    key = _key(s, option_names(TessellateOptions))
     if s.level_mode == "ADAPTIVE":
         key += ((view @ model).tobytes(), np.asarray(projection).tobytes(), width, height)
     if entry.view == key:

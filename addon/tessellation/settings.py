@@ -2,8 +2,8 @@
 
 The same annotations define `TESSERA_PG_tessellation` (stored on every object as ``Object.tessera.tessellate``,
 so a batch script can re-run what the artist chose) and the properties of ``tessera.tessellate``.
-`copy_settings` moves values between the two; `surface_options` and `adaptive_settings` turn either
-into the kernels' dataclasses.
+`addon.settings_scaffold.copy_options` moves values between the two; `surface_options` and `adaptive_settings` turn
+either into the kernels' dataclasses.
 """
 
 import bpy
@@ -116,7 +116,6 @@ class TessellateOptions:
     output: bpy.props.EnumProperty(name="Output", items=OUTPUT_ITEMS, default="NEW_OBJECT",
                                    description="Make a new object, or replace this object's mesh")
 
-SETTING_NAMES = tuple(TessellateOptions.__annotations__)
 
 
 #: The invalidation topic of these settings (`addon.viewport`).
@@ -131,12 +130,6 @@ class TESSERA_PG_tessellation(TessellateOptions, bpy.types.PropertyGroup):
         name="Live Preview", default=False, update=_redraw,
         description="Draw this mesh tessellated on the GPU with these settings, in place of the mesh, with its "
                     "modifiers (adaptive levels follow the view); no mesh is made")
-
-
-def copy_settings(source, target):
-    """Copy every tessellation setting from ``source`` to ``target`` (operator or property group)."""
-    for name in SETTING_NAMES:
-        setattr(target, name, getattr(source, name))
 
 
 def surface_options(settings):

@@ -2,8 +2,9 @@
 
 import bpy
 
+from ..settings_scaffold import copy_options
 from ..sidebar import Sidebar, active_object, panel_order, preview_notice
-from .settings import copy_tubes_settings, draw_tubes_settings
+from .settings import TubeOptions, draw_tubes_settings
 from .sources import SOURCE_TYPES
 
 
@@ -34,7 +35,7 @@ class TESSERA_PT_tubes(Sidebar, bpy.types.Panel):
         row = self.layout.row()
         row.scale_y = 1.4
         op = row.operator("tessera.tubes", icon="MESH_CYLINDER", text="Make Tube Mesh")
-        copy_tubes_settings(settings, op)
+        copy_options(TubeOptions, settings, op)
 
 
 classes = (TESSERA_PT_tubes,)

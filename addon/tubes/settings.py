@@ -8,7 +8,8 @@ import bpy
 from ...kernels.common.limits import MAX_PIXELS, MAX_WORLD_VALUE
 from ...kernels.tubes.builder import TubeSettings
 from ..cameras import CAMERA_ITEMS
-from ..viewport import invalidator, with_update
+from ..settings_scaffold import stored_options
+from ..viewport import invalidator
 
 RADIUS_ITEMS = (
     ("POINT", "From Points", "Curves: point radius times Radius (like a bevel); hair: its 'radius' attribute "
@@ -33,7 +34,8 @@ REFINE_ITEMS = (
 
 class TubeOptions:
     """The tube options, declared once: the operator ``tessera.tubes`` inherits them as they are, and
-    `TESSERA_PG_tubes` (``Object.tessera.tubes``) takes them with the preview's invalidation added (`with_update`)."""
+    `TESSERA_PG_tubes` (``Object.tessera.tubes``) takes them with the preview's invalidation added
+    (`addon.settings_scaffold`)."""
 
     radius_source: bpy.props.EnumProperty(name="Radius From", items=RADIUS_ITEMS, default="POINT",
                                           description="Where each point's tube radius comes from")
@@ -81,21 +83,12 @@ class TubeOptions:
 #: The invalidation topic of these settings (`addon.viewport`): the preview forgets what a change makes stale.
 TOPIC = "tubes"
 _changed = invalidator(TOPIC)
-TUBE_SETTING_NAMES = tuple(TubeOptions.__annotations__)
 
 
 class TESSERA_PG_tubes(bpy.types.PropertyGroup):
-    __annotations__ = {
-        **with_update(TubeOptions, _changed),
-        "preview": bpy.props.BoolProperty(name="Preview Tubes", update=_changed, default=False,
-                                          description="Draw this object's tubes in the 3D viewport on the GPU "
-                                                      "(no mesh is made)"),
-    }
-
-
-def copy_tubes_settings(source, target):
-    for name in TUBE_SETTING_NAMES:
-        setattr(target, name, getattr(source, name))
+    __annotations__ = stored_options(TubeOptions, _changed, preview=bpy.props.BoolProperty(
+        name="Preview Tubes", update=_changed, default=False,
+        description="Draw this object's tubes in the 3D viewport on the GPU (no mesh is made)"))
 
 
 def kernel_settings(s, aa_clamp=None):
