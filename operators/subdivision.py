@@ -35,7 +35,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
     output: bpy.props.EnumProperty(
         name="Output", default="NEW_OBJECT", description="Make a new object, or replace this object's mesh",
         items=(("NEW_OBJECT", "New Object", "Add a new object beside the source (its modifiers applied first)"),
-               ("REPLACE", "Replace", "Replace the object's mesh (one undo step brings it back)")))
+               ("REPLACE", "Replace Mesh", "Replace the object's mesh (one undo step brings it back)")))
 
     @classmethod
     def poll(cls, context):

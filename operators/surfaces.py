@@ -52,7 +52,7 @@ class TESSERA_OT_parametric_surface_add(ParametricOptions, bpy.types.Operator):
     bl_label = "Parametric Surface"
     bl_options = {"REGISTER", "UNDO"}
 
-    output: bpy.props.EnumProperty(name="Output", default="MESH", description="A mesh, or a live object", items=(
+    output: bpy.props.EnumProperty(name="Make", default="MESH", description="A mesh, or a live object", items=(
         ("MESH", "Mesh", "Bake the surface into a mesh"),
         ("LIVE", "Live", "An empty drawn as the surface by the GPU (no mesh; Bake Surface makes one on demand)")))
 

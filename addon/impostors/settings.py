@@ -17,7 +17,7 @@ class TESSERA_PG_impostors(bpy.types.PropertyGroup):
     relief: bpy.props.BoolProperty(name="Relief Mapping", default=True, update=_changed,
                                    description="Pre-warp the board for the eye (parallax corrected, per-texel "
                                                "depth); off: a plain sprite, regenerated sooner")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=1.5, min=0.1, max=100.0, soft_max=16.0,
+    tolerance: bpy.props.FloatProperty(name="Screen Error", default=1.5, min=0.1, max=100.0, soft_max=16.0,
                                        subtype="PIXEL", update=_changed,
                                        description="How many screen pixels a board texel or its error may grow to "
                                                    "before the board is made again")

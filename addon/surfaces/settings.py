@@ -129,7 +129,7 @@ class CurveOptions:
     tolerance: bpy.props.FloatProperty(name="Tolerance", default=0.01, min=1e-9, max=MAX_WORLD_VALUE, soft_max=1.0,
                                        subtype="DISTANCE", unit="LENGTH",
                                        description="Largest distance between the polyline and the curve")
-    pixels: bpy.props.FloatProperty(name="Pixels", default=1.0, min=0.01, max=MAX_PIXELS, soft_max=16.0,
+    pixels: bpy.props.FloatProperty(name="Screen Error", default=1.0, min=0.01, max=MAX_PIXELS, soft_max=16.0,
                                     subtype="PIXEL",
                                     description="Largest distance between the polyline and the curve on screen")
     camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",

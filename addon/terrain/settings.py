@@ -104,7 +104,7 @@ class TerrainOptions:
                                    soft_max=10000.0, subtype="DISTANCE", unit="LENGTH",
                                    description="Closer than this, tiles get their most detail (0: where a texel "
                                    "spans 4 pixels)")
-    levels: bpy.props.EnumProperty(name="Levels", items=LEVEL_ITEMS, default="POW2",
+    levels: bpy.props.EnumProperty(name="Level Steps", items=LEVEL_ITEMS, default="POW2",
                                    description="Which levels tiles may take")
     culling: bpy.props.BoolProperty(name="Frustum Culling", default=True,
                                     description="Drop tiles outside the camera's view")

@@ -70,13 +70,13 @@ class TessellateOptions:
     method: bpy.props.EnumProperty(name="Method", items=METHOD_ITEMS, default="PN",
                                    description="How the new vertices are placed: on a curved surface or the flat "
                                                "triangles")
-    level_mode: bpy.props.EnumProperty(name="Levels", items=LEVEL_MODE_ITEMS, default="UNIFORM",
+    level_mode: bpy.props.EnumProperty(name="Level Mode", items=LEVEL_MODE_ITEMS, default="UNIFORM",
                                        description="One level everywhere, or a level per edge from what the camera "
                                                    "sees and how the surface bends")
     level: bpy.props.FloatProperty(
         name="Level", description="Segments per edge (and inner level) for every triangle",
         default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2)
-    spacing: bpy.props.EnumProperty(name="Spacing", items=SPACING_ITEMS, default="EQUAL",
+    spacing: bpy.props.EnumProperty(name="Segment Spacing", items=SPACING_ITEMS, default="EQUAL",
                                     description="How a fractional level splits an edge")
     alpha: bpy.props.FloatProperty(
         name="Shape Factor", description="How far the surface bulges toward the normals: 0 flat, 1 fully rounded",

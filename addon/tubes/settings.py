@@ -54,7 +54,7 @@ class TubeOptions:
                                      description="Fewest faces around a tube, however small it looks")
     max_sides: bpy.props.IntProperty(name="Max Sides", default=32, min=3, max=1024, soft_max=64,
                                      description="Most faces around a tube, however close it is")
-    edge_pixels: bpy.props.FloatProperty(name="Side Length", description="Target width of one side on screen",
+    edge_pixels: bpy.props.FloatProperty(name="Edge Pixels", description="Target width of one side on screen",
                                          default=8.0, min=0.5, max=MAX_PIXELS, soft_max=64.0, subtype="PIXEL")
     camera_source: bpy.props.EnumProperty(name="Camera", items=CAMERA_ITEMS, default="SCENE",
                                           description="Whose view sets the sides and the pixel clamp")

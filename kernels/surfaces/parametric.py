@@ -69,7 +69,7 @@ class Cone:
     base."""
 
     radius: float = parameter(0.5, "Radius", "Radius of the base circle")
-    height: float = parameter(1.5, "Height", "Height of the apex above the base")
+    height: float = parameter(1.5, "Cone Height", "Height of the apex above the base")
     closure = Closure(u=PERIODIC, collapse=("v1",))
     colour_offset = 0.4
 
@@ -138,7 +138,7 @@ class MobiusBand:
     """A Möbius band of ring radius 1 (times ``radius``) and the given width: t = 2π u, s = width (v - 1/2)."""
 
     radius: float = parameter(1.0, "Radius", "Radius of the band's middle circle")
-    width: float = parameter(0.8, "Width", "Width of the band")
+    width: float = parameter(0.8, "Band Width", "Width of the band")
     closure = Closure(u=TWISTED)
     colour_offset = 0.4
 

@@ -6,6 +6,7 @@ slip in without it):
   plain numbers listed in `UNITLESS` with what it counts;
 - no soft range reaches 1e9, so dragging a number means something;
 - no label, tooltip or enum item uses research jargon (`ui_rules.JARGON`);
+- no label names two kinds of setting (a length and a pixel count, a count and a choice);
 - every operator has a one-sentence description;
 - the menus hold what Blender users look for where they look (creators under Add, exporters under File › Export,
   tools on the active object under Object › Tessera), and every menu path named in the source or the docs exists;
@@ -146,6 +147,41 @@ def test_no_research_jargon_in_labels_tooltips_and_items(bpy_module, properties)
     texts = _ui_texts(bpy_module, properties)
     assert len(texts) > 500
     bad = [f"{where}: {found} in {text!r}" for where, text in texts if (found := jargon(text))]
+    assert not bad, "\n".join(bad)
+
+
+#: Labels that name two kinds of setting on purpose, with why: Blender's own words.
+SHARED_LABELS = {"Radius": "a tube's radius in scene units; the brush's in pixels, as Blender labels its brushes'"}
+
+
+def _kind(prop):
+    """What a setting is, for `test_no_label_names_two_kinds_of_setting`: numbers by their subtype and unit (a length,
+    a pixel count, a plain number: integer or not), enums by their items' labels, the rest by their type."""
+    if prop.type in ("INT", "FLOAT"):
+        return ("NUMBER", prop.subtype, prop.unit)
+    if prop.type == "ENUM":
+        return ("ENUM", "FLAG" if prop.is_enum_flag else "ONE")
+    return (prop.type,)
+
+
+def test_no_label_names_two_kinds_of_setting(properties):
+    """One word, one meaning: the settings that share a label are the same kind of thing (Tolerance a distance
+    everywhere, Screen Error pixels everywhere); enums that share a label offer some of the same choices (Evaluate On:
+    CPU and GPU). Stored identifiers may differ (they stay as files hold them); the label is what the artist reads."""
+    by_label = {}
+    for owner, p in properties:
+        by_label.setdefault(p.name, []).append((owner, p))
+    assert len(by_label) > 100
+    bad = []
+    for label, entries in sorted(by_label.items()):
+        if label in SHARED_LABELS:
+            continue
+        kinds = {_kind(p) for _, p in entries}
+        enums = [p for _, p in entries if p.type == "ENUM"]
+        items = [{i.name for i in p.enum_items} for p in enums]
+        disjoint = any(not (a & b) for k, a in enumerate(items) for b in items[k + 1:])
+        if len(kinds) > 1 or disjoint:
+            bad.append(f"{label!r}: " + ", ".join(sorted({f"{o}.{p.identifier} {_kind(p)}" for o, p in entries})))
     assert not bad, "\n".join(bad)
 
 
