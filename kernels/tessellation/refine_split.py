@@ -120,175 +120,199 @@ def interior_template(m):
 
 def refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing):
     """Same contract and output as `refine_general` (and output edges): outer strips in closed form, interiors
-    stamped per inner segment count. Returns a `Refinement`."""
+    stamped per inner segment count. Returns a `Refinement` whose arrays are built on first use, so the threads that
+    evaluate the surface build them side by side (see `tessellate`)."""
+    split = _SplitFaces(tris, n_vertices, edges, face_edges, flipped, levels, spacing)
     edge_f, edge_n, inner_f, inner_n = levels
-    outer_n = edge_n[face_edges].astype(np.int64)  # (T, 3)
-    n_faces = len(tris)
-    point_edge, point_start, edge_point_t = edge_points(edge_f, edge_n, spacing)
-    edge_first = n_vertices + point_start
-    interior_first = n_vertices + len(point_edge)
+    slot_bary, slots = Lazy(split.slot_barys), Lazy(split.strip)
+    split.slots = slots
+    n_faces, n_b = len(tris), split.n_b
+    return Refinement(
+        n_corners=int(n_vertices), faces=tris, edges=edges,
+        edge_point_edge=split.point_edge.astype(np.int32), edge_point_t=split.edge_point_t, spacing=spacing,
+        edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
+        interior_counts=split.n_int, n_triangles=split.n_out, face_edges=face_edges, flipped=flipped,
+        arrays=LazyArrays(
+            triangles=Lazy(split.triangle_ids),
+            triangle_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), split.tri_counts)),
+            interior_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), split.n_int)),
+            interior_bary=Lazy(lambda: slot_bary.get()[n_b:]),
+            corner_bary=Lazy(lambda: slot_bary.get()[slots.get()[0]]), output_edges=Lazy(split.output_edges),
+            corner_slots=Lazy(lambda: (split.slot_faces(), slot_bary.get(), slots.get()[0]))),
+    )
 
-    m = np.asarray(inner_n, np.int64)
-    n_int = interior_counts(m)
-    int_start = np.cumsum(n_int) - n_int
-    boundary = outer_n.sum(axis=1)
-    side = np.maximum(m - 2, 0)  # segments per side of ring 1
-    ring1_loop = np.where(m >= 3, 3 * side, 1)  # ring-1 vertices (a point for m == 2)
-    n_strip_inner = np.where(m >= 3, 3 * side, 0)  # the strip's ring-1 triangles
-    n_strip_outer = np.where(m >= 2, boundary, 1)  # its boundary triangles (m == 1: the face itself)
-    values, inverse = np.unique(m, return_inverse=True)
-    templates = [interior_template(int(v)) for v in values]
-    groups = group_by_class(inverse.reshape(-1), len(values))
-    n_before = np.array([len(t.before) for t in templates], np.int64)[inverse]
-    n_after = np.array([len(t.after) for t in templates], np.int64)[inverse]
-    tri_counts = n_strip_outer + n_before + n_strip_inner + n_after
-    tri_start = np.cumsum(tri_counts) - tri_counts
-    n_out = int(tri_counts.sum())
 
-    # Slots: every face's boundary loop, then the interior points in output order.
-    b_face, b_pos, b_start = ragged(boundary)
-    n_b = len(b_face)
-    boundary_slots = Lazy(lambda: boundary_vertices(tris, face_edges, flipped, outer_n, edge_first, edge_point_t,
-                                                    n_vertices, b_face, b_pos))  # (ids, barycentrics)
-    n_interior = int(n_int.sum())
-    index_type = np.int32 if n_b + n_interior + interior_first < 2**31 else np.int64
-    interior_base = n_b + int_start  # slot of each face's first interior point
-    # Built on first use, so the threads that evaluate the surface build them side by side (see `tessellate`).
+class _SplitFaces:
+    """What every part of one `refine_split` shares: the faces' counts and where each face's triangles, boundary
+    slots and interior points start. Slots number every face's boundary loop (``n_b`` of them), then the interior
+    points in output order; a triangle corner is first a slot, its vertex id looked up when asked for."""
 
-    def ids_of(block, boundary_columns):  # output vertex of the slots (k, 3) whose listed columns are boundary slots
-        out = block + (interior_first - n_b)  # interior slots are numbered in vertex order
+    def __init__(self, tris, n_vertices, edges, face_edges, flipped, levels, spacing):
+        edge_f, edge_n, inner_f, inner_n = levels
+        self.tris, self.n_vertices, self.edges = tris, n_vertices, edges
+        self.face_edges, self.flipped = face_edges, flipped
+        self.edge_n, self.inner_f, self.spacing = edge_n, inner_f, spacing
+        self.outer_n = edge_n[face_edges].astype(np.int64)  # (T, 3)
+        self.point_edge, self.point_start, self.edge_point_t = edge_points(edge_f, edge_n, spacing)
+        self.edge_first = n_vertices + self.point_start
+        self.interior_first = n_vertices + len(self.point_edge)
+        m = self.m = np.asarray(inner_n, np.int64)
+        self.n_int = interior_counts(m)
+        self.int_start = np.cumsum(self.n_int) - self.n_int
+        self.boundary = self.outer_n.sum(axis=1)
+        self.side = np.maximum(m - 2, 0)  # segments per side of ring 1
+        self.ring1_loop = np.where(m >= 3, 3 * self.side, 1)  # ring-1 vertices (a point for m == 2)
+        self.n_strip_inner = np.where(m >= 3, 3 * self.side, 0)  # the strip's ring-1 triangles
+        self.n_strip_outer = np.where(m >= 2, self.boundary, 1)  # its boundary triangles (m == 1: the face itself)
+        values, self.inverse = np.unique(m, return_inverse=True)
+        self.templates = [interior_template(int(v)) for v in values]
+        self.groups = group_by_class(self.inverse.reshape(-1), len(values))
+        self.n_before = np.array([len(t.before) for t in self.templates], np.int64)[self.inverse]
+        self.n_after = np.array([len(t.after) for t in self.templates], np.int64)[self.inverse]
+        self.tri_counts = self.n_strip_outer + self.n_before + self.n_strip_inner + self.n_after
+        self.tri_start = np.cumsum(self.tri_counts) - self.tri_counts
+        self.n_out = int(self.tri_counts.sum())
+        self.b_face, self.b_pos, self.b_start = ragged(self.boundary)
+        self.n_b = len(self.b_face)
+        self.boundary_slots = Lazy(lambda: boundary_vertices(
+            tris, face_edges, flipped, self.outer_n, self.edge_first, self.edge_point_t, n_vertices, self.b_face,
+            self.b_pos))  # (ids, barycentrics)
+        self.n_interior = int(self.n_int.sum())
+        total = self.n_b + self.n_interior + self.interior_first
+        self.index_type = np.int32 if total < 2**31 else np.int64
+        self.interior_base = self.n_b + self.int_start  # slot of each face's first interior point
+        self.slots = None  # the Lazy of `strip`, set by `refine_split`
+
+    def ids_of(self, block, boundary_columns):
+        """Output vertex of the slots (k, 3) whose listed columns are boundary slots."""
+        out = block + (self.interior_first - self.n_b)  # interior slots are numbered in vertex order
         for col in boundary_columns:
-            out[:, col] = boundary_slots.get()[0][block[:, col]]
-        return out.astype(index_type, copy=False)
+            out[:, col] = self.boundary_slots.get()[0][block[:, col]]
+        return out.astype(self.index_type, copy=False)
 
-    def slot_faces():
-        out = np.empty(n_b + n_interior, index_type)
-        out[:n_b] = b_face
-        out[n_b:] = np.repeat(np.arange(n_faces, dtype=index_type), n_int)
+    def slot_faces(self):
+        out = np.empty(self.n_b + self.n_interior, self.index_type)
+        out[:self.n_b] = self.b_face
+        out[self.n_b:] = np.repeat(np.arange(len(self.tris), dtype=self.index_type), self.n_int)
         return out
 
-    def slot_barys():
-        slot_bary = np.empty((n_b + n_interior, 3))
-        slot_bary[:n_b] = boundary_slots.get()[1]
-        in_bary = slot_bary[n_b:]  # the interior points' rows, written in place
-        if spacing == "EQUAL":
-            for tpl, faces in zip(templates, groups, strict=True):
-                put_blocks(in_bary, int_start[faces], tpl.bary)
-        else:
-            # The inner partition's parameters once per face and point index; the weights once per point of one side
-            # of each ring, rotated onto the other two (the same bits per element as `interior_bary`).
-            index = np.arange(int(m.max()) + 1)
-            table = point_params(inner_f[:, None], m[:, None], np.minimum(index, m[:, None]), spacing)
-            for tpl, faces in zip(templates, groups, strict=True):
-                if not len(tpl.ring_k):
-                    continue
-                params = table[faces]
-                weights = np.concatenate(side_weights(params[:, tpl.side_k], params[:, tpl.side_k + tpl.side_j],
-                                                      tpl.side_j, tpl.side_len), axis=1)  # (F, 3Q)
-                put_blocks(in_bary, int_start[faces],
-                           np.take(weights, tpl.column_source.ravel(), axis=1).reshape(len(faces), -1, 3))
+    def slot_barys(self):
+        """Barycentrics (n_b + n_interior, 3) of every slot."""
+        slot_bary = np.empty((self.n_b + self.n_interior, 3))
+        slot_bary[:self.n_b] = self.boundary_slots.get()[1]
+        in_bary = slot_bary[self.n_b:]  # the interior points' rows, written in place
+        if self.spacing == "EQUAL":
+            for tpl, faces in zip(self.templates, self.groups, strict=True):
+                put_blocks(in_bary, self.int_start[faces], tpl.bary)
+            return slot_bary
+        # The inner partition's parameters once per face and point index; the weights once per point of one side of
+        # each ring, rotated onto the other two (the same bits per element as `interior_bary`).
+        m = self.m
+        index = np.arange(int(m.max()) + 1)
+        table = point_params(self.inner_f[:, None], m[:, None], np.minimum(index, m[:, None]), self.spacing)
+        for tpl, faces in zip(self.templates, self.groups, strict=True):
+            if not len(tpl.ring_k):
+                continue
+            params = table[faces]
+            weights = np.concatenate(side_weights(params[:, tpl.side_k], params[:, tpl.side_k + tpl.side_j],
+                                                  tpl.side_j, tpl.side_len), axis=1)  # (F, 3Q)
+            put_blocks(in_bary, self.int_start[faces],
+                       np.take(weights, tpl.column_source.ravel(), axis=1).reshape(len(faces), -1, 3))
         return slot_bary
 
-    def strip():  # slot of every output triangle corner; the strip rows (boundary, ring 1) and unrefined faces
-        tri_slots = np.empty((n_out, 3), index_type)
-        # Strip, boundary triangles: segment i (local edge e, index j of n) reaches ring-1 vertex `inner_pos`, the
-        # number of ring-1 segments whose midpoint comes before its midpoint: e * s, plus those q of side e with
-        # (2q + 1) n < (2j + 1) s.
-        sf = np.flatnonzero(m[b_face] >= 2)
-        f, i = b_face[sf], b_pos[sf]
-        e, j = local_edge(i, outer_n[f])
-        n = outer_n[f, e]
-        s = side[f]
+    def _boundary_rows(self, tri_slots):
+        """The strip's boundary triangles into ``tri_slots``: segment i (local edge e, index j of n) reaches ring-1
+        vertex `inner_pos`, the number of ring-1 segments whose midpoint comes before its midpoint: e * s, plus those
+        q of side e with (2q + 1) n < (2j + 1) s. Returns (f, e, j, n, rows, walk, vertex ids)."""
+        sf = np.flatnonzero(self.m[self.b_face] >= 2)
+        f, i = self.b_face[sf], self.b_pos[sf]
+        e, j = local_edge(i, self.outer_n[f])
+        n = self.outer_n[f, e]
+        s = self.side[f]
         inner_pos = e * s + ((2 * j + 1) * s + n - 1) // (2 * n)
-        a_rows = tri_start[f] + i
-        a_block = np.stack([b_start[f] + i, b_start[f] + (i + 1) % boundary[f],
-                            interior_base[f] + inner_pos % ring1_loop[f]], axis=1)
-        put_rows(tri_slots, a_rows, a_block.astype(index_type))
-        a_walk = i + inner_pos
-        # Strip, ring-1 triangles: segment q of side c reaches boundary vertex `outer_pos`, the number of boundary
-        # segments whose midpoint comes at or before its midpoint.
-        c_face, jj, _ = ragged(n_strip_inner)
-        s = side[c_face]
+        rows = self.tri_start[f] + i
+        block = np.stack([self.b_start[f] + i, self.b_start[f] + (i + 1) % self.boundary[f],
+                          self.interior_base[f] + inner_pos % self.ring1_loop[f]], axis=1)
+        put_rows(tri_slots, rows, block.astype(self.index_type))
+        return f, e, j, n, rows, i + inner_pos, self.ids_of(block, (0, 1))
+
+    def _ring1_rows(self, tri_slots):
+        """The strip's ring-1 triangles into ``tri_slots``: segment q of side c reaches boundary vertex `outer_pos`,
+        the number of boundary segments whose midpoint comes at or before its midpoint. Returns (faces, jj, rows,
+        walk, vertex ids)."""
+        c_face, jj, _ = ragged(self.n_strip_inner)
+        s = self.side[c_face]
         c, q = jj // np.maximum(s, 1), jj % np.maximum(s, 1)
-        n_c = outer_n[c_face, c]
-        before_c = np.where(c >= 1, outer_n[c_face, 0], 0) + np.where(c >= 2, outer_n[c_face, 1], 0)
+        n_c = self.outer_n[c_face, c]
+        before_c = np.where(c >= 1, self.outer_n[c_face, 0], 0) + np.where(c >= 2, self.outer_n[c_face, 1], 0)
         outer_pos = before_c + ((2 * q + 1) * n_c + s) // (2 * s)
-        c_rows = tri_start[c_face] + n_strip_outer[c_face] + n_before[c_face] + jj
-        c_block = np.stack([interior_base[c_face] + (jj + 1) % ring1_loop[c_face], interior_base[c_face] + jj,
-                            b_start[c_face] + outer_pos % boundary[c_face]], axis=1)
-        put_rows(tri_slots, c_rows, c_block.astype(index_type))
-        c_walk = jj + outer_pos
-        # Unrefined faces (m == 1): the boundary loop's three corners.
-        lone = np.flatnonzero(m == 1)
-        lone_block = b_start[lone][:, None] + np.arange(3)
-        tri_slots[tri_start[lone]] = lone_block
-        # Interiors, stamped per inner segment count.
-        for tpl, faces in zip(templates, groups, strict=True):
-            for part, offset in ((tpl.before, n_strip_outer[faces]),
-                                 (tpl.after, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
-                put_blocks(tri_slots, tri_start[faces] + offset, part, interior_base[faces])
-        # The strip rows' vertex ids (their boundary slots looked up), for the triangles and the output edges.
-        return (tri_slots, (f, e, j, n, a_rows, a_walk, ids_of(a_block, (0, 1))),
-                (c_face, jj, c_rows, c_walk, ids_of(c_block, (2,))), (lone, ids_of(lone_block, (0, 1, 2))))
+        rows = self.tri_start[c_face] + self.n_strip_outer[c_face] + self.n_before[c_face] + jj
+        block = np.stack([self.interior_base[c_face] + (jj + 1) % self.ring1_loop[c_face],
+                          self.interior_base[c_face] + jj, self.b_start[c_face] + outer_pos % self.boundary[c_face]],
+                         axis=1)
+        put_rows(tri_slots, rows, block.astype(self.index_type))
+        return c_face, jj, rows, jj + outer_pos, self.ids_of(block, (2,))
 
-    slot_bary, slots = Lazy(slot_barys), Lazy(strip)
+    def strip(self):
+        """The slot of every output triangle corner (n_out, 3), and the strip rows (boundary, ring 1) and unrefined
+        faces with their vertex ids, for the triangles and the output edges."""
+        tri_slots = np.empty((self.n_out, 3), self.index_type)
+        a = self._boundary_rows(tri_slots)
+        c = self._ring1_rows(tri_slots)
+        lone = np.flatnonzero(self.m == 1)  # unrefined faces: the boundary loop's three corners
+        lone_block = self.b_start[lone][:, None] + np.arange(3)
+        tri_slots[self.tri_start[lone]] = lone_block
+        for tpl, faces in zip(self.templates, self.groups, strict=True):  # interiors, stamped per inner count
+            for part, offset in ((tpl.before, self.n_strip_outer[faces]),
+                                 (tpl.after, self.n_strip_outer[faces] + self.n_before[faces]
+                                  + self.n_strip_inner[faces])):
+                put_blocks(tri_slots, self.tri_start[faces] + offset, part, self.interior_base[faces])
+        return tri_slots, a, c, (lone, self.ids_of(lone_block, (0, 1, 2)))
 
-    def triangle_ids():  # the slots' vertex ids; only strip rows and unrefined faces hold boundary slots
-        tri_slots, (*_, a_rows, _, a_ids), (_, _, c_rows, _, c_ids), (lone, lone_ids) = slots.get()
-        out = np.add(tri_slots, interior_first - n_b, dtype=index_type)
-        for rows, ids in ((a_rows, a_ids), (c_rows, c_ids), (tri_start[lone], lone_ids)):
+    def triangle_ids(self):
+        """The slots' vertex ids; only strip rows and unrefined faces hold boundary slots."""
+        tri_slots, (*_, a_rows, _, a_ids), (_, _, c_rows, _, c_ids), (lone, lone_ids) = self.slots.get()
+        out = np.add(tri_slots, self.interior_first - self.n_b, dtype=self.index_type)
+        for rows, ids in ((a_rows, a_ids), (c_rows, c_ids), (self.tri_start[lone], lone_ids)):
             put_rows(out, rows, ids)
         return out
 
-    def output_edges():
-        seg_start, seg_ends = edge_segments(edges, edge_n, point_start, n_vertices)
+    def output_edges(self):
+        """The output edges (E', 2) int32 and the edge leaving each triangle corner (n_out, 3) int32."""
+        seg_start, seg_ends = edge_segments(self.edges, self.edge_n, self.point_start, self.n_vertices)
         n_seg = len(seg_ends)
-        spokes = n_strip_outer * (m >= 2) + n_strip_inner  # one spoke per strip triangle
-        n_tpl = np.array([len(t.edges) for t in templates], np.int64)[inverse]
+        m, tri_start, templates = self.m, self.tri_start, self.templates
+        spokes = self.n_strip_outer * (m >= 2) + self.n_strip_inner  # one spoke per strip triangle
+        n_tpl = np.array([len(t.edges) for t in templates], np.int64)[self.inverse]
         counts = spokes + n_tpl
         face_start = n_seg + np.cumsum(counts) - counts
         out = np.empty((n_seg + int(counts.sum()), 2), np.int32)
         out[:n_seg] = seg_ends
-        corner = np.empty((n_out, 3), np.int32)
-        _, a, (c_face, jj, c_rows, c_walk, c_ids), (lone, _) = slots.get()
+        corner = np.empty((self.n_out, 3), np.int32)
+        _, a, (c_face, jj, c_rows, c_walk, c_ids), (lone, _) = self.slots.get()
         # The strip's spokes, numbered by walk position: a triangle's spoke is the one it starts from (its first
         # boundary and ring-1 vertex); the one it ends on is the next triangle's.
         f, e, j, n, rows, walk, a_ids = a
         base, count = face_start[f], spokes[f]
-        canonical = np.where(flipped[f, e], n - 1 - j, j)
-        put_rows(corner, rows, np.stack([seg_start[face_edges[f, e]] + canonical, base + (walk + 1) % count,
-                                              base + walk], axis=1).astype(np.int32))
+        canonical = np.where(self.flipped[f, e], n - 1 - j, j)
+        put_rows(corner, rows, np.stack([seg_start[self.face_edges[f, e]] + canonical, base + (walk + 1) % count,
+                                         base + walk], axis=1).astype(np.int32))
         put_rows(out, base + walk, a_ids[:, [0, 2]].astype(np.int32))
         base, count = face_start[c_face], spokes[c_face]
-        put_rows(corner, c_rows, np.stack([base + spokes[c_face] + _ring1_edges(templates, inverse[c_face], jj),
-                                                base + c_walk, base + (c_walk + 1) % count], axis=1).astype(np.int32))
+        put_rows(corner, c_rows, np.stack([base + spokes[c_face] + _ring1_edges(templates, self.inverse[c_face], jj),
+                                           base + c_walk, base + (c_walk + 1) % count], axis=1).astype(np.int32))
         put_rows(out, base + c_walk, c_ids[:, [2, 1]].astype(np.int32))
-        corner[tri_start[lone]] = seg_start[face_edges[lone]]  # one segment a side
-        for tpl, faces in zip(templates, groups, strict=True):
+        corner[tri_start[lone]] = seg_start[self.face_edges[lone]]  # one segment a side
+        for tpl, faces in zip(templates, self.groups, strict=True):
             if not len(tpl.edges):
                 continue
             first = face_start[faces] + spokes[faces]
-            put_blocks(out, first, tpl.edges, interior_first + int_start[faces])
+            put_blocks(out, first, tpl.edges, self.interior_first + self.int_start[faces])
             for part_edges, offset in (
-                    (tpl.before_edges, n_strip_outer[faces]),
-                    (tpl.after_edges, n_strip_outer[faces] + n_before[faces] + n_strip_inner[faces])):
+                    (tpl.before_edges, self.n_strip_outer[faces]),
+                    (tpl.after_edges, self.n_strip_outer[faces] + self.n_before[faces] + self.n_strip_inner[faces])):
                 put_blocks(corner, tri_start[faces] + offset, part_edges, first)
         return out, corner
-
-    ref = Refinement(
-        n_corners=int(n_vertices), faces=tris, edges=edges,
-        edge_point_edge=point_edge.astype(np.int32), edge_point_t=edge_point_t, spacing=spacing,
-        edge_level=edge_f, edge_segments=edge_n, inner_level=inner_f, inner_segments=inner_n,
-        interior_counts=n_int, n_triangles=n_out, face_edges=face_edges, flipped=flipped,
-        arrays=LazyArrays(
-            triangles=Lazy(triangle_ids),
-            triangle_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), tri_counts)),
-            interior_face=Lazy(lambda: np.repeat(np.arange(n_faces, dtype=np.int32), n_int)),
-            interior_bary=Lazy(lambda: slot_bary.get()[n_b:]),
-            corner_bary=Lazy(lambda: slot_bary.get()[slots.get()[0]]), output_edges=Lazy(output_edges),
-            corner_slots=Lazy(lambda: (slot_faces(), slot_bary.get(), slots.get()[0]))),
-    )
-    return ref
 
 
 def _ring1_edges(templates, classes, jj):
