@@ -169,7 +169,49 @@ def _gdal_metadata_scale(page):
 
 
 def _tiff_geoinfo(path):
+    """The placement of a GeoTIFF read with tifffile (no GDAL): a `GeoInfo`, or None when the file has no GeoTIFF
+    keys. Raises `InvalidInputError` with what to do for what only GDAL could read."""
     name = os.path.basename(path)
+    page = _tiff_page(path, name)
+    tags = page["tags"]
+    if not tags:
+        return None
+    if page["masked"]:
+        raise InvalidInputError(f"{name} marks its voids with a mask band, which Tessera reads only through GDAL, "
+                                f"not available on this system ({gdal_raster.why_not()})")
+    x0, y0, dx, dy = _tiff_placement(name, tags)
+    geographic = _key(tags, "GTModelTypeGeoKey") == 2
+    unit = _key(tags, "ProjLinearUnitsGeoKey")
+    crs = _key(tags, "GeographicTypeGeoKey" if geographic else "ProjectedCSTypeGeoKey") or 0
+    if not geographic and unit is None and crs and not any(a <= crs <= b for a, b in _METRE_CRS):
+        raise InvalidInputError(f"{name} names its unit only through EPSG code {crs}, which Tessera resolves only "
+                                f"through GDAL, not available on this system ({gdal_raster.why_not()})")
+    if not geographic and unit is not None and unit not in LINEAR_UNITS:
+        raise InvalidInputError(f"{name} gives its positions in unit code {unit}, which Tessera does not know "
+                                "(metre, foot, US survey foot, kilometre, nautical mile)")
+    angular = _key(tags, "GeogAngularUnitsGeoKey")
+    if geographic and angular not in (None, 9102):
+        raise InvalidInputError(f"{name} gives its angles in unit code {angular}; Tessera reads degrees (9102)")
+    notes = []
+    vertical_metres = _tiff_vertical_metres(name, tags, notes)
+    nodata = page["nodata"]
+    if nodata is not None:
+        try:
+            nodata = float(str(nodata).strip().rstrip("\x00"))
+        except ValueError as err:
+            raise InvalidInputError(f"{name} has a no-data value that is not a number: {nodata!r}") from err
+    band_scale, band_offset = page["scale"]
+    if band_scale != 1.0 or band_offset != 0.0:
+        notes.append(f"stored values x {band_scale:g} + {band_offset:g}")
+    return GeoInfo(path, (float(x0), float(y0)), (float(dx), float(dy)), page["size"], geographic,
+                   LINEAR_UNITS.get(unit, 1.0), vertical_metres, nodata, crs, "", band_scale, band_offset,
+                   abs(band_scale) if page["integer"] else 0.0, 1, False, "tiff", tuple(notes))
+
+
+def _tiff_page(path, name):
+    """What `_tiff_geoinfo` reads of a TIFF's first page: {tags: its GeoTIFF keys, nodata: the GDAL no-data tag's
+    value or None, size: (width, height), integer: whether its samples are integers, masked: whether a mask band
+    follows, scale: (scale, offset) of its values}."""
     try:
         import tifffile
     except ImportError as err:  # bundled with the extension; only a broken install lacks it
@@ -177,20 +219,21 @@ def _tiff_geoinfo(path):
     try:
         with tifffile.TiffFile(path) as tf:
             page = tf.pages.first
-            tags = page.geotiff_tags or {}
-            # tifffile drops a no-data value at the edge of float32 (GDAL's -3.4028234663852886e+38) as 0
-            nodata = page.tags[42113].value if 42113 in page.tags else None
-            width, height = int(page.imagewidth), int(page.imagelength)
-            integer = page.dtype is not None and np.dtype(page.dtype).kind in "iu"
-            masked = any(int(p.subfiletype) & 4 for p in tf.pages[1:])
-            band_scale, band_offset = _gdal_metadata_scale(page)
+            return {
+                "tags": page.geotiff_tags or {},
+                # tifffile drops a no-data value at the edge of float32 (GDAL's -3.4028234663852886e+38) as 0
+                "nodata": page.tags[42113].value if 42113 in page.tags else None,
+                "size": (int(page.imagewidth), int(page.imagelength)),
+                "integer": page.dtype is not None and np.dtype(page.dtype).kind in "iu",
+                "masked": any(int(p.subfiletype) & 4 for p in tf.pages[1:]),
+                "scale": _gdal_metadata_scale(page),
+            }
     except (tifffile.TiffFileError, OSError, ValueError, IndexError, KeyError) as err:
         raise InvalidInputError(f"{name} is not a TIFF file that can be read: {err}") from err
-    if not tags:
-        return None
-    if masked:
-        raise InvalidInputError(f"{name} marks its voids with a mask band, which Tessera reads only through GDAL, "
-                                f"not available on this system ({gdal_raster.why_not()})")
+
+
+def _tiff_placement(name, tags):
+    """The first sample's centre and the sample spacing from a GeoTIFF's keys: (x0, y0, dx, dy), north up."""
     scale, tie, matrix = tags.get("ModelPixelScale"), tags.get("ModelTiepoint"), tags.get("ModelTransformation")
     if tie is not None:  # tifffile gives one tie point flat, several as a list of six-value lists
         tie = np.asarray(tie, np.float64).ravel()
@@ -217,44 +260,25 @@ def _tiff_geoinfo(path):
                                 "Tessera needs north-up data: flip it first (gdalwarp)")
     if _key(tags, "GTRasterTypeGeoKey") != 2:  # PixelIsArea (the default): samples at the pixel centres
         x0, y0 = x0 + 0.5 * dx, y0 - 0.5 * dy
-    geographic = _key(tags, "GTModelTypeGeoKey") == 2
-    unit = _key(tags, "ProjLinearUnitsGeoKey")
-    crs = _key(tags, "GeographicTypeGeoKey" if geographic else "ProjectedCSTypeGeoKey") or 0
-    if not geographic and unit is None and crs and not any(a <= crs <= b for a, b in _METRE_CRS):
-        raise InvalidInputError(f"{name} names its unit only through EPSG code {crs}, which Tessera resolves only "
-                                f"through GDAL, not available on this system ({gdal_raster.why_not()})")
-    if not geographic and unit is not None and unit not in LINEAR_UNITS:
-        raise InvalidInputError(f"{name} gives its positions in unit code {unit}, which Tessera does not know "
-                                "(metre, foot, US survey foot, kilometre, nautical mile)")
-    angular = _key(tags, "GeogAngularUnitsGeoKey")
-    if geographic and angular not in (None, 9102):
-        raise InvalidInputError(f"{name} gives its angles in unit code {angular}; Tessera reads degrees (9102)")
+    return x0, y0, dx, dy
+
+
+def _tiff_vertical_metres(name, tags, notes):
+    """Metres per height unit from a GeoTIFF's vertical keys; appends to ``notes`` when the file names none."""
     vertical = _key(tags, "VerticalUnitsGeoKey")
     vertical_crs = _key(tags, "VerticalCSTypeGeoKey")
-    notes = []
     if vertical is None and vertical_crs is not None:
         if vertical_crs not in _VERTICAL_CRS:
             raise InvalidInputError(f"{name} names its height unit only through EPSG code {vertical_crs}, which "
                                     "Tessera resolves only through GDAL, not available on this system "
                                     f"({gdal_raster.why_not()})")
-        vertical_metres = _VERTICAL_CRS[vertical_crs]
-    elif vertical is not None and vertical not in LINEAR_UNITS:
+        return _VERTICAL_CRS[vertical_crs]
+    if vertical is not None and vertical not in LINEAR_UNITS:
         raise InvalidInputError(f"{name} gives its heights in unit code {vertical}, which Tessera does not know "
                                 "(metre, foot, US survey foot)")
-    else:
-        vertical_metres = LINEAR_UNITS.get(vertical, 1.0)
-        if vertical is None:
-            notes.append("heights read as metres (the file names no vertical unit)")
-    if nodata is not None:
-        try:
-            nodata = float(str(nodata).strip().rstrip("\x00"))
-        except ValueError as err:
-            raise InvalidInputError(f"{name} has a no-data value that is not a number: {nodata!r}") from err
-    if band_scale != 1.0 or band_offset != 0.0:
-        notes.append(f"stored values x {band_scale:g} + {band_offset:g}")
-    return GeoInfo(path, (float(x0), float(y0)), (float(dx), float(dy)), (width, height), geographic,
-                   LINEAR_UNITS.get(unit, 1.0), vertical_metres, nodata, crs, "", band_scale, band_offset,
-                   abs(band_scale) if integer else 0.0, 1, False, "tiff", tuple(notes))
+    if vertical is None:
+        notes.append("heights read as metres (the file names no vertical unit)")
+    return LINEAR_UNITS.get(vertical, 1.0)
 
 
 def metres_per_unit(info, latitude=None):

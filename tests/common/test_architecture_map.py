@@ -39,3 +39,25 @@ def test_each_package_says_what_it_is_for_and_leaves_the_map_to_the_page():
         modules = {Path(m).stem for m in _product_modules() if Path(m).parent == Path(path).parent}
         named = sorted(m for m in modules if f"`{m}`" in doc)
         assert len(doc.splitlines()) <= 4 and len(named) <= 2, f"{path}: {len(doc.splitlines())} lines, names {named}"
+
+
+#: DESIGN's sizes: a module of about 500 lines at most (600 the limit), a function of at most 80.
+MAX_MODULE_LINES, MAX_FUNCTION_LINES = 600, 80
+
+
+def test_modules_and_functions_stay_small():
+    """No product module over 600 lines and no product function over 80: a file that grows past them has taken on a
+    second job, to be split by what it does (as the patch tessellator was)."""
+    import ast
+
+    long_modules, long_functions = [], []
+    for path in _product_modules():
+        text = (ROOT / path).read_text(encoding="utf-8")
+        if len(text.splitlines()) > MAX_MODULE_LINES:
+            long_modules.append(f"{path}: {len(text.splitlines())} lines")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                size = node.end_lineno - node.lineno + 1
+                if size > MAX_FUNCTION_LINES:
+                    long_functions.append(f"{path}: {node.name} {size} lines")
+    assert not long_modules and not long_functions, long_modules + long_functions
