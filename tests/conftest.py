@@ -116,11 +116,13 @@ def addon_module(addon):
 
 @pytest.fixture
 def clean_scene(bpy_module, addon):
-    """An empty current scene; removes objects, meshes and materials the test left behind."""
+    """An empty current scene; removes the objects, meshes, curves, materials, cameras and images the test left
+    behind (an image another test made, such as a baked card, must not be taken for this test's)."""
     bpy = bpy_module
 
     def wipe():
-        for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.cameras):
+        for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.materials, bpy.data.cameras,
+                           bpy.data.images):
             for item in list(collection):
                 collection.remove(item)
 

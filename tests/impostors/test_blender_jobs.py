@@ -224,7 +224,7 @@ def test_what_tessera_makes_survives_save_and_reload_bit_for_bit(clean_scene, bp
     names = sorted({n.image.name for n in card.data.materials[0].node_tree.nodes if getattr(n, "image", None)})
     known = set(bpy.data.images.keys())
     assert bpy.ops.tessera.vector_field_texture(width=32, height=32) == {"FINISHED"}
-    names += sorted(set(bpy.data.images.keys()) - known)
+    names += sorted(n for n in set(bpy.data.images.keys()) - known if bpy.data.images[n].type == "IMAGE")
     assert len(names) == 4  # colour, normal and depth atlases; the texture
     before = {n: _pixels(bpy.data.images[n]) for n in names}
     path = str(tmp_path / "made.blend")
