@@ -18,7 +18,9 @@ from ..addon.tessellation.settings import (
 )
 from ..kernels.common.budget import check_budget
 from ..kernels.common.errors import GPUContextError, GPUShaderError
+from ..kernels.common.topology import mesh_topology
 from ..kernels.tessellation.adaptive import adaptive_levels
+from ..kernels.tessellation.mesh_levels import mesh_levels
 from ..kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
 from .selection import is_mesh, mesh_poll, place_mesh, read_source
 
@@ -78,22 +80,27 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
         return {"FINISHED"}
 
     def _levels(self, context, ob, arrays):
+        """The mesh's `MeshLevels`: its edge table built once, the levels chosen on it, clamped and counted once,
+        then carried through the estimate to the refinement."""
+        topology = mesh_topology(arrays.triangles, len(arrays.positions))
         if self.level_mode == "UNIFORM":
-            return uniform_levels(arrays, self.level), None
+            return mesh_levels(topology, uniform_levels(arrays, self.level, topology), None, self.spacing)
         camera = camera_for(context, self.camera_source) if needs_camera(self) else None
         world = _world_positions(arrays.positions.astype(np.float64), ob.matrix_world)
-        return adaptive_levels(world, arrays.triangles, adaptive_settings(self), camera, arrays.corner_normals)
+        edge, inner = adaptive_levels(world, arrays.triangles, adaptive_settings(self), camera, arrays.corner_normals,
+                                      topology)
+        return mesh_levels(topology, edge, inner, self.spacing)
 
     def _build_mesh(self, context, ob, progress):
         """Read, tessellate and write; returns ``(mesh, skipped, notes)``. Creates nothing on failure."""
         arrays, info, _ = read_source(context, ob, self.output)
         progress(0.1)
-        edge_levels, inner_levels = self._levels(context, ob, arrays)
+        levels = self._levels(context, ob, arrays)
         budget = get_preferences(context).memory_budget_bytes
-        check_budget(estimate(arrays, edge_levels, inner_levels, spacing=self.spacing), budget)
+        check_budget(estimate(arrays, levels), budget)
         notes = []
         result = tessellate(
-            arrays, edge_levels, inner_levels, spacing=self.spacing, method=self.method,
+            arrays, levels, method=self.method,
             options=surface_options(self), progress=lambda f: progress(0.1 + 0.7 * f),
             surface=self._gpu_surface(notes),
         )

@@ -1,5 +1,7 @@
 """Edge topology of triangle meshes, and the ragged-array helper the refinement is built on."""
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .errors import InvalidInputError
@@ -52,6 +54,26 @@ def triangle_edges(triangles):
     edges = np.stack([uniq // n, uniq % n], axis=1).astype(np.int32)
     face_edges = inverse.reshape(triangles.shape).astype(np.int32)
     return edges, face_edges, start > end
+
+
+@dataclass(frozen=True)
+class MeshTopology:
+    """A triangle mesh's edge table, built once and carried to every step that needs it.
+
+    triangles: (T, 3) int32, validated; n_vertices: V; edges, face_edges, flipped: as `triangle_edges` returns them.
+    """
+
+    triangles: np.ndarray
+    n_vertices: int
+    edges: np.ndarray
+    face_edges: np.ndarray
+    flipped: np.ndarray
+
+
+def mesh_topology(triangles, n_vertices):
+    """Validate ``triangles`` (T, 3) and build their edge table: a `MeshTopology`."""
+    tris = validate_triangles(triangles, n_vertices)
+    return MeshTopology(tris, int(n_vertices), *triangle_edges(tris))
 
 
 def ragged(counts):

@@ -16,7 +16,7 @@ import numpy as np
 from ..common.errors import InvalidInputError
 from ..common.normals import face_unit_normals, shared_vertex_normals
 from ..common.partition import MAX_LEVEL
-from ..common.topology import triangle_edges, validate_triangles
+from ..common.topology import mesh_topology, triangle_edges, validate_triangles
 from . import metrics
 from .patches import pn_control, pn_edge_control
 
@@ -96,19 +96,20 @@ def _curvature(positions, tris, edges, vertex_normals, settings):
     return edge, inner
 
 
-def adaptive_levels(positions, triangles, settings, camera=None, corner_normals=None):
+def adaptive_levels(positions, triangles, settings, camera=None, corner_normals=None, topology=None):
     """Edge and inner levels for a mesh.
 
     positions: (V, 3) world space; triangles: (T, 3) int; settings: `AdaptiveSettings`; camera:
     `kernels.common.camera.Camera` (needed by DISTANCE, PROJECTED, SILHOUETTE); corner_normals: (T, 3, 3) or None,
     used by CURVATURE through the same shared vertex normals the PN geometry uses.
     Returns ``(edge_levels (E,), inner_levels (T,))`` float64 in ``[1, max_level]``, edges as in
-    `kernels.common.topology.triangle_edges`. Inner levels are at least the face's largest edge level.
+    `kernels.common.topology.triangle_edges`. Inner levels are at least the face's largest edge level. topology: the
+    mesh's `kernels.common.topology.MeshTopology`, if built already.
     """
     settings.validate()
     positions = np.asarray(positions, np.float64)
-    tris = validate_triangles(triangles, len(positions))
-    edges, face_edges, _ = triangle_edges(tris)
+    topology = topology or mesh_topology(triangles, len(positions))
+    tris, edges, face_edges = topology.triangles, topology.edges, topology.face_edges
     if camera is None and any(m in CAMERA_METRICS for m in settings.metrics):
         raise InvalidInputError("Distance, projected-edge and silhouette levels need a camera (scene or viewport)")
     t_max = settings.max_level

@@ -28,9 +28,8 @@ OpenGL terms, local edge 0 (v0-v1) is ``gl_TessLevelOuter[2]``, edge 1 (v1-v2) i
 
 import numpy as np
 
-from ..common.topology import triangle_edges, validate_triangles
 from . import refine_templates
-from .refine_general import face_levels, interior_counts
+from .mesh_levels import carried_levels
 from .refine_split import refine_split
 
 
@@ -39,14 +38,7 @@ def refinement_counts(triangles, n_vertices, edge_levels, inner_levels=None, spa
 
     Returns ``(n_out_vertices, n_out_triangles)``. Arguments as in `refine`.
     """
-    tris = validate_triangles(triangles, n_vertices)
-    edges, face_edges, _ = triangle_edges(tris)
-    _, edge_n, _, inner_n = face_levels(face_edges, len(edges), edge_levels, inner_levels, spacing)
-    interior = interior_counts(inner_n)
-    boundary = edge_n[face_edges].sum(axis=1)
-    n_vertices_out = n_vertices + int((edge_n - 1).sum()) + int(interior.sum())
-    # Euler's formula for a triangulated disk: T = 2V - B - 2 with V = B + interior.
-    return n_vertices_out, int((boundary + 2 * interior - 2).sum())
+    return carried_levels(triangles, n_vertices, edge_levels, inner_levels, spacing).counts()
 
 
 def triangle_count(outer, inner):
@@ -71,17 +63,20 @@ def refine(triangles, n_vertices, edge_levels, inner_levels=None, spacing="EQUAL
     """Refine a triangle mesh with one level per edge and one inner level per triangle.
 
     triangles: (T, 3) int, counter-clockwise; n_vertices: int, V;
-    edge_levels: (E,) float, one level per edge of `kernels.common.topology.triangle_edges` (sorted ``(lo, hi)``);
+    edge_levels: (E,) float, one level per edge of `kernels.common.topology.triangle_edges` (sorted ``(lo, hi)``), or
+    a `kernels.tessellation.mesh_levels.MeshLevels` carried from an earlier step (then it holds the inner levels and
+    the spacing, and the edge table is not built again);
     inner_levels: (T,) float or None (then the largest of the triangle's three edge levels);
     spacing: ``"EQUAL"`` or ``"FRACTIONAL_EVEN"`` (see `kernels.common.partition`).
     Returns a `Refinement`. Shared edges give shared vertices, so a closed manifold input gives a closed
     manifold output.
     """
-    tris = validate_triangles(triangles, n_vertices)
-    edges, face_edges, flipped = triangle_edges(tris)
-    edge_f, edge_n, inner_f, inner_n = face_levels(face_edges, len(edges), edge_levels, inner_levels, spacing)
-    levels = (edge_f, edge_n, inner_f, inner_n)
+    carried = carried_levels(triangles, n_vertices, edge_levels, inner_levels, spacing)
+    topo, levels, spacing = carried.topology, carried.levels, carried.spacing
+    edge_f, edge_n, inner_f, inner_n = levels
+    tris, edges, face_edges, flipped = topo.triangles, topo.edges, topo.face_edges, topo.flipped
     classes = refine_templates.pattern_classes(edge_f[face_edges], edge_n[face_edges], inner_f, inner_n, spacing)
     if refine_templates.worth_it(classes, len(tris)):
-        return refine_templates.refine_by_class(tris, n_vertices, edges, face_edges, flipped, levels, classes, spacing)
-    return refine_split(tris, n_vertices, edges, face_edges, flipped, levels, spacing)
+        return refine_templates.refine_by_class(tris, topo.n_vertices, edges, face_edges, flipped, levels, classes,
+                                                spacing)
+    return refine_split(tris, topo.n_vertices, edges, face_edges, flipped, levels, spacing)

@@ -22,9 +22,10 @@ from ..common.budget import Estimate
 from ..common.errors import InvalidInputError
 from ..common.mesh_arrays import MeshArrays
 from ..common.normals import shared_vertex_normals
-from ..common.topology import triangle_edges, validate_triangles
+from ..common.topology import MeshTopology, mesh_topology
 from . import patches
 from .interpolate import corner_values, face_values, normalized, point_values
+from .mesh_levels import carried_levels, mesh_levels
 from .normals import NORMAL_MODES, split_by_normals, split_corners
 from .refine import refine, refinement_counts
 from .surface_eval import evaluate_corners, evaluate_corners_by_class, evaluate_surface
@@ -67,15 +68,15 @@ BYTES_PER_VERTEX = 64
 BYTES_PER_CHANNEL = 4
 
 
-def uniform_levels(mesh, level):
-    """One level for every edge of ``mesh``: (E,) float64."""
-    tris = validate_triangles(mesh.triangles, len(mesh.positions))
-    edges, _, _ = triangle_edges(tris)
-    return np.full(len(edges), float(level))
+def uniform_levels(mesh, level, topology=None):
+    """One level for every edge of ``mesh``: (E,) float64. topology: its `MeshTopology`, if built already."""
+    topology = topology or mesh_topology(mesh.triangles, len(mesh.positions))
+    return np.full(len(topology.edges), float(level))
 
 
 def estimate(mesh, edge_levels, inner_levels=None, spacing="EQUAL"):
-    """Counts and peak-memory estimate for `tessellate` with the same arguments. Returns `Estimate`."""
+    """Counts and peak-memory estimate for `tessellate` with the same arguments (``edge_levels`` may be a carried
+    `MeshLevels`, as in `refine`). Returns `Estimate`."""
     n_vertices, n_triangles = refinement_counts(
         mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing
     )
@@ -97,11 +98,13 @@ def _check_options(method, options):
         raise InvalidInputError("The Phong shape factor must be a finite number")
 
 
-def _split_mesh(mesh, edge_levels):
-    """SPLIT mode: one vertex per distinct corner normal. Returns (mesh', vertex normals, levels', opened)."""
+def _split_mesh(mesh, edge_levels, topology=None):
+    """SPLIT mode: one vertex per distinct corner normal. Returns (mesh', its `MeshTopology`, vertex normals,
+    levels', opened)."""
     tris, source, normals = split_by_normals(mesh.triangles, mesh.corner_normals, len(mesh.positions))
-    old_edges, _, _ = triangle_edges(mesh.triangles)
-    new_edges, _, _ = triangle_edges(tris)
+    old_edges = (topology or mesh_topology(mesh.triangles, len(mesh.positions))).edges
+    split_topology = mesh_topology(tris, len(source))
+    new_edges = split_topology.edges
     n = len(mesh.positions)
     old_keys = old_edges[:, 0].astype(np.int64) * n + old_edges[:, 1]
     a, b = source[new_edges[:, 0]], source[new_edges[:, 1]]
@@ -113,7 +116,7 @@ def _split_mesh(mesh, edge_levels):
         corner_attributes=mesh.corner_attributes, face_attributes=mesh.face_attributes,
         attribute_types=mesh.attribute_types,
     )
-    return split, normals, levels, len(new_edges) - len(old_edges)
+    return split, split_topology, normals, levels, len(new_edges) - len(old_edges)
 
 
 def _alpha_values(mesh, options):
@@ -137,7 +140,8 @@ class SurfaceInputs:
     mesh: the mesh the surface is built on (``SPLIT`` mode: split along sharp edges); positions: (V, 3) float64;
     vertex_normals: (V, 3) one geometry normal per vertex; split: (T, 3) bool corners whose shading normal
     differs from the vertex normal, or None; edge_levels: (E,) for ``mesh``'s edges; alpha: (V,) per-vertex
-    Phong factors, or None for ``options.alpha``; opened_edges: edges ``SPLIT`` cut open.
+    Phong factors, or None for ``options.alpha``; opened_edges: edges ``SPLIT`` cut open; topology: ``mesh``'s
+    `MeshTopology` where it was built (None: not yet).
     """
 
     mesh: MeshArrays
@@ -147,6 +151,7 @@ class SurfaceInputs:
     edge_levels: np.ndarray
     alpha: np.ndarray | None
     opened_edges: int = 0
+    topology: MeshTopology | None = None
 
     def shading_normals(self):
         """Per-corner shading normals (T, 3, 3) float64: a split face keeps all its own corner normals."""
@@ -158,19 +163,21 @@ class SurfaceInputs:
         return out
 
 
-def surface_inputs(mesh, edge_levels, method, options):
-    """Apply ``options.normal_mode`` to ``mesh`` for ``method`` (PHONG or PN): a `SurfaceInputs`."""
+def surface_inputs(mesh, edge_levels, method, options, topology=None):
+    """Apply ``options.normal_mode`` to ``mesh`` for ``method`` (PHONG or PN): a `SurfaceInputs`. topology: the
+    mesh's `MeshTopology`, if built already."""
     positions = np.asarray(mesh.positions, np.float64)
     if options.normal_mode == "SPLIT" and mesh.corner_normals is not None:
-        source, vertex_normals, edge_levels, opened = _split_mesh(mesh, edge_levels)
+        source, topology, vertex_normals, edge_levels, opened = _split_mesh(mesh, edge_levels, topology)
         alpha = _alpha_values(source, options) if method == "PHONG" else None
         return SurfaceInputs(source, np.asarray(source.positions, np.float64), vertex_normals, None,
-                             np.asarray(edge_levels, np.float64), alpha, opened)
+                             np.asarray(edge_levels, np.float64), alpha, opened, topology)
     vertex_normals = shared_vertex_normals(positions, mesh.triangles, mesh.corner_normals)
     split = None if mesh.corner_normals is None else split_corners(mesh.triangles, mesh.corner_normals,
                                                                    vertex_normals)
     alpha = _alpha_values(mesh, options) if method == "PHONG" else None
-    return SurfaceInputs(mesh, positions, vertex_normals, split, np.asarray(edge_levels, np.float64), alpha)
+    return SurfaceInputs(mesh, positions, vertex_normals, split, np.asarray(edge_levels, np.float64), alpha,
+                         topology=topology)
 
 
 def _edge_data(ref, positions, normals):
@@ -240,10 +247,10 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
                progress=None, options=None, surface=None):
     """Tessellate a `MeshArrays` and return a `Tessellation`.
 
-    edge_levels: (E,) float, one per edge of `kernels.common.topology.triangle_edges`; inner_levels: (T,) float or
-    None; spacing: see `kernels.common.partition`; method: one of `METHODS`; backend: see
-    `kernels.tessellation.interpolate.gather_weighted`; progress: optional callable ``(fraction)``; options:
-    `SurfaceOptions` for PHONG and PN; surface: for PHONG and PN, an optional evaluator
+    edge_levels: (E,) float, one per edge of `kernels.common.topology.triangle_edges`, or a carried `MeshLevels` (as in
+    `refine`); inner_levels: (T,) float or None; spacing: see `kernels.common.partition`; method: one of `METHODS`;
+    backend: see `kernels.tessellation.interpolate.gather_weighted`; progress: optional callable ``(fraction)``;
+    options: `SurfaceOptions` for PHONG and PN; surface: for PHONG and PN, an optional evaluator
     ``(refinement, SurfaceInputs) -> (positions (N, 3), unit point normals (N, 3))`` that replaces the numpy
     surface (the GPU compute path). Face attributes of the output are per output triangle. Curved
     methods write unit ``point_normals`` (and ``corner_normals`` where the input has split normals).
@@ -251,15 +258,15 @@ def tessellate(mesh, edge_levels, inner_levels=None, spacing="EQUAL", method="LI
     options = options or SurfaceOptions()
     _check_options(method, options)
     mesh.validate()
+    levels = carried_levels(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
     with workers.parallel_section():
-        return _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend,
-                           progress or (lambda fraction: None), options, surface)
+        return _tessellate(mesh, levels, method, backend, progress or (lambda fraction: None), options, surface)
 
 
-def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, report, options, surface):
+def _tessellate(mesh, levels, method, backend, report, options, surface):
     result = Tessellation(mesh=None, refinement=None)
     if method == "LINEAR":
-        ref = refine(mesh.triangles, len(mesh.positions), edge_levels, inner_levels, spacing)
+        ref = refine(mesh.triangles, len(mesh.positions), levels)
         report(0.4)
         attributes = workers.submit(_attributes, ref, mesh, backend)
         edges = _output_edges_job(ref)
@@ -268,13 +275,15 @@ def _tessellate(mesh, edge_levels, inner_levels, spacing, method, backend, repor
         if mesh.corner_normals is not None:
             out.corner_normals = normalized(corner_values(ref, mesh.corner_normals, backend))
     else:
-        inputs = surface_inputs(mesh, edge_levels, method, options)
-        source, positions, vertex_normals, split, edge_levels, alpha = (
-            inputs.mesh, inputs.positions, inputs.vertex_normals, inputs.split, inputs.edge_levels, inputs.alpha)
+        inputs = surface_inputs(mesh, levels.edge_level, method, options, levels.topology)
+        source, positions, vertex_normals, split, alpha = (
+            inputs.mesh, inputs.positions, inputs.vertex_normals, inputs.split, inputs.alpha)
         result.opened_edges = inputs.opened_edges
         if result.opened_edges:
             result.notes.append(f"Split normals opened {result.opened_edges} edge(s): the surface has gaps there")
-        ref = refine(source.triangles, len(source.positions), edge_levels, inner_levels, spacing)
+        if source is not mesh:  # SPLIT: the levels of the split mesh's own edges, the same inner levels
+            levels = mesh_levels(inputs.topology, inputs.edge_levels, levels.inner_level, levels.spacing)
+        ref = refine(source.triangles, len(source.positions), levels)
         report(0.4)
         # Four independent parts, longest first, on the two workers (this thread waits).
         attributes = workers.submit(_attributes, ref, source, backend)

@@ -228,3 +228,46 @@ def test_numpy_gather_is_the_tap_order_sum_bit_for_bit(taps):
             want += w[:, t, None] * values[idx[:, t]]
         got = gather_weighted_numpy(values, idx, w)
         assert got.dtype == np.float32 and got.tobytes() == want.astype(np.float32).tobytes()
+
+
+@pytest.mark.parametrize("method, normal_mode", [("LINEAR", "WATERTIGHT"), ("PN", "WATERTIGHT"), ("PHONG", "SPLIT")])
+def test_levels_carried_from_the_choice_to_the_refinement_build_the_edge_table_once(monkeypatch, method,
+                                                                                    normal_mode):
+    """The operator's walk: the edge table is built once (`mesh_topology`), the levels are chosen on it and clamped
+    once (`mesh_levels`), and the estimate and the tessellation take that `MeshLevels` without building or clamping
+    again (SPLIT builds the split mesh's own table, once). The mesh is byte for byte the one from plain arrays."""
+    import tessera.kernels.common.topology as topology
+    import tessera.kernels.tessellation.refine_general as refine_general
+    from tessera.kernels.tessellation.mesh_levels import mesh_levels
+    from tessera.kernels.tessellation.tessellate import SurfaceOptions
+
+    mesh, _, _, _ = mesh_with_attributes(3)
+    mesh.corner_normals = np.random.default_rng(4).normal(size=(len(mesh.triangles), 3, 3)).astype(np.float32)
+    options = SurfaceOptions(normal_mode=normal_mode)
+    table = topology.mesh_topology(mesh.triangles, len(mesh.positions))
+    raw = np.random.default_rng(5).uniform(0.5, 70, len(table.edges))
+    inner = np.random.default_rng(6).uniform(0.5, 70, len(mesh.triangles))
+    levels = mesh_levels(table, uniform_levels(mesh, 3.0, table) + raw, inner, "FRACTIONAL_EVEN")
+    calls = {"edges": 0, "clamps": 0}
+
+    def counted(name, function):
+        def call(*args, **kwargs):
+            calls[name] += 1
+            return function(*args, **kwargs)
+        return call
+
+    monkeypatch.setattr(topology, "triangle_edges", counted("edges", topology.triangle_edges))
+    monkeypatch.setattr(refine_general, "clamp_levels", counted("clamps", refine_general.clamp_levels))
+    estimated = estimate(mesh, levels)
+    carried = tessellate(mesh, levels, method=method, options=options, backend="numpy")
+    split = normal_mode == "SPLIT"
+    assert calls == {"edges": int(split), "clamps": 2 * split}  # SPLIT: the split mesh's own table and levels, once
+    monkeypatch.undo()
+    plain = tessellate(mesh, uniform_levels(mesh, 3.0) + raw, inner, spacing="FRACTIONAL_EVEN", method=method,
+                       options=options, backend="numpy")
+    assert estimated.triangles == len(plain.mesh.triangles)
+    assert estimated.vertices == len(plain.mesh.positions) or split  # SPLIT opens edges: their points twice
+    assert carried.mesh.positions.tobytes() == plain.mesh.positions.tobytes()
+    assert carried.mesh.triangles.tobytes() == plain.mesh.triangles.tobytes()
+    with pytest.raises(InvalidInputError, match="These levels are for a mesh of"):
+        tessellate(MeshArrays(positions=mesh.positions[:-1], triangles=mesh.triangles[:-1]), levels)
