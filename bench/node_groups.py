@@ -221,7 +221,8 @@ def run(bpy, ob, groups, spec, method, level):
     for _ in range(REPEAT):
         mod = ob.modifiers.new(spec.name, "NODES")
         mod.node_group = groups.ensure_group(spec)
-        seconds, counts["group"] = evaluate(bpy, ob, mod, lambda m, lv=level: groups.set_inputs(m, {"Level": lv}))
+        seconds, counts["group"] = evaluate(bpy, ob, mod,
+                                            lambda m, lv=level: groups.set_inputs(m, {"Subdivisions": lv}))
         best["group"] = min(best["group"], seconds)
         ob.modifiers.remove(mod)
         mod = ob.modifiers.new("Subsurf", "SUBSURF")

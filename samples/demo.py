@@ -543,8 +543,8 @@ def build_node_groups_scene():
     image = bpy.data.images.new("Ridges", 129, 129, float_buffer=True, is_data=True)
     image.pixels.foreach_set(np.repeat(heights.ravel(), 4).astype(np.float32))
     stacks = [
-        (monkey, "Suzanne, smooth", [("Tessera PN Triangles", {"Level": 2})]),
-        (cylinder, "Cylinder, sharp rims", [("Tessera Phong", {"Level": 3, "Shape Factor": 1.0,
+        (monkey, "Suzanne, smooth", [("Tessera PN Triangles", {"Subdivisions": 2})]),
+        (cylinder, "Cylinder, sharp rims", [("Tessera Phong", {"Subdivisions": 3, "Shape Factor": 1.0,
                                                                "Sharp Edges": "Split"})]),
         (trefoil, "Trefoil curve", [("Tessera Tubes", {"Radius": 0.12, "Sides": 12, "Caps": "Round"})]),
         (terrain, "Height-map image", [("Tessera Terrain", {"Image": image, "Texel Size": 0.017,

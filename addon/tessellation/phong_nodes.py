@@ -16,7 +16,7 @@ from ..node_groups import Graph, GroupSpec, register_group
 from .surface_nodes import CORNER_NORMAL, set_shading, surface_interface
 
 GROUP_NAME = "Tessera Phong"
-VERSION = 5
+VERSION = 6
 
 
 def _build(tree):
@@ -34,7 +34,7 @@ def _build(tree):
     for name, field in zip(names, (diag, off, plane), strict=True):
         geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", name), ("Value", field)],
                           data_type="FLOAT_VECTOR", domain="POINT").outputs[0]
-    fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Level"])]).outputs[0]
+    fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Subdivisions"])]).outputs[0]
 
     def carried(name):  # the point values, interpolated by the subdivision with the same weights as positions
         return g.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type="FLOAT_VECTOR").outputs[0]

@@ -17,7 +17,7 @@ from ..node_groups import Graph, GroupSpec, register_group
 from .surface_nodes import CORNER_NORMAL, set_shading, surface_interface
 
 GROUP_NAME = "Tessera PN Triangles"
-VERSION = 4
+VERSION = 5
 _CONTROL = [f"tessera_pn_{i}" for i in range(10)]  # order of cubic_basis: P1 P2 P3 b210 b120 b021 b012 b102 b201 b111
 _NORMAL_CONTROL = [f"tessera_pn_n{i}" for i in range(6)]  # order of quadratic_basis: N1 N2 N3 n110 n011 n101
 _BARY = "tessera_pn_bary"
@@ -63,7 +63,7 @@ def _build(tree):
                       for i in range(3)))
     geometry = g.node("GeometryNodeStoreNamedAttribute", [(0, geometry), ("Name", _BARY), ("Value", one_hot)],
                       data_type="FLOAT_VECTOR", domain="CORNER").outputs[0]
-    fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Level"])]).outputs[0]
+    fine = g.node("GeometryNodeSubdivideMesh", [(0, geometry), (1, gi.outputs["Subdivisions"])]).outputs[0]
 
     def read(name):
         return g.node("GeometryNodeInputNamedAttribute", [(0, name)], data_type="FLOAT_VECTOR").outputs[0]

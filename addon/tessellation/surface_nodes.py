@@ -30,13 +30,15 @@ SHARP_EDGE_MODES = ("Watertight", "Split")
 
 
 def surface_interface(g, shape_default, shape_description):
-    """The sockets the curved-surface groups share (Geometry, Level, Shape Factor, Sharp Edges -> Geometry).
+    """The sockets the curved-surface groups share (Geometry, Subdivisions, Shape Factor, Sharp Edges -> Geometry).
+    Subdivisions counts Subdivide Mesh passes (each splits every edge in two), not the Tessellate operator's Level
+    (segments per edge), so the two keep different names.
     Returns ``(group input, group output, mesh, normal)``: the triangulated (and in Split mode split) mesh, and
     the field of each point's geometry normal on it."""
     tree = g.tree
     socket(tree, "Geometry", "NodeSocketGeometry", description="The mesh to tessellate (faces are triangulated)")
-    socket(tree, "Level", "NodeSocketInt", default=2, min_value=0, max_value=6,
-           description="Subdivision levels of every face (Subdivide Mesh)")
+    socket(tree, "Subdivisions", "NodeSocketInt", default=2, min_value=0, max_value=6,
+           description="Times every face is subdivided: each time splits every edge in two")
     socket(tree, "Shape Factor", "NodeSocketFloat", default=shape_default, min_value=0.0, max_value=1.0,
            subtype="FACTOR",
            description=shape_description)

@@ -62,3 +62,13 @@ def test_the_performance_summary_is_read_from_the_bench_tables_on_the_page():
     row = next(r for r in report.page_rows(page, "tessellation") if r["case"] == "operator_pn_smooth")
     ratio = float(row["baseline seconds"]) / float(row["seconds"])
     assert f"| {ratio:.2f}x faster |" in block or f"| {1 / ratio:.2f}x slower |" in block
+
+
+def test_the_changelog_starts_at_the_manifests_version():
+    """docs/changelog.md's newest heading is the version the manifest gives the extension, so a release cannot ship
+    without saying what changed."""
+    import tomllib
+
+    version = tomllib.loads((ROOT / "blender_manifest.toml").read_text(encoding="utf-8"))["version"]
+    headings = re.findall(r"(?m)^## (\d+\.\d+\.\d+)\b", (ROOT / "docs" / "changelog.md").read_text(encoding="utf-8"))
+    assert headings and headings[0] == version, (headings, version)

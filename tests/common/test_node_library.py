@@ -98,7 +98,7 @@ def test_node_group_add_puts_the_group_on_the_selection(clean_scene, bpy_module,
     assert tree.get("tessera_version") == addon_module("addon.tessellation.phong_nodes").VERSION
     assert tree.is_modifier
     descriptions = {i.name: i.description for i in tree.interface.items_tree if i.item_type == "SOCKET"}
-    assert all(descriptions.values()) and {"Level", "Shape Factor"} <= set(descriptions)
+    assert all(descriptions.values()) and {"Subdivisions", "Shape Factor"} <= set(descriptions)
     bpy.data.node_groups.remove(tree)
 
 
@@ -149,7 +149,7 @@ def farm_scene(bpy, addon_module):
     bpy.ops.object.camera_add(location=(-9, -9, 6))  # the terrain's levels follow the active camera
     bpy.context.scene.camera = bpy.context.active_object
     bpy.context.active_object.name = "Camera"
-    inputs = {"Phong": {"Level": 2}, "PN": {"Level": 2, "Sharp Edges": "Split"},
+    inputs = {"Phong": {"Subdivisions": 2}, "PN": {"Subdivisions": 2, "Sharp Edges": "Split"},
               "Tubes": {"Caps": "Round", "Sides": 6}, "Displace": {"Map": "Height", "Image": image,
                                                                    "Strength": 0.2},
               "Terrain": {"Image": heights, "Tile Size": 8, "Full-Detail Distance": 8.0, "Height Scale": 3.0}}
@@ -204,3 +204,24 @@ def test_a_file_using_every_group_evaluates_the_same_without_the_add_on(clean_sc
         tree = ng.ensure_group(spec)
         assert tree.nodes[0].label == "kept", spec.name
     assert {tree.name for tree in bpy.data.node_groups} == names
+
+
+def test_a_group_input_named_like_a_tessellate_setting_means_the_same(bpy_module, addon_module):
+    """One word, one meaning across the operator and the node groups: the groups' Subdivisions counts Subdivide Mesh
+    passes (each splits every edge in two), the operator's Level counts segments per edge, so no group input is
+    called Level; the inputs the two do share (Shape Factor, Sharp Edges) take the operator's meaning and slider."""
+    bpy = bpy_module
+    ng = addon_module("addon.node_groups")
+    op = {p.name: p for p in bpy.ops.tessera.tessellate.get_rna_type().properties}
+    for spec in ("tessellation.phong_nodes", "tessellation.pn_nodes"):
+        tree = ng.ensure_group(addon_module(f"addon.{spec}").SPEC)
+        try:
+            inputs = {i.name: i for i in tree.interface.items_tree if i.item_type == "SOCKET" and i.in_out == "INPUT"}
+            assert "Subdivisions" in inputs and "Level" not in inputs and "Level" in op
+            shared = set(inputs) & set(op)
+            assert shared <= {"Shape Factor", "Sharp Edges"}, shared
+            if "Shape Factor" in shared:
+                assert (inputs["Shape Factor"].min_value, inputs["Shape Factor"].max_value) == (
+                    op["Shape Factor"].soft_min, op["Shape Factor"].soft_max)  # the slider the operator shows
+        finally:
+            bpy.data.node_groups.remove(tree)
