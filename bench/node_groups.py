@@ -96,7 +96,7 @@ def run_terrain(bpy, groups, spec, synth):
     group_ob = bpy.data.objects.new("Terrain Group", bpy.data.meshes.new("Terrain Group"))
     bpy.context.scene.collection.objects.link(group_ob)
     inputs = {"Image": image, "Texel Size": TEXEL, "Height Scale": HEIGHT, "Tile Size": TILE,
-              "Full-Detail Distance": FULL_DETAIL}
+              "Detail Distance": FULL_DETAIL}
     bpy.ops.tessera.terrain_add(source="IMAGE", image_name=image.name, texel_size=TEXEL, height_scale=HEIGHT,
                                 tile_size=TILE, mode="DISTANCE", d_max=FULL_DETAIL, levels="POW2", culling=False)
     baked = bpy.context.active_object

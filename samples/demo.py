@@ -549,7 +549,7 @@ def build_node_groups_scene():
         (trefoil, "Trefoil curve", [("Tessera Tubes", {"Radius": 0.12, "Sides": 12, "Caps": "Round"})]),
         (terrain, "Height-map image", [("Tessera Terrain", {"Image": image, "Texel Size": 0.017,
                                                             "Height Scale": 0.9, "Tile Size": 16,
-                                                            "Full-Detail Distance": 9.0, "Material": clay})]),
+                                                            "Detail Distance": 9.0, "Material": clay})]),
     ]
     counts = []
     for ob, source, stack in stacks:

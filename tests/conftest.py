@@ -195,17 +195,19 @@ class Recorder:
     """A stand-in for `bpy.types.UILayout` that records the label of every property row (a heading prefixes the
     rows under it, and a box makes a section of its own, as Blender shows them) and accepts every other call."""
 
-    def __init__(self, rows, heading=""):
+    def __init__(self, rows, heading="", fields=None):
         self.rows, self.heading = rows, heading
+        self.fields = [] if fields is None else fields  # (label, property type) of every row, shared by children
         self.boxes = 0
 
     def prop(self, data, name, text=None, **_):
         label = text if text is not None else data.bl_rna.properties[name].name
         if label:
             self.rows.append(f"{self.heading}{label}")
+            self.fields.append((label, data.bl_rna.properties[name].type))
 
     def _child(self, heading=""):
-        return Recorder(self.rows, f"{self.heading}{heading}: " if heading else self.heading)
+        return Recorder(self.rows, f"{self.heading}{heading}: " if heading else self.heading, self.fields)
 
     def column(self, align=False, heading="", **_):
         return self._child(heading)
@@ -215,7 +217,7 @@ class Recorder:
 
     def box(self):
         self.boxes += 1
-        return Recorder(self.rows, f"{self.heading}box {self.boxes}: ")
+        return Recorder(self.rows, f"{self.heading}box {self.boxes}: ", self.fields)
 
     def split(self, **_):
         return self._child()

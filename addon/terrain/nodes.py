@@ -32,7 +32,7 @@ from ...kernels.common.partition import MAX_LEVEL  # the largest level: quads a 
 from ..node_groups import Graph, GroupSpec, register_group, socket
 
 GROUP_NAME = "Tessera Terrain"
-VERSION = 2
+VERSION = 3
 _TILE = ("tessera_x0", "tessera_y0", "tessera_wx", "tessera_wy", "tessera_r", "tessera_bottom", "tessera_right",
          "tessera_top", "tessera_left")
 _BORDER = "tessera_border"
@@ -53,7 +53,7 @@ def _interface(tree):
                        "Bake Terrain); Uniform: Max Level everywhere")
     socket(tree, "Max Level", "NodeSocketInt", default=MAX_LEVEL, min_value=1, max_value=MAX_LEVEL,
            description="Quads per tile side at most (capped by the tile size)")
-    socket(tree, "Full-Detail Distance", "NodeSocketFloat", default=100.0, min_value=1e-6, subtype="DISTANCE",
+    socket(tree, "Detail Distance", "NodeSocketFloat", default=100.0, min_value=1e-6, subtype="DISTANCE",
            description="Distance from the camera within which tiles get Max Level; beyond, the level falls with "
                        "the square of the distance")
     socket(tree, "UV Map", "NodeSocketString", default="UVMap", description="Name of the UVs (X/(W-1), Y/(H-1))")
@@ -101,7 +101,7 @@ class _Terrain:
         g = self.g
         top = self.top_level()
         d = g.vec("DISTANCE", self.world(x, y, self.sample(x, y)), eye, out=1)
-        d_max = self.inp("Full-Detail Distance")
+        d_max = self.inp("Detail Distance")
         law = g.math("DIVIDE", g.math("MULTIPLY", top, g.math("MULTIPLY", d_max, d_max)), g.math("MULTIPLY", d, d))
         far = g.math("MINIMUM", g.math("MAXIMUM", law, 1.0), top)
         t = g.switch("FLOAT", g.math("LESS_THAN", d_max, d), top, far)  # d <= d_max: T_max

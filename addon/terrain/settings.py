@@ -89,18 +89,18 @@ class TerrainOptions:
                                      description="Texels per tile side (64: one quad per texel at the most detail)")
     mode: bpy.props.EnumProperty(name="Level Mode", items=MODE_ITEMS, default="OURS",
                                  description="What decides how much detail each tile gets")
-    g: bpy.props.EnumProperty(name="Roughness Curve", items=G_ITEMS, default="SQRT",
+    g: bpy.props.EnumProperty(name="Detail Curve", items=G_ITEMS, default="SQRT",
                               description="How a tile's most detail grows with its roughness (how sharply its slope "
                                           "changes)")
-    ham_scale: bpy.props.FloatProperty(name="Roughness Scale", default=4.0, min=1e-3, max=MAX_FACTOR, soft_max=64.0,
-                                       description="How much detail roughness buys (a factor in the Roughness Curve)")
+    ham_scale: bpy.props.FloatProperty(name="Detail Scale", default=4.0, min=1e-3, max=MAX_FACTOR, soft_max=64.0,
+                                       description="How much detail roughness buys (a factor in the Detail Curve)")
     epsilon: bpy.props.FloatProperty(name="Screen Error", default=3.0, min=0.05, max=MAX_PIXELS, soft_max=32.0,
                                      subtype="PIXEL",
                                      description="Largest error allowed on screen: how far a tile's peak may be drawn "
                                                  "from its true height")
     t_min_rule: bpy.props.EnumProperty(name="Error Rule", items=T_MIN_ITEMS, default="SEARCH",
                                        description="How the least detail that keeps the Screen Error is found")
-    d_max: bpy.props.FloatProperty(name="Full-Detail Distance", default=0.0, min=0.0, max=MAX_WORLD_VALUE,
+    d_max: bpy.props.FloatProperty(name="Detail Distance", default=0.0, min=0.0, max=MAX_WORLD_VALUE,
                                    soft_max=10000.0, subtype="DISTANCE", unit="LENGTH",
                                    description="Closer than this, tiles get their most detail (0: where a texel "
                                    "spans 4 pixels)")

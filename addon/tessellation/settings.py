@@ -76,7 +76,7 @@ class TessellateOptions:
     level: bpy.props.FloatProperty(
         name="Level", description="Segments per edge (and inner level) for every triangle",
         default=3.0, min=1.0, max=float(MAX_LEVEL), soft_max=16.0, step=100, precision=2)
-    spacing: bpy.props.EnumProperty(name="Segment Spacing", items=SPACING_ITEMS, default="EQUAL",
+    spacing: bpy.props.EnumProperty(name="Segments", items=SPACING_ITEMS, default="EQUAL",
                                     description="How a fractional level splits an edge")
     alpha: bpy.props.FloatProperty(
         name="Shape Factor", description="How far the surface bulges toward the normals: 0 flat, 1 fully rounded",

@@ -1,5 +1,6 @@
-"""No sidebar panel shows two rows with the same label in one section (Tubes once had two called "Sides"): every
-panel is drawn into a layout that records its rows, for an object of each kind."""
+"""No sidebar panel shows two rows with the same label in one section (Tubes once had two called "Sides"), and no
+label is cut short at Blender's default sidebar width ("Segment Spac..."): every panel is drawn into a layout that
+records its rows, for an object of each kind."""
 
 from types import SimpleNamespace
 
@@ -10,20 +11,33 @@ from conftest import Recorder
 pytestmark = pytest.mark.blender
 
 
+#: The widest label the sidebar's label column shows whole at its default width and UI scale 1, in pixels of
+#: Blender's interface font at 11 px (measured in the real window: "Angle Tolerance", 86 px, fits; "Segment Spacing",
+#: 93 px, is cut to "Segment Spac...").
+LABEL_COLUMN_PX = 88
+
+
 def _drawn(bpy, addon_module):
-    """{panel bl_idname: the labels of its rows} for the panels the active object gets."""
+    """{panel bl_idname: the labels of its rows} for the panels the active object gets; the labels of the rows that
+    are not check boxes (a check box's label stands in the wider value column) are checked against the label
+    column's width."""
+    import blf
+
     sidebar = addon_module("addon.sidebar")
     out = {}
     for idname in sidebar.PANEL_ORDER:
         panel = getattr(bpy.types, idname, None)
         if panel is None or not panel.poll(bpy.context):
             continue
-        rows = []
+        rows, fields = [], []
         context = SimpleNamespace(**{k: getattr(bpy.context, k) for k in ("view_layer", "scene", "active_object",
                                                                           "preferences", "window_manager")},
                                   space_data=None, region=SimpleNamespace(width=240))
-        panel.draw(SimpleNamespace(layout=Recorder(rows)), context)
+        panel.draw(SimpleNamespace(layout=Recorder(rows, fields=fields)), context)
         out[idname] = rows
+        blf.size(0, 11)
+        cut = [label for label, kind in fields if kind != "BOOLEAN" and blf.dimensions(0, label)[0] > LABEL_COLUMN_PX]
+        assert not cut, f"{idname}: labels cut short in the sidebar: {cut}"
     return out
 
 

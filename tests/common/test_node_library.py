@@ -152,7 +152,7 @@ def farm_scene(bpy, addon_module):
     inputs = {"Phong": {"Subdivisions": 2}, "PN": {"Subdivisions": 2, "Sharp Edges": "Split"},
               "Tubes": {"Caps": "Round", "Sides": 6}, "Displace": {"Map": "Height", "Image": image,
                                                                    "Strength": 0.2},
-              "Terrain": {"Image": heights, "Tile Size": 8, "Full-Detail Distance": 8.0, "Height Scale": 3.0}}
+              "Terrain": {"Image": heights, "Tile Size": 8, "Detail Distance": 8.0, "Height Scale": 3.0}}
     for name, spec in (("Phong", "tessera.phong_nodes"), ("PN", "tessera.pn_nodes"), ("Tubes", "tubes.nodes"),
                        ("Displace", "displacement.nodes"), ("Terrain", "terrain.nodes")):
         ob = bpy.data.objects[name]

@@ -94,7 +94,7 @@ def test_levels_heights_and_welding_equal_the_kernel(clean_scene, bpy_module, ad
     image = height_image(bpy, samples)
     ob, _ = terrain_object(bpy, addon_module, image, **{
         "Texel Size": texel, "Height Scale": scale, "Tile Size": tile_size, "Max Level": max_level,
-        "Full-Detail Distance": d_max, "Level Mode": mode.title()})
+        "Detail Distance": d_max, "Level Mode": mode.title()})
     pos, verts, starts, edges, me = evaluated(bpy, ob)
     table, sel = kernel_selection(addon_module, hm, tile_size, mode, max_level, d_max, eye)
     if mode == "DISTANCE":  # the camera sees near and far tiles: several levels to agree on
