@@ -166,6 +166,18 @@ def guarded(execute):
     return wrapper
 
 
+def targets(context, wanted):
+    """The objects an operator on the active object acts on (see `each_selected`): the active one, then the other
+    selected objects ``wanted(ob)`` accepts, in selection order; the active one alone when it is not selected (a script
+    that only set it active) or when it is not wanted but nothing else is."""
+    active = context.active_object
+    if active is not None and not active.select_get():
+        return [active]
+    out = [active] if active is not None and wanted(active) else []
+    out += [ob for ob in context.selected_objects if ob is not active and wanted(ob)]
+    return out or ([active] if active is not None else [])
+
+
 def each_selected(wanted):
     """Make ``execute(self, context, tx)`` of an operator on the active object act on every selected object that
     ``wanted(ob)`` accepts, as Blender's own object operators do: once per object (the active one first, then the
@@ -177,15 +189,11 @@ def each_selected(wanted):
     def decorate(execute):
         @functools.wraps(execute)
         def wrapper(self, context, tx):
-            active = context.active_object
-            if active is not None and not active.select_get():
-                return execute(self, context, tx)
-            targets = [active] if active is not None and wanted(active) else []
-            targets += [ob for ob in context.selected_objects if ob is not active and wanted(ob)]
-            if len(targets) <= 1:
+            acted_on = targets(context, wanted)
+            if len(acted_on) <= 1:
                 return execute(self, context, tx)
             results = []
-            for ob in targets:
+            for ob in acted_on:
                 with context.temp_override(active_object=ob, object=ob, selected_objects=[ob],
                                            selected_editable_objects=[ob]):
                     result = execute(self, bpy.context, tx)

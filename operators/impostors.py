@@ -26,6 +26,8 @@ from ..kernels.common.errors import TesseraError
 from .render_job import RenderJobOperator
 from .selection import object_poll, select_only
 
+#: The object types a card can be baked of (what Cycles renders as geometry).
+_BAKEABLE = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
 #: The last views rendered (before dilation), by what their render depended on: the redo panel reuses them.
 _last = {"key": None, "rendered": None, "what": None, "device": ""}
 
@@ -40,7 +42,7 @@ def _object(what):
 
 
 class TESSERA_OT_impostor_bake(RenderJobOperator, bpy.types.Operator):
-    """Render the active object from many directions with Cycles onto a camera-facing card that stands in for it"""
+    """Render each selected object from many directions with Cycles onto a camera-facing card that stands in for it"""
 
     bl_idname = "tessera.impostor_bake"
     bl_label = "Bake Impostor"
@@ -69,8 +71,11 @@ class TESSERA_OT_impostor_bake(RenderJobOperator, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return object_poll(cls, context, {"MESH", "CURVE", "SURFACE", "META", "FONT"},
-                           "Select an object with geometry in Object Mode")
+        return object_poll(cls, context, _BAKEABLE, "Select an object with geometry in Object Mode")
+
+    @staticmethod
+    def _wanted(ob):
+        return ob.type in _BAKEABLE
 
     def _render_key(self, context):
         """What the views depend on (`render_jobs.render_key`) and the settings that change the render (Blend Views

@@ -6,13 +6,17 @@ show how far it is and on which device, Esc stops it and leaves nothing). When t
 `_prepare` run on a worker thread, then `_make_steps` makes the data one step per timer tick, all in one
 `Transaction`. Scripts, ``blender -b`` and the redo panel call `execute`, which runs to the end with progress lines and
 renders again only when something the render depends on changed (`_render_key`): otherwise the last render is reused.
+
+Both act on every selected object the bake takes (`_wanted`), as Blender's own object operators do (`each_selected`):
+the active one first, then the others, one render after another, each seeing its object as the active one; all in one
+`Transaction`, so Esc or a failure on any of them leaves nothing of the others.
 """
 
 import time
 
 import bpy
 
-from ..addon.guarded import Transaction, check_numbers, guarded, guarded_step, run_to_end
+from ..addon.guarded import Transaction, check_numbers, each_selected, guarded, guarded_step, run_to_end, targets
 from ..kernels.common import workers
 
 #: Renders at most this large are kept for the redo panel.
@@ -32,11 +36,16 @@ class RenderJobOperator:
     - ``_prepare(rendered, what, *settings)`` (static): what `_make_steps` makes the data from (a worker thread too);
     - ``_make_steps(context, tx, prepared, what, device)``: a generator making the data, one short step per yield;
       returns the operator's result (``self._t0``: when the bake started).
-    ``_check(context)`` (optional) runs before a kept render is reused.
+    ``_check(context)`` (optional) runs before a kept render is reused; ``_wanted(ob)`` (static) says which selected
+    objects the bake takes.
     """
 
     job_label = "Rendering"
     cancelled = "Cancelled: nothing was changed"
+
+    @staticmethod
+    def _wanted(ob):
+        return ob.type == "MESH"
 
     def _check(self, context):
         check_numbers(self)
@@ -45,11 +54,13 @@ class RenderJobOperator:
         """The status bar's words while the worker renders."""
         device = job.device()
         on = f" on {device}" if device else ""
+        label = self.job_label
+        if len(self._targets) > 1:
+            label += f" ({self._target + 1} of {len(self._targets)} objects, {self._targets[self._target].name})"
         if job.total > 1:
             view = min(int(job.fraction()) + 1, job.total)
-            return (f"{self.job_label}: {view} of {job.total} ({100.0 * job.fraction() / job.total:.0f}%){on} — "
-                    "Esc to cancel")
-        return f"{self.job_label}{on} — Esc to cancel"
+            return f"{label}: {view} of {job.total} ({100.0 * job.fraction() / job.total:.0f}%){on} — Esc to cancel"
+        return f"{label}{on} — Esc to cancel"
 
     @staticmethod
     def _render_bytes(rendered):
@@ -66,7 +77,7 @@ class RenderJobOperator:
         """In the UI: start the worker and follow it from a timer (the UI never waits); elsewhere: `execute`."""
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        result = self._begin(context)
+        result = self._begin_all(context)
         if self._job is None:
             return result
         wm = context.window_manager
@@ -85,6 +96,19 @@ class RenderJobOperator:
         self._job, self._what = self._start(context)
         return {"FINISHED"}
 
+    def _begin_all(self, context):
+        """The objects to bake (`addon.guarded.targets`), one transaction for all of them, and the first one's worker
+        started (``self._job``; None when refused, and the refusal reported)."""
+        self._targets, self._target, self._made = targets(context, self._wanted), 0, []
+        self._tx = Transaction()  # every object's data: Esc or a failure removes all of it
+        return self._begin_target(context)
+
+    def _begin_target(self, context):
+        """`_begin` on the current target, seen as the active and only selected object."""
+        ob = self._targets[self._target]
+        with context.temp_override(active_object=ob, object=ob, selected_objects=[ob], selected_editable_objects=[ob]):
+            return self._begin(bpy.context)
+
     def _end(self, context):
         wm = context.window_manager
         wm.event_timer_remove(self._timer)
@@ -94,8 +118,7 @@ class RenderJobOperator:
     def modal(self, context, event):
         if event.type == "ESC":
             self._job.job.cancel()
-            if self._making is not None:
-                self._tx.rollback()  # what was made so far
+            self._tx.rollback()  # what was made so far, of every object
             self._end(context)
             self.report({"WARNING"}, self.cancelled)
             return {"CANCELLED"}
@@ -121,12 +144,24 @@ class RenderJobOperator:
         if not self._reading.done():
             return {"RUNNING_MODAL"}
         if self._making is None:  # then the data, one step per tick
-            self._tx = Transaction()
             self._making = self._finish_steps(context)
         result = guarded_step(self, self._tx, self._making)
         if result is None:
             return {"RUNNING_MODAL"}
+        if "FINISHED" in result and self._target + 1 < len(self._targets):  # the next object's render
+            self._made.append(context.view_layer.objects.active)
+            self._target += 1
+            self._reading = self._making = None
+            if "FINISHED" in self._begin_target(context):
+                context.workspace.status_text_set(self._status_text(self._job.job))
+                return {"RUNNING_MODAL"}
+            self._tx.rollback()  # refused (and reported): nothing of the others either
+            result = {"CANCELLED"}
         self._end(context)
+        if "FINISHED" in result:
+            for ob in self._made:  # every result selected, the last one active (as each run leaves its own)
+                if ob is not None and ob.name in context.view_layer.objects:
+                    ob.select_set(True)
         return result
 
     def _finish_steps(self, context):
@@ -136,8 +171,11 @@ class RenderJobOperator:
 
     @guarded
     def execute(self, context, tx):
-        """Scripts, ``blender -b`` and the redo panel: to the end, with progress lines; the last render is reused when
-        nothing it depends on changed."""
+        """Scripts, ``blender -b`` and the redo panel: every selected object the bake takes, each to the end, with
+        progress lines; the last render is reused when nothing it depends on changed."""
+        return each_selected(self._wanted)(type(self)._execute_one)(self, context, tx)
+
+    def _execute_one(self, context, tx):
         self._t0 = time.perf_counter()
         key = self._render_key(context)
         last = self._last

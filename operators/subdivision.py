@@ -112,7 +112,7 @@ _last = {"key": None, "rendered": None, "what": None, "device": ""}
 
 
 class TESSERA_OT_bake_lighting_hce(RenderJobOperator, bpy.types.Operator):
-    """Bake the active mesh's light with Cycles and store it on the mesh, so Loop Subdivide shows it at any level"""
+    """Bake each selected mesh's light with Cycles and store it on the mesh, so Loop Subdivide shows it at any level"""
 
     bl_idname = "tessera.bake_lighting_hce"
     bl_label = "Bake Lighting"

@@ -64,7 +64,9 @@ class UiOperator:
     def report(self, kind, text):
         self.reports.append((set(kind), text))
 
-    def drive(self, context, escape_after=None, timeout=300):
+    def drive(self, context, escape_after=None, timeout=300, until=None):
+        """Timer events (Esc after ``escape_after`` ticks) until the operator ends: its result; or None as soon as
+        ``until()`` is true."""
         class UI:  # the real context, with a window's status bar and timers that need no window
             window_manager = type("WM", (), {"event_timer_remove": staticmethod(lambda t: None),
                                              "progress_update": staticmethod(lambda v: None),
@@ -77,6 +79,8 @@ class UiOperator:
         ui = UI()
         start, ticks = time.monotonic(), 0
         while time.monotonic() - start < timeout:
+            if until is not None and until():
+                return None
             ticks += 1
             kind = "ESC" if escape_after is not None and ticks > escape_after else "TIMER"
             result = self.modal(ui, type("Event", (), {"type": kind})())

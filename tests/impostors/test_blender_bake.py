@@ -176,3 +176,24 @@ def test_the_card_exports_to_gltf_with_its_atlas_and_layout(clean_scene, bpy_mod
         bpy.ops.tessera.impostor_export(filepath=str(tmp_path / "missing" / "card.glb"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["card.glb"]
     assert set(bpy.data.objects) == objects and set(bpy.data.meshes) == meshes
+
+
+def test_bake_impostor_makes_a_card_for_every_selected_object(clean_scene, bpy_module):
+    """As Blender's own object operators: a card for each selected object with geometry (the active one first), the
+    cards selected afterwards; a selected camera is left alone."""
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add(size=1.0)
+    cube = bpy.context.active_object
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(2, 0, 0))
+    sphere = bpy.context.active_object
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    for ob in (cube, sphere, cam):
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = cube
+    assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=1) == {"FINISHED"}
+    cards = sorted(o.name for o in bpy.data.objects if o.name.endswith(" impostor"))
+    assert cards == ["Cube impostor", "Sphere impostor"]
+    selected = {o.name for o in bpy.context.selected_objects}
+    assert set(cards) <= selected and not {"Cube", "Sphere"} & selected
+    assert bpy.context.view_layer.objects.active.name in cards

@@ -265,7 +265,7 @@ def test_the_ui_path_of_the_impostor_bake_makes_the_card_of_the_script_path(clea
         bpy.data.images.remove(image)
     box = _box(bpy)
     op = UiOperator(bpy, "tessera.impostor_bake", grid=2, tile=16, samples=2, dilation=2)
-    op._begin(bpy.context)
+    op._begin_all(bpy.context)
     assert op.drive(bpy.context) == {"FINISHED"}
     card = bpy.context.active_object
     assert card.name == "Cube impostor" and any("2x2 views of 16px" in text for _, text in op.reports)
@@ -277,6 +277,39 @@ def test_the_ui_path_of_the_impostor_bake_makes_the_card_of_the_script_path(clea
     bpy.context.view_layer.objects.active = box
     assert bpy.ops.tessera.impostor_bake(grid=2, tile=16, samples=2, dilation=2) == {"FINISHED"}  # the kept views
     assert np.array_equal(np.array(bpy.data.images["Cube impostor colour"].pixels[:]), ui_colour)
+    assert not addon_module("addon.render_jobs").open_folders()
+
+
+def test_the_ui_path_bakes_every_selected_object_in_turn_and_esc_undoes_all(clean_scene, bpy_module, addon_module):
+    """In the UI the bake renders the selected objects one after another, the status bar saying which; Esc during the
+    second removes the first one's card too (one transaction), and no job folder is left."""
+    bpy = bpy_module
+    bpy.ops.mesh.primitive_cube_add(size=1.0)
+    cube = bpy.context.active_object
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(2, 0, 0), segments=8, ring_count=4)
+    sphere = bpy.context.active_object
+    cube.select_set(True)
+    bpy.context.view_layer.objects.active = cube
+    op = UiOperator(bpy, "tessera.impostor_bake", grid=2, tile=16, samples=1)
+    assert op._begin_all(bpy.context) == {"FINISHED"}
+    assert [o.name for o in op._targets] == ["Cube", "Sphere"]
+    assert "(1 of 2 objects, Cube)" in op._status_text(op._job.job)
+    assert op.drive(bpy.context) == {"FINISHED"}
+    cards = sorted(o.name for o in bpy.data.objects if o.name.endswith(" impostor"))
+    assert cards == ["Cube impostor", "Sphere impostor"]
+    assert {o.name for o in bpy.context.selected_objects} >= set(cards)
+    for name in cards:
+        bpy.data.objects.remove(bpy.data.objects[name])
+    n_images, n_objects = len(bpy.data.images), len(bpy.data.objects)
+    for ob in (cube, sphere):
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = cube
+    op = UiOperator(bpy, "tessera.impostor_bake", grid=2, tile=16, samples=64)  # the second render takes a while
+    assert op._begin_all(bpy.context) == {"FINISHED"}
+    assert op.drive(bpy.context, until=lambda: op._target == 1) is None  # the first card made, the second rendering
+    assert len(bpy.data.objects) == n_objects + 1
+    assert op.drive(bpy.context, escape_after=0) == {"CANCELLED"}
+    assert (len(bpy.data.images), len(bpy.data.objects)) == (n_images, n_objects)
     assert not addon_module("addon.render_jobs").open_folders()
 
 

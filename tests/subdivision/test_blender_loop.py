@@ -251,14 +251,14 @@ def test_the_ui_path_of_the_lighting_bake_stores_the_bake_or_cancels_cleanly(cle
     del ob.data["tessera_hce"]
     op = UiOperator(bpy, "tessera.bake_lighting_hce", depth=1, samples=2)
     op._job, op._encoding = None, None
-    assert op._begin(bpy.context) == {"FINISHED"} and op._job is not None
+    assert op._begin_all(bpy.context) == {"FINISHED"} and op._job is not None
     assert op.drive(bpy.context) == {"FINISHED"}
     assert bytes(ob.data["tessera_hce"]) == want  # the same Cycles bake, encoded on a thread
     assert any("Baked lighting on CPU" in text for _, text in op.reports)
     del ob.data["tessera_hce"]
     op = UiOperator(bpy, "tessera.bake_lighting_hce", depth=2, samples=4096)
     op._job, op._encoding = None, None
-    op._begin(bpy.context)
+    op._begin_all(bpy.context)
     assert op.drive(bpy.context, escape_after=2) == {"CANCELLED"}
     assert op._job.job.process.poll() is not None and not os.path.exists(op._job.job.folder)
     assert "tessera_hce" not in ob.data and not addon_module("addon.render_jobs").open_folders()
@@ -292,3 +292,27 @@ def test_the_redo_panel_bakes_again_only_when_the_render_changes(clean_scene, bp
     arrays, _ = addon_module("addon.bridge").read_mesh(ob.data)
     assert len(ob.data["tessera_hce"]) > 1000
     assert len(hce.unpack_container(ob.data["tessera_hce"], arrays.triangles).node_start) == len(arrays.triangles) + 1
+
+
+def test_bake_lighting_bakes_every_selected_mesh(clean_scene, bpy_module, addon_module):
+    """As Blender's own object operators: every selected mesh gets its light (the active one first); a selected
+    light is not a mesh and is left alone; a mesh that cannot be baked fails the run and leaves the others as they
+    were (one transaction)."""
+    bpy = bpy_module
+    ob = lit_scene(bpy, addon_module("addon.compat"))
+    bpy.ops.mesh.primitive_cube_add(size=0.6, location=(0.8, 0.8, 0))
+    cube = bpy.context.active_object
+    light = next(o for o in bpy.data.objects if o.type == "LIGHT")
+    for o in (ob, light, cube):
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    assert bpy.ops.tessera.bake_lighting_hce(depth=1, samples=1) == {"FINISHED"}
+    assert "tessera_hce" in ob.data and "tessera_hce" in cube.data
+    del ob.data["tessera_hce"], cube.data["tessera_hce"]
+    empty = bpy.data.objects.new("No Faces", bpy.data.meshes.new("No Faces"))
+    bpy.context.scene.collection.objects.link(empty)
+    empty.select_set(True)
+    bpy.context.view_layer.objects.active = ob  # baked first, then undone when the empty mesh is refused
+    with pytest.raises(RuntimeError, match="No Faces|no faces"):
+        bpy.ops.tessera.bake_lighting_hce(depth=1, samples=1)
+    assert "tessera_hce" not in ob.data and "tessera_hce" not in cube.data
