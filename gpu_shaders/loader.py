@@ -94,18 +94,19 @@ def batch(key, build):
 
 def pattern_batch(key, shader, make, wireframe=False):
     """The `batch` of a refinement pattern drawn instanced, cached under ``key`` and ``wireframe``: ``make()`` gives
-    ``(vertex attributes {name: (V, k) array}, triangles (T, 3) int32)``; drawn as its triangles, or with
-    ``wireframe`` as each of its edges once (lines)."""
+    ``(vertex attributes {name: (V, k) array}, triangles (T, 3) int32)`` and optionally the edges (K, 2) int32 the
+    applied mesh has (a pattern of quads: not their diagonals); drawn as its triangles, or with ``wireframe`` as those
+    edges (by default every edge of the triangles once), as lines."""
 
     def build():
         from gpu_extras.batch import batch_for_shader
 
         from ..kernels.common.topology import triangle_edges
 
-        attributes, triangles = make()
+        attributes, triangles, *edges = make()
         if wireframe:
-            return batch_for_shader(shader, "LINES", attributes,
-                                    indices=triangle_edges(np.asarray(triangles, np.int32))[0])
+            lines = edges[0] if edges else triangle_edges(np.asarray(triangles, np.int32))[0]
+            return batch_for_shader(shader, "LINES", attributes, indices=np.asarray(lines, np.int32))
         return batch_for_shader(shader, "TRIS", attributes, indices=np.asarray(triangles, np.int32))
 
     return batch((*key, "wire" if wireframe else "tris"), build)

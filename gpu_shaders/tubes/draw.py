@@ -66,19 +66,24 @@ def section_order(lines):
     return np.insert(idx, where, extra)
 
 
+def ring_pattern(n):
+    """The ring pattern with ``n`` sides: vertex attributes {"ij": (64 n, 2) float32: section and side}, its 63 x n
+    quads as triangles (126 n, 3) int32, and the quads' edges (127 n, 2) int32: each section's ring and the lines from
+    one section to the next, as the tube mesh has them (no diagonals)."""
+    k, j = np.meshgrid(np.arange(SECTIONS_PER_PATCH), np.arange(n), indexing="ij")
+    ij = np.stack((k, j), axis=-1).reshape(-1, 2).astype(np.float32)
+    a = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + np.arange(n)[None, :]).ravel()
+    a1 = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + (np.arange(n)[None, :] + 1) % n).ravel()
+    tris = np.concatenate((np.stack((a, a1, a1 + n), 1), np.stack((a, a1 + n, a + n), 1))).astype(np.int32)
+    every = np.arange(SECTIONS_PER_PATCH * n)
+    rings = np.stack((every, every - every % n + (every + 1) % n), 1)
+    along = np.stack((a, a + n), 1)
+    return {"ij": ij}, tris, np.concatenate((rings, along)).astype(np.int32)
+
+
 def pattern_batch(shader, n, wireframe=False):
-    """Instanced ring pattern with ``n`` sides: 64 x n vertices (ij), 63 x n quads as triangles, or their edges
-    (cached)."""
-
-    def make():
-        k, j = np.meshgrid(np.arange(SECTIONS_PER_PATCH), np.arange(n), indexing="ij")
-        ij = np.stack((k, j), axis=-1).reshape(-1, 2).astype(np.float32)
-        a = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + np.arange(n)[None, :]).ravel()
-        a1 = (np.arange(SECTIONS_PER_PATCH - 1)[:, None] * n + (np.arange(n)[None, :] + 1) % n).ravel()
-        tris = np.concatenate((np.stack((a, a1, a1 + n), 1), np.stack((a, a1 + n, a + n), 1))).astype(np.int32)
-        return {"ij": ij}, tris
-
-    return loader.pattern_batch(("tubes", n), shader, make, wireframe)
+    """Instanced `ring_pattern` with ``n`` sides: its triangles, or with ``wireframe`` its quads' edges (cached)."""
+    return loader.pattern_batch(("tubes", n), shader, lambda: ring_pattern(n), wireframe)
 
 
 class TubeDrawData:

@@ -101,3 +101,20 @@ def test_preview_cache_refreshes_only_on_change(gpu_renderer, addon_module, clea
     ob.tessera.tubes.preview = False
     bpy.data.curves.remove(ob.data)
     preview.PREVIEW.cache.clear()
+
+
+@pytest.mark.parametrize("n", [3, 8])
+def test_the_preview_wire_is_the_tube_mesh_s_quads_not_their_diagonals(addon_module, n):
+    """In Wireframe the preview draws the edges the applied tube mesh has: every side of every quad once (each
+    section's ring, each line along the tube), none of the diagonals that split the quads into triangles."""
+    draw = addon_module("gpu_shaders.tubes.draw")
+    _, tris, edges = draw.ring_pattern(n)
+    drawn = {tuple(sorted(e)) for e in edges.tolist()}
+    assert len(drawn) == len(edges)  # each once
+    quads = tris[: len(tris) // 2]  # (a, a1, a1 + n): a quad's first triangle; the quad is a, a1, a1 + n, a + n
+    a, a1 = quads[:, 0], quads[:, 1]
+    sides = {tuple(sorted(e)) for e in np.concatenate([np.stack(p, 1) for p in (
+        (a, a1), (a1, a1 + n), (a + n, a1 + n), (a, a + n))]).tolist()}
+    diagonals = {tuple(sorted(e)) for e in np.stack((a, a1 + n), 1).tolist()}
+    assert sides <= drawn and not diagonals & drawn
+    assert drawn - sides == set()  # and nothing else: the last section's ring is a quad side too
