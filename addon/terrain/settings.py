@@ -176,8 +176,7 @@ def draw_terrain_settings(layout, s, show_source=True):
     col.prop(s, "mode")
     if s.mode == "OURS":
         col.prop(s, "g")
-        col.prop(s, "ham_scale")
-        col.prop(s, "t_min_rule")
+        col.prop(s, "ham_scale")  # t_min_rule (the Error Rule) is for scripts: research comparisons, not artists
     col.prop(s, "epsilon")
     col.prop(s, "d_max")
     col.prop(s, "levels")
