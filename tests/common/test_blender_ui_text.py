@@ -270,3 +270,33 @@ def test_the_sidebar_tab_is_always_there(bpy_module, addon, clean_scene):
     assert "TESSERA_PT_tessellation" in shown() and start.__name__ not in shown()
     bpy.ops.object.camera_add()  # an object no Tessera panel is for: the tab stays, with the start panel
     assert shown() == {"TESSERA_PT_start"}
+
+
+def _documented_settings():
+    """(page, name, name without a parenthesis) of every setting the manual's option tables name (first column of a
+    table headed "option" or "setting"; "A, B" names two)."""
+    out = []
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        in_table = False
+        for line in page.read_text(encoding="utf-8").splitlines():
+            if re.match(r"\| (option|setting) \|", line):
+                in_table = True
+                continue
+            if not line.startswith("|"):
+                in_table = False
+            elif in_table and not line.startswith("|---"):
+                for part in re.split(r",| and ", line.split("|")[1]):
+                    name = part.strip().strip("*").strip()
+                    if name:  # "Levels (0–6)": the label, or the label with its unit ("Memory Budget (MiB)")
+                        out.append((page.name, name, re.sub(r"\s*\([^)]*\)", "", name)))
+    return out
+
+
+def test_every_setting_the_manual_names_exists(properties):
+    """A page's option table names settings by their labels; each is the label of a setting Tessera registers (a
+    renamed label fails here until the page follows)."""
+    labels = {p.name for _, p in properties}
+    named = _documented_settings()
+    assert len(named) > 60
+    missing = sorted({f"{page}: {name}" for page, name, bare in named if name not in labels and bare not in labels})
+    assert not missing, missing
