@@ -54,6 +54,7 @@ def _create_context():
     registered = not hasattr(bpy.types, _ENGINE_ID)
     if registered:
         bpy.utils.register_class(_ContextEngine)
+    results = {im.name for im in bpy.data.images if im.type == "RENDER_RESULT"}
     scene = bpy.data.scenes.new("__tessera_gpu_context")
     cam_data = bpy.data.cameras.new("__tessera_gpu_context")
     cam = bpy.data.objects.new("__tessera_gpu_context", cam_data)
@@ -69,5 +70,7 @@ def _create_context():
         bpy.data.objects.remove(cam)
         bpy.data.cameras.remove(cam_data)
         bpy.data.scenes.remove(scene)
+        for im in [im for im in bpy.data.images if im.type == "RENDER_RESULT" and im.name not in results]:
+            bpy.data.images.remove(im)  # the render made one: the context leaves nothing behind
         if registered:
             bpy.utils.unregister_class(_ContextEngine)

@@ -124,7 +124,8 @@ def clean_scene(bpy_module, addon):
         for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.materials, bpy.data.cameras,
                            bpy.data.images):
             for item in list(collection):
-                collection.remove(item)
+                if getattr(item, "type", "IMAGE") == "IMAGE" or collection is not bpy.data.images:
+                    collection.remove(item)  # Blender's own Render Result stays (it comes back by itself)
 
     wipe()
     yield bpy.context.scene
