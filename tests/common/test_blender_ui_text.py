@@ -300,3 +300,14 @@ def test_every_setting_the_manual_names_exists(properties):
     assert len(named) > 60
     missing = sorted({f"{page}: {name}" for page, name, bare in named if name not in labels and bare not in labels})
     assert not missing, missing
+
+
+def test_the_readme_names_exactly_the_tools_the_command_line_runs(bpy_module, addon):
+    """The README's command-line quick start lists the tools that are verbs; the list is the registry's, by the
+    labels the menus show (no claim that every tool is one)."""
+    verbs = importlib.import_module(f"{ADDON_MODULE}.addon.command_line.verbs").VERBS
+    labels = {getattr(bpy_module.types, getattr(bpy_module.ops.tessera, v.operator.split(".")[1]).idname()).bl_label
+              for v in verbs.values()}
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    sentence = re.search(r"The tools that turn files into files are also verbs of.*?Files in", text, re.DOTALL).group(0)
+    assert set(re.findall(r"\*([^*]+)\*", sentence)) == labels
