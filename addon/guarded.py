@@ -200,14 +200,20 @@ def each_selected(wanted):
                 if "CANCELLED" in result:
                     return result
                 results.append(context.view_layer.objects.active)
-            for ob in results:  # every result selected, the last one active (as each run leaves its own)
-                if ob is not None:
-                    ob.select_set(True)
+            select_results(context, results)
             return {"FINISHED"}
 
         return wrapper
 
     return decorate
+
+
+def select_results(context, results):
+    """After an operator ran once per object: every run's result (the object each run left active) selected, as
+    Blender's own multi-object operators leave them; a result removed meanwhile, or None, is passed over."""
+    for ob in results:
+        if ob is not None and ob.name in context.view_layer.objects:
+            ob.select_set(True)
 
 
 def run_to_end(steps):

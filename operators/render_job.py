@@ -16,7 +16,16 @@ import time
 
 import bpy
 
-from ..addon.guarded import Transaction, check_numbers, each_selected, guarded, guarded_step, run_to_end, targets
+from ..addon.guarded import (
+    Transaction,
+    check_numbers,
+    each_selected,
+    guarded,
+    guarded_step,
+    run_to_end,
+    select_results,
+    targets,
+)
 from ..kernels.common import workers
 
 #: Renders at most this large are kept for the redo panel.
@@ -159,9 +168,7 @@ class RenderJobOperator:
             result = {"CANCELLED"}
         self._end(context)
         if "FINISHED" in result:
-            for ob in self._made:  # every result selected, the last one active (as each run leaves its own)
-                if ob is not None and ob.name in context.view_layer.objects:
-                    ob.select_set(True)
+            select_results(context, self._made)
         return result
 
     def _finish_steps(self, context):
