@@ -21,7 +21,7 @@ from ..kernels.subdivision import hce
 from ..kernels.subdivision.loop import loop_subdivide
 from ..kernels.subdivision.loop_rules import SHARPNESS_INFINITE, crease_to_sharpness
 from .render_job import RenderJobOperator
-from .selection import is_mesh, mesh_poll, place_mesh, read_source
+from .selection import HIDE_SOURCE, is_mesh, mesh_poll, place_mesh, read_source
 
 
 class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
@@ -36,6 +36,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
         name="Output", default="NEW_OBJECT", description="Make a new object, or replace this object's mesh",
         items=(("NEW_OBJECT", "New Object", "Add a new object beside the source (its modifiers applied first)"),
                ("REPLACE", "Replace Mesh", "Replace the object's mesh (one undo step brings it back)")))
+    hide_source: HIDE_SOURCE
 
     @classmethod
     def poll(cls, context):
@@ -67,7 +68,7 @@ class TESSERA_OT_loop_subdivide(LoopOptions, bpy.types.Operator):
                 bridge.write_point_colours(mesh, BAKED_COLOUR, baked)
         finally:
             wm.progress_end()
-        place_mesh(context, tx, ob, mesh, self.output, "loop")
+        place_mesh(context, tx, ob, mesh, self.output, "loop", self.hide_source)
         for note in build.notes:
             self.report({"WARNING"}, note)
         if marks.n_gons:

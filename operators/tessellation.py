@@ -22,7 +22,7 @@ from ..kernels.common.topology import mesh_topology
 from ..kernels.tessellation.adaptive import adaptive_levels
 from ..kernels.tessellation.mesh_levels import mesh_levels
 from ..kernels.tessellation.tessellate import estimate, tessellate, uniform_levels
-from .selection import is_mesh, mesh_poll, place_mesh, read_source
+from .selection import HIDE_SOURCE, is_mesh, mesh_poll, place_mesh, read_source
 
 
 def _world_positions(positions, matrix):
@@ -41,6 +41,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
     use_object_settings: bpy.props.BoolProperty(
         name="Use Object Settings", description="Take every setting from the object (Sidebar › Tessera › Tessellate)",
         default=False, options={"SKIP_SAVE"})
+    hide_source: HIDE_SOURCE
 
     @classmethod
     def poll(cls, context):
@@ -54,6 +55,8 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
 
     def draw(self, context):
         draw_settings(self.layout, self)
+        if self.output == "NEW_OBJECT":
+            self.layout.prop(self, "hide_source")
 
     @guarded
     @each_selected(is_mesh)
@@ -73,7 +76,7 @@ class TESSERA_OT_tessellate(TessellateOptions, bpy.types.Operator):
             self.report({"INFO"}, f"Not carried over (no interpolation for these types): {', '.join(skipped)}")
         for note in notes:
             self.report({"WARNING"}, note)
-        target = place_mesh(context, tx, ob, new_mesh, self.output, "tessellated")
+        target = place_mesh(context, tx, ob, new_mesh, self.output, "tessellated", self.hide_source)
         for holder in {ob, target}:
             copy_options(TessellateOptions, self, holder.tessera.tessellate)
             holder.tessera.tessellate.stored = True

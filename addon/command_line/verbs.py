@@ -60,8 +60,8 @@ VERBS = {v.name: v for v in (
          "Mesh height maps and elevation files (GeoTIFF, .hgt, .asc, .img, .vrt) for the scene camera"),
 )}
 _TERRAIN_BAKE = Verb("terrain", "tessera.terrain_bake", "Mesh a terrain again for the camera")
-#: Operator options the command line sets itself or that need a window.
-_NOT_OPTIONS = {"output", "camera_source", "filepath", "tile_files", "source", "image_name"}
+#: Operator options the command line sets itself or that need a window (or a view layer to hide things in).
+_NOT_OPTIONS = {"output", "hide_source", "camera_source", "filepath", "tile_files", "source", "image_name"}
 
 
 class Usage(Exception):

@@ -17,7 +17,7 @@ from ..viewport import invalidator
 
 METHOD_ITEMS = (
     ("PN", "PN Triangles", "A smooth cubic surface through the corners, shaped by the vertex normals (smoothest)"),
-    ("PHONG", "Phong", "A rounded surface that bulges toward the vertex normals (fastest curved method)"),
+    ("PHONG", "Phong", "A rounded surface that bulges toward the vertex normals, as far as the Shape Factor says"),
     ("LINEAR", "Linear", "New vertices on the flat triangles: same shape, more vertices"),
 )
 LEVEL_MODE_ITEMS = (

@@ -51,6 +51,33 @@ def test_new_object_has_the_hardware_triangle_count(clean_scene, bpy_module):
     assert ob.data.vertices and len(ob.data.polygons) == 500  # the source is untouched
 
 
+@pytest.mark.parametrize("hide_source, output, hidden", [
+    (True, "NEW_OBJECT", True), (False, "NEW_OBJECT", False), (True, "REPLACE", False)])
+def test_the_source_is_hidden_under_a_new_object_unless_asked_not_to(clean_scene, bpy_module, hide_source, output,
+                                                                     hidden):
+    bpy = bpy_module
+    ob = add_suzanne(bpy)
+    assert bpy.ops.tessera.tessellate(level=2, output=output, hide_source=hide_source) == {"FINISHED"}
+    new = bpy.context.active_object
+    assert ob.hide_get() is hidden
+    assert not new.hide_get() and new.select_get()
+
+
+def test_a_failed_run_on_several_objects_leaves_every_source_shown(clean_scene, bpy_module):
+    bpy = bpy_module
+    me = bpy.data.meshes.new("Points")  # a mesh without faces: its run fails after the active object's succeeded
+    me.from_pydata([(0, 0, 0), (1, 0, 0)], [(0, 1)], [])
+    wire = bpy.data.objects.new("Wire", me)
+    clean_scene.collection.objects.link(wire)
+    ob = add_suzanne(bpy)  # active, so it runs first
+    wire.select_set(True)
+    names = sorted(o.name for o in bpy.data.objects)
+    with pytest.raises(RuntimeError, match="no faces"):
+        bpy.ops.tessera.tessellate(level=2)
+    assert sorted(o.name for o in bpy.data.objects) == names
+    assert not ob.hide_get() and not wire.hide_get()
+
+
 def test_linear_tessellation_keeps_shape_and_shading(clean_scene, bpy_module):
     bpy = bpy_module
     ob = add_suzanne(bpy)
