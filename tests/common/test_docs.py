@@ -64,6 +64,47 @@ def test_the_performance_summary_is_read_from_the_bench_tables_on_the_page():
     assert f"| {ratio:.2f}x faster |" in block or f"| {1 / ratio:.2f}x slower |" in block
 
 
+#: A speed figure in prose: "1.36x", "1.36–1.96x" (not a version such as "4.x").
+_FIGURE = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)(?:[–-](\d+(?:\.\d+)?))?x\b")
+#: Columns of the bench tables that hold a ratio between two measured times.
+_RATIO_COLUMN = re.compile(r"speedup|ratio|faster|slower|/ ")
+
+
+def _bench_ratios(page):
+    """Every cell of a ratio column in the bench tables of ``page`` (docs/performance.md): its number, as printed."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("bench_report", ROOT / "tools" / "bench_report.py")
+    report = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(report)
+    found = set()
+    for match in report.BLOCK.finditer(page):
+        for row in report.page_rows(page, match.group(2)):
+            for column, cell in row.items():
+                number = re.match(r"\d+(?:\.\d+)?", cell or "")
+                if _RATIO_COLUMN.search(column) and number:
+                    found.add(number.group(0))
+    return found
+
+
+def test_every_speed_figure_in_prose_is_a_bench_ratio():
+    """A figure such as "1.36–1.96x" in the README or a docs page (the performance page's own tables aside) is a ratio
+    the bench wrote into docs/performance.md, each end of a range a measured row: prose cannot keep a number the
+    bench no longer gives."""
+    page = (ROOT / "docs" / "performance.md").read_text(encoding="utf-8")
+    ratios = _bench_ratios(page)
+    assert {"1.36", "1.96"} <= ratios  # the stencil rows the subdivision page cites
+    stale = []
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        if path.name in ("performance.md", "changelog.md"):
+            continue
+        for line_no, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            for figure in _FIGURE.finditer(line):
+                if not all(end in ratios for end in figure.groups() if end):
+                    stale.append(f"{path.name}:{line_no}: {figure.group(0)}")
+    assert not stale, f"speed figures that no bench table of docs/performance.md gives: {stale}"
+
+
 def test_the_changelog_starts_at_the_manifests_version():
     """docs/changelog.md's newest heading is the version the manifest gives the extension, so a release cannot ship
     without saying what changed."""
