@@ -6,7 +6,7 @@
 #   tools/manual_shots.sh          (needs what the window tier needs: root and Debian's packages)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-scenarios=(quick_start)
+scenarios=(quick_start worked_examples)
 work=$(mktemp -d "${TMPDIR:-/tmp}/tessera-shots.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$here/docs/shots"

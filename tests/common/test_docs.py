@@ -105,6 +105,16 @@ def test_every_speed_figure_in_prose_is_a_bench_ratio():
     assert not stale, f"speed figures that no bench table of docs/performance.md gives: {stale}"
 
 
+def test_every_picture_of_the_window_is_shown():
+    """Each picture tools/manual_shots.sh made (docs/shots/) is shown by the README or a docs page: none is left over
+    from an example that was dropped."""
+    shown = (ROOT / "README.md").read_text(encoding="utf-8") + "".join(
+        p.read_text(encoding="utf-8") for p in (ROOT / "docs").glob("*.md"))
+    pictures = sorted(p.name for p in (ROOT / "docs" / "shots").glob("*.png"))
+    assert pictures
+    assert [name for name in pictures if f"shots/{name})" not in shown] == []
+
+
 def test_the_changelog_starts_at_the_manifests_version():
     """docs/changelog.md's newest heading is the version the manifest gives the extension, so a release cannot ship
     without saying what changed."""

@@ -1,29 +1,20 @@
 """The README's first quick start, run as printed in a real Blender window (scenario ``quick_start``): its steps are
 the README's, in its order, and they give the picture the README shows beside them."""
 
-import ast
 import re
 
-import numpy as np
 import pytest
 from conftest import ROOT
-from window_tier import assert_no_traceback, run_scenario, window_blender  # noqa: F401 -- fixtures
+from window_tier import (  # noqa: F401 -- fixtures
+    assert_menu_labels,
+    assert_no_traceback,
+    assert_picture_current,
+    run_scenario,
+    scenario_constant,
+    window_blender,
+)
 
 pytestmark = pytest.mark.window
-
-SCENARIO = ROOT / "tests" / "window" / "scenarios" / "quick_start.py"
-#: The README's picture against this run's: at most this share of the pixels of the view's middle (half its width,
-#: 60 % of its height: the monkey, not the header or toolbars a newer Blender may redraw) differ by > 16/255 in a
-#: channel. The same run gives 0; the flat monkey shown for the smooth one, about 9 %.
-PICTURE_BAR = 0.03
-
-
-def scenario_steps():
-    """The scenario's `STEPS`, read without Blender: [(the README's words, operator), ...]."""
-    tree = ast.parse(SCENARIO.read_text())
-    node = next(n for n in tree.body if isinstance(n, ast.Assign) and n.targets[0].id == "STEPS")
-    return [(words, idname) for words, idname, _ in ast.literal_eval(node.value)]
-
 
 def readme_step_one():
     text = (ROOT / "README.md").read_text()
@@ -33,7 +24,7 @@ def readme_step_one():
 
 def test_the_readme_names_the_scenarios_steps_in_order():
     step, at = readme_step_one(), -1
-    for words, _ in scenario_steps():
+    for words, _, _ in scenario_constant("quick_start", "STEPS"):
         found = step.find(f"*{words}*", at + 1)
         assert found > at, f"the README's first quick-start step does not name *{words}* (in this order)"
         at = found
@@ -59,19 +50,11 @@ def test_the_steps_give_a_smooth_result_over_a_hidden_source(quick_start):
 def test_the_readme_shows_what_the_steps_give(quick_start, name):
     _, _, out = quick_start
     assert f"docs/shots/{name}.png" in readme_step_one()
-    import OpenImageIO as oiio
+    assert_picture_current(out, name)
 
-    shown = oiio.ImageBuf(str(ROOT / "docs" / "shots" / f"{name}.png"))
-    made = oiio.ImageBuf(str(out / f"shot_{name}.png"))
-    spec = shown.spec()
-    made = oiio.ImageBufAlgo.resize(made, roi=oiio.ROI(0, spec.width, 0, spec.height, 0, 1, 0, 3))
-    a = shown.get_pixels(oiio.UINT8)[..., :3].astype(np.int16)
-    b = made.get_pixels(oiio.UINT8)[..., :3].astype(np.int16)
-    h, w = a.shape[:2]
-    middle = (slice(h // 5, h - h // 5), slice(w // 4, w - w // 4))
-    share = float((np.abs(a[middle] - b[middle]) > 16).any(axis=2).mean())
-    assert share <= PICTURE_BAR, (f"{share:.1%} of docs/shots/{name}.png differs from what the steps give now: run "
-                                  f"tools/manual_shots.sh ({out})")
+
+def test_each_menu_path_ends_in_the_label_of_the_operator_it_runs(quick_start):
+    assert_menu_labels(quick_start[0])
 
 
 def test_the_picture_command_lists_the_scenario():

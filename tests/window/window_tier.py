@@ -77,3 +77,54 @@ def scenario_fixture(scenario, name=None):
 def assert_no_traceback(log):
     """The scenario's Blender printed no traceback."""
     assert log.count("Traceback") == 0, f"the session printed a traceback:\n{log[-3000:]}"
+
+
+#: A picture of the manual against the same shot taken now: at most this share of the pixels of the view's middle
+#: (half its width, 60 % of its height: what the shot is about, not the header or toolbars a newer Blender may
+#: redraw) differ by > 16/255 in a channel. The same run gives 0; the quick start's flat monkey shown for its smooth
+#: one, about 9 %.
+PICTURE_BAR = 0.03
+
+
+def picture_drift(shown, made):
+    """The share of the middle of picture file ``shown`` (in docs/shots/, scaled by tools/manual_shots.sh) that
+    differs from the screenshot file ``made``, scaled the same way: compare with `PICTURE_BAR`."""
+    import numpy as np
+    import OpenImageIO as oiio
+
+    shown_buf, made_buf = oiio.ImageBuf(str(shown)), oiio.ImageBuf(str(made))
+    spec = shown_buf.spec()
+    made_buf = oiio.ImageBufAlgo.resize(made_buf, roi=oiio.ROI(0, spec.width, 0, spec.height, 0, 1, 0, 3))
+    a = shown_buf.get_pixels(oiio.UINT8)[..., :3].astype(np.int16)
+    b = made_buf.get_pixels(oiio.UINT8)[..., :3].astype(np.int16)
+    h, w = a.shape[:2]
+    middle = (slice(h // 5, h - h // 5), slice(w // 4, w - w // 4))
+    return float((np.abs(a[middle] - b[middle]) > 16).any(axis=2).mean())
+
+
+def assert_picture_current(out, name):
+    """docs/shots/NAME.png is what the scenario whose output folder is ``out`` shot as ``shot_NAME.png`` now."""
+    share = picture_drift(ROOT / "docs" / "shots" / f"{name}.png", Path(out) / f"shot_{name}.png")
+    assert share <= PICTURE_BAR, (f"{share:.1%} of docs/shots/{name}.png differs from what its steps give now: run "
+                                  f"tools/manual_shots.sh ({out})")
+
+
+def scenario_constant(scenario, name):
+    """The literal value of module constant ``name`` of scenario ``scenario`` (tests/window/scenarios), read without
+    Blender."""
+    import ast
+
+    tree = ast.parse((ROOT / "tests" / "window" / "scenarios" / f"{scenario}.py").read_text())
+    node = next(n for n in tree.body if isinstance(n, ast.Assign) and getattr(n.targets[0], "id", "") == name)
+    return ast.literal_eval(node.value)
+
+
+def assert_menu_labels(results):
+    """Each menu path a scenario ran (``results["labels"]``: words -> the operator's label) ends in that label:
+    *Object › Shade Smooth* runs the operator Blender calls *Shade Smooth*, and an item of the Add menu the one
+    called *Add* and the item (*Add › Mesh › Monkey*: *Add Monkey*)."""
+    labels = results["labels"]
+    assert labels, "the scenario ran no menu step"
+    wrong = {words: label for words, label in labels.items()
+             if label not in (words.split(" › ")[-1], "Add " + words.split(" › ")[-1])}
+    assert not wrong, f"menu paths whose last item is not the operator's label: {wrong}"

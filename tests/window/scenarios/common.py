@@ -129,3 +129,16 @@ def region_ms(w, iterations=REDRAWS, warm=True):
         start = time.perf_counter()
         bpy.ops.wm.redraw_timer(type="DRAW", iterations=iterations)
     return 1000.0 * (time.perf_counter() - start) / iterations
+
+
+def menu_step(w, words, idname, props):
+    """Run operator ``idname`` (``"mesh.primitive_monkey_add"``) with ``props`` as its menu entry runs it: invoked in
+    the 3D viewport. Records in ``w.results["labels"]`` the label Blender gives the operator under ``words`` (the
+    menu path the manual prints), so a test can hold the path's last item to it."""
+    module, name = idname.split(".")
+    op = getattr(getattr(bpy.ops, module), name)
+    w.results.setdefault("labels", {})[words] = op.get_rna_type().name
+    with bpy.context.temp_override(**w.context()):
+        result = op("INVOKE_DEFAULT", **props)
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"{idname} returned {result}")

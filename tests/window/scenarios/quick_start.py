@@ -8,7 +8,7 @@ panel opens). Shots: ``shot_quick_start_monkey.png`` (the flat monkey after *Add
 """
 
 import bpy
-from common import differing_share, shot, silhouette
+from common import differing_share, menu_step, shot, silhouette
 
 #: (the README's words, the operator's bl_idname in Python form, its arguments)
 STEPS = (
@@ -19,14 +19,6 @@ STEPS = (
 )
 VIEW = (1.2, 0.0, 0.55)  # a three-quarter view from the front left, as the README's picture shows it
 SETTLE = 0.5
-
-
-def _call(w, idname, props):
-    module, name = idname.split(".")
-    with bpy.context.temp_override(**w.context()):
-        result = getattr(getattr(bpy.ops, module), name)("INVOKE_DEFAULT", **props)
-    if result != {"FINISHED"}:
-        raise RuntimeError(f"{idname} returned {result}")
 
 
 def run(w):
@@ -47,7 +39,7 @@ def run(w):
     empty = flat = monkey = None
     for words, idname, props in STEPS:
         print(f"@@ {words}", flush=True)
-        _call(w, idname, props)
+        menu_step(w, words, idname, props)
         yield SETTLE
         if idname == "object.delete":
             empty = shot(w, "empty")
