@@ -9,6 +9,13 @@ from common import menu_step, silhouette
 
 #: example -> (the page in docs/, ((the page's words, operator, arguments), ...)); the last step is Tessera's
 EXAMPLES = {
+    "tessellation": ("tessellation.md", (
+        ("Delete", "object.delete", {"confirm": False}),
+        ("Add › Mesh › Monkey", "mesh.primitive_monkey_add", {}),
+        ("Object › Shade Smooth", "object.shade_smooth", {}),
+        ("Object › Tessera › Tessellate", "tessera.tessellate",
+         {"level_mode": "ADAPTIVE", "camera_source": "VIEWPORT", "edge_pixels": 30.0}),
+    )),
     "tubes": ("tubes.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Curve › Bézier", "curve.primitive_bezier_curve_add", {}),
@@ -20,6 +27,12 @@ EXAMPLES = {
         ("Object › Shade Smooth", "object.shade_smooth", {}),
         ("Object › Tessera › Loop Subdivide", "tessera.loop_subdivide", {}),
     )),
+    "node_groups": ("node_groups.md", (
+        ("Delete", "object.delete", {"confirm": False}),
+        ("Add › Mesh › Monkey", "mesh.primitive_monkey_add", {}),
+        ("Object › Shade Smooth", "object.shade_smooth", {}),
+        ("Object › Tessera › Add Tessera Node Group", "tessera.node_group_add", {"group": "Tessera PN Triangles"}),
+    )),
     "surface": ("surfaces.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Tessera › Parametric Surface", "tessera.parametric_surface_add", {}),
@@ -27,6 +40,7 @@ EXAMPLES = {
 }
 SETTLE = 0.5
 DISTANCE = {"tubes": 3.5}  # how far the view stands from the origin, where 7 leaves the result small
+WIREFRAME = {"tessellation"}  # examples shown with the wireframe overlay: their point is where the triangles go
 
 
 def _default_scene(w):
@@ -61,6 +75,7 @@ def run(w):
         rv3d.view_perspective = "PERSP"
         rv3d.view_distance = DISTANCE.get(example, 7.0)
         rv3d.view_location = (0.0, 0.0, 0.0)
+        w.space.overlay.show_wireframes = example in WIREFRAME
         yield SETTLE
         for k, (words, idname, props) in enumerate(steps):
             print(f"@@ {example}: {words}", flush=True)
@@ -72,8 +87,11 @@ def run(w):
                 w.redraw(2)
                 w.screenshot(f"shot_{example}_start", w.area)
         made = bpy.context.active_object
+        if example in WIREFRAME:
+            made.select_set(False)  # its wires grey, not the selection's orange (it stays active: its panels show)
         r[f"{example}_made"] = made.name
-        r[f"{example}_faces"] = len(made.data.polygons) if made.type == "MESH" else 0
+        evaluated = made.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        r[f"{example}_faces"] = len(evaluated.data.polygons) if made.type == "MESH" else 0  # with its modifiers
         r[f"{example}_pixels"] = int(silhouette(w.screenshot(), empty).sum())
         w.redraw(2)
         w.screenshot(f"shot_{example}", w.area)
