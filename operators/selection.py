@@ -68,15 +68,15 @@ def read_source(context, ob, output):
 #: The operator option that hides the source under a new object made exactly over it (Tessellate, Loop Subdivide).
 HIDE_SOURCE = bpy.props.BoolProperty(
     name="Hide Source", default=True,
-    description="Hide the source object in the viewport, so the new object over it shows (its eye in the Outliner "
-                "brings it back)")
+    description="Hide the source object in the viewport and in renders, so the new object over it shows alone (the "
+                "eye and camera icons in the Outliner bring it back)")
 
 
 def place_mesh(context, tx, ob, mesh, output, suffix, hide_source=False):
     """Put ``mesh`` (mesh or curve data, as ``ob``'s) in the scene: swapped into ``ob`` (REPLACE; the old mesh
     removed if nothing else uses it, undone on rollback) or as a new object ``<ob.name>.<suffix>`` in ``ob``'s
     collections with its transform and object-linked materials, selected and active, ``ob`` hidden in the viewport
-    when ``hide_source``. Returns the object that holds it."""
+    and in renders when ``hide_source`` (both undone on rollback). Returns the object that holds it."""
     for material in ob.data.materials:
         mesh.materials.append(material)
     if output == "REPLACE":
@@ -96,9 +96,15 @@ def place_mesh(context, tx, ob, mesh, output, suffix, hide_source=False):
         if src_slot.link == "OBJECT":
             dst_slot.link = "OBJECT"
             dst_slot.material = src_slot.material
-    if hide_source and not ob.hide_get(view_layer=context.view_layer):
-        view_layer = context.view_layer
+    if hide_source:
+        view_layer, hidden, unrendered = context.view_layer, ob.hide_get(view_layer=context.view_layer), ob.hide_render
+
+        def show_again():
+            ob.hide_set(hidden, view_layer=view_layer)
+            ob.hide_render = unrendered
+
         ob.hide_set(True, view_layer=view_layer)
-        tx.on_rollback(lambda: ob.hide_set(False, view_layer=view_layer))
+        ob.hide_render = True
+        tx.on_rollback(show_again)
     select_only(context, [new])
     return new

@@ -105,7 +105,7 @@ def add_camera(location, rotation, lens=50):
 def tessellate(source, **settings):
     bpy.context.view_layer.objects.active = source
     t0 = time.perf_counter()
-    result = bpy.ops.tessera.tessellate(output="NEW_OBJECT", **settings)
+    result = bpy.ops.tessera.tessellate(output="NEW_OBJECT", hide_source=False, **settings)  # sources shown beside
     elapsed = time.perf_counter() - t0
     if result != {"FINISHED"}:
         sys.exit(f"demo: tessellate returned {result}")
@@ -463,7 +463,7 @@ def build_loop_scene():
     for source, levels in ((coarse, 2), (cube, 3)):
         bpy.context.view_layer.objects.active = source
         t0 = time.perf_counter()
-        if bpy.ops.tessera.loop_subdivide(levels=levels) != {"FINISHED"}:
+        if bpy.ops.tessera.loop_subdivide(levels=levels, hide_source=False) != {"FINISHED"}:
             sys.exit("demo: loop_subdivide failed")
         out = bpy.context.active_object
         rows.append((source.name, len(out.data.polygons), time.perf_counter() - t0))
@@ -507,7 +507,7 @@ def build_hce_scene():
     if bpy.ops.tessera.bake_lighting_hce(depth=2, samples=64) != {"FINISHED"}:
         sys.exit("demo: bake_lighting_hce failed")
     seconds = time.perf_counter() - t0
-    if bpy.ops.tessera.loop_subdivide(levels=3) != {"FINISHED"}:
+    if bpy.ops.tessera.loop_subdivide(levels=3, hide_source=False) != {"FINISHED"}:
         sys.exit("demo: loop_subdivide failed")
     out = bpy.context.active_object
     out.location.x += 1.7

@@ -52,7 +52,7 @@ def test_suzanne_gives_the_kernels_mesh_with_uvs(clean_scene, bpy_module, addon_
     assert bpy.ops.tessera.loop_subdivide(levels=2) == {"FINISHED"}
     out = bpy.context.active_object
     assert out is not ob and out.name == "Suzanne.loop" and out.data.materials[0].name == "Skin"
-    assert ob.hide_get() and not out.hide_get()  # the new object shows, not the source under it
+    assert ob.hide_get() and ob.hide_render and not out.hide_render  # the new object shows, not the source under it
     ref, marks = kernel_of(addon_module, bpy, ob, 2)
     assert marks.n_gons == 468
     pos, tris, use = arrays_of(out.data)

@@ -59,8 +59,8 @@ def test_the_source_is_hidden_under_a_new_object_unless_asked_not_to(clean_scene
     ob = add_suzanne(bpy)
     assert bpy.ops.tessera.tessellate(level=2, output=output, hide_source=hide_source) == {"FINISHED"}
     new = bpy.context.active_object
-    assert ob.hide_get() is hidden
-    assert not new.hide_get() and new.select_get()
+    assert ob.hide_get() is hidden and ob.hide_render is hidden
+    assert not new.hide_get() and not new.hide_render and new.select_get()
 
 
 def test_a_failed_run_on_several_objects_leaves_every_source_shown(clean_scene, bpy_module):
@@ -75,7 +75,7 @@ def test_a_failed_run_on_several_objects_leaves_every_source_shown(clean_scene, 
     with pytest.raises(RuntimeError, match="no faces"):
         bpy.ops.tessera.tessellate(level=2)
     assert sorted(o.name for o in bpy.data.objects) == names
-    assert not ob.hide_get() and not wire.hide_get()
+    assert not ob.hide_get() and not wire.hide_get() and not ob.hide_render
 
 
 def test_linear_tessellation_keeps_shape_and_shading(clean_scene, bpy_module):
