@@ -1,6 +1,7 @@
 """Helpers shared by the blender-tier tests (importable as ``blender_helpers``, like ``mesh_checks``)."""
 
 import importlib
+import os
 import time
 
 import pytest
@@ -183,3 +184,17 @@ def installed_blender(built_zips, home, binds=()):
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     run.start, run.env, run.packaged = start, env, packaged
     return run
+
+
+def processes_naming(text):
+    """The ids of the running processes whose command line holds ``text`` (one that ends while /proc is read is
+    passed over)."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if text.encode() in f.read():
+                    found.append(int(pid))
+        except OSError:  # it ended meanwhile
+            pass
+    return found

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from blender_helpers import installed_blender
+from blender_helpers import installed_blender, processes_naming
 from tessera.tools.geotiff_files import write_geotiff
 
 pytestmark = pytest.mark.blender
@@ -375,19 +375,6 @@ def test_a_killed_task_leaves_no_output_and_the_next_task_clears_its_partial_fil
     assert sorted(os.listdir(out)) == ["other.ply"]
 
 
-def _processes_naming(text):
-    """The ids of the running processes whose command line holds ``text``."""
-    found = []
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            with open(f"/proc/{pid}/cmdline", "rb") as f:
-                if text.encode() in f.read():
-                    found.append(int(pid))
-        except OSError:
-            pass
-    return found
-
-
 def test_a_killed_task_takes_its_render_worker_and_job_folder_with_it(blender, bpy_module, tmp_path):
     """SIGKILL of an impostors task (a farm's pre-emption): within 5 s no worker renders on and no job folder stays."""
     _blend(tmp_path / "prop.blend", "bpy.ops.mesh.primitive_monkey_add()")
@@ -400,17 +387,17 @@ def test_a_killed_task_takes_its_render_worker_and_job_folder_with_it(blender, b
     deadline, workers, folders = time.monotonic() + 120, [], []
     while time.monotonic() < deadline and not workers:
         folders = [temp / n for n in os.listdir(temp) if n.startswith("tessera-impostor-")]
-        workers = [p for f in folders for p in _processes_naming(f"{f}/job.json") if p != proc.pid]
+        workers = [p for f in folders for p in processes_naming(f"{f}/job.json") if p != proc.pid]
         time.sleep(0.05)
     assert workers, "the task started no render worker"
     time.sleep(1.0)  # rendering
     proc.kill()
     proc.wait(timeout=30)
     deadline = time.monotonic() + 5.0
-    while time.monotonic() < deadline and (any(_processes_naming(f"{f}/job.json") for f in folders)
+    while time.monotonic() < deadline and (any(processes_naming(f"{f}/job.json") for f in folders)
                                            or any(f.exists() for f in folders)):
         time.sleep(0.05)
-    assert not any(_processes_naming(f"{f}/job.json") for f in folders), "a render worker outlived its task"
+    assert not any(processes_naming(f"{f}/job.json") for f in folders), "a render worker outlived its task"
     assert not any(f.exists() for f in folders), "the job folder outlived its task"
 
 

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 import pytest
-from blender_helpers import UiOperator
+from blender_helpers import UiOperator, processes_naming
 from test_blender_bake import baked_box
 
 pytestmark = pytest.mark.blender
@@ -411,24 +411,11 @@ def test_a_worker_that_dies_is_told_by_its_reason_not_its_start_up_lines(addon_m
     assert render_jobs.failure("Rendering", 3, b"Read blend\n").endswith("(it exited with code 3)")
 
 
-def _pids_running(text):
-    """The ids of the processes whose command line holds ``text`` (one that ends while it is read is passed over)."""
-    found = []
-    for name in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            with open(f"/proc/{name}/cmdline", "rb") as f:
-                if text.encode() in f.read():
-                    found.append(int(name))
-        except OSError:  # it ended meanwhile
-            continue
-    return found
-
-
 def test_closing_a_workers_leash_ends_it_and_removes_its_folder(addon_module, tmp_path):
     render_jobs = addon_module("addon.render_jobs")
     process, folder = _leashed(render_jobs, tmp_path, "import time\ntime.sleep(600)\n")
     time.sleep(0.5)
-    worker = [pid for pid in _pids_running(str(tmp_path / "worker.py")) if pid != process.pid]
+    worker = [pid for pid in processes_naming(str(tmp_path / "worker.py")) if pid != process.pid]
     assert worker, "the worker did not start"
     assert render_jobs.stop_process(process, timeout=10)
     assert not os.path.exists(folder)  # removed by the leash
