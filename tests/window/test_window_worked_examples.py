@@ -45,6 +45,10 @@ def test_the_page_names_the_steps_in_order_and_shows_their_pictures(example):
         at = found
     shown = re.findall(r"\]\(shots/([\w-]+)\.png\)", section)
     assert shown == pictures(example), f"{page} shows {shown}"
+    import markdown  # as tools/manual.py makes the manual's HTML: the steps stay one numbered list, pictures inside
+
+    html = markdown.markdown(section, extensions=["tables", "fenced_code", "toc"])
+    assert html.count("<ol>") == 1 and html.index("<ol>") < html.index("<img") < html.index("</ol>"), html
 
 
 @pytest.fixture(scope="module")
