@@ -9,12 +9,14 @@ from window_tier import (  # noqa: F401 -- fixtures
     assert_menu_labels,
     assert_no_traceback,
     assert_picture_current,
+    assert_steps_in_order,
     run_scenario,
     scenario_constant,
     window_blender,
 )
 
 pytestmark = pytest.mark.window
+
 
 def readme_step_one():
     text = (ROOT / "README.md").read_text()
@@ -23,15 +25,8 @@ def readme_step_one():
 
 
 def test_the_readme_names_the_scenarios_steps_in_order():
-    step, at = readme_step_one(), -1
-    for words, _, _ in scenario_constant("quick_start", "STEPS"):
-        found = step.find(f"*{words}*", at + 1)
-        assert found > at, f"the README's first quick-start step does not name *{words}* (in this order)"
-        at = found
-    import markdown  # as tools/manual.py makes the manual's HTML: the pictures stay inside the numbered step
-
-    html = markdown.markdown(step, extensions=["tables", "fenced_code", "toc"])
-    assert html.count("<ol>") == 1 and html.index("<ol>") < html.index("<img") < html.index("</ol>"), html
+    assert_steps_in_order(readme_step_one(), scenario_constant("quick_start", "STEPS"),
+                          "the README's first quick-start step")
 
 
 @pytest.fixture(scope="module")

@@ -128,3 +128,18 @@ def assert_menu_labels(results):
     wrong = {words: label for words, label in labels.items()
              if label not in (words.split(" › ")[-1], "Add " + words.split(" › ")[-1])}
     assert not wrong, f"menu paths whose last item is not the operator's label: {wrong}"
+
+
+def assert_steps_in_order(text, steps, where):
+    """``text`` (a numbered list of a page) names each step's words as ``*words*``, in the order of ``steps`` ((words,
+    operator, arguments), ...), and stays one numbered list, pictures inside, in the manual's HTML (as
+    tools/manual.py makes it)."""
+    import markdown
+
+    at = -1
+    for words, _, _ in steps:
+        found = text.find(f"*{words}*", at + 1)
+        assert found > at, f"{where} does not name *{words}* (in this order)"
+        at = found
+    html = markdown.markdown(text, extensions=["tables", "fenced_code", "toc"])
+    assert html.count("<ol>") == 1 and html.index("<ol>") < html.index("<img") < html.index("</ol>"), html
