@@ -1,13 +1,15 @@
 """The manual as it ships inside the extension: every page of ``docs/`` (and the README as ``readme.html``) made into
 HTML with Python-Markdown, links between pages kept, pictures scaled down (at most `MAX_WIDTH` pixels wide, JPEG) so
-the whole manual is a few MB, and nothing that points outside it. The sidebar's *Manual* button opens
-``manual/index.html`` (`addon.manifest.manual_url`), so the manual works offline.
+the whole manual is a few MB, the sample files the examples link (``docs/samples/``) copied as they are, and nothing
+that points outside it. The sidebar's *Manual* button opens ``manual/index.html`` (`addon.manifest.manual_url`), so
+the manual works offline.
 
 Usage: python tools/manual.py OUT_DIR      (tools/build_extension.py calls `build_manual` into the staged copy)
 """
 
 import html
 import re
+import shutil
 import sys
 from pathlib import Path
 
@@ -57,6 +59,7 @@ def build_manual(out_dir, docs=ROOT / "docs", readme=ROOT / "README.md"):
     names = {p.resolve(): _page_name(p) for p in pages}
     pictures = {}
     written = []
+    samples, samples_out, copied = (docs / "samples").resolve(), out_dir / "samples", set()
     for page in pages:
         body = markdown.markdown(page.read_text(encoding="utf-8"), extensions=["tables", "fenced_code", "toc"])
 
@@ -67,6 +70,11 @@ def build_manual(out_dir, docs=ROOT / "docs", readme=ROOT / "README.md"):
                 return f'{kind}="{names[path]}{anchor}"'
             if kind == "src" and path.suffix.lower() in (".png", ".jpg") and path.is_file():
                 return f'{kind}="{_picture(path, out_dir, pictures)}"'
+            if kind == "href" and path.parent == samples and path.is_file():  # a file an example uses, as it is
+                samples_out.mkdir(exist_ok=True)
+                shutil.copyfile(path, samples_out / path.name)
+                copied.add(samples_out / path.name)
+                return f'{kind}="samples/{path.name}"'
             return f'{kind}="https://github.com/tessera-blender/tessera/blob/main/{target}{anchor}"' \
                 if not target.startswith("/") else m.group(0)
 
@@ -79,7 +87,7 @@ def build_manual(out_dir, docs=ROOT / "docs", readme=ROOT / "README.md"):
         target = out_dir / names[page.resolve()]
         target.write_text(text, encoding="utf-8")
         written.append(target)
-    return written + [out_dir / n for n in pictures.values()]
+    return written + [out_dir / n for n in pictures.values()] + sorted(copied)
 
 
 if __name__ == "__main__":

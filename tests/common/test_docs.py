@@ -115,6 +115,25 @@ def test_every_picture_of_the_window_is_shown():
     assert [name for name in pictures if f"shots/{name})" not in shown] == []
 
 
+def test_the_sample_files_are_what_their_tool_writes_and_each_is_linked():
+    """docs/samples/ holds what tools/sample_height_map.py writes now, sample for sample, and a page links each file
+    there (the manual ships the linked ones)."""
+    import importlib.util
+
+    import numpy as np
+    import OpenImageIO as oiio
+
+    spec = importlib.util.spec_from_file_location("sample_height_map", ROOT / "tools" / "sample_height_map.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    buf = oiio.ImageBuf(str(tool.SAMPLE))
+    assert buf.spec().format == oiio.UINT16 and buf.spec().nchannels == 1
+    assert np.array_equal(buf.get_pixels(oiio.UINT16)[..., 0], tool.height_map())
+    pages = "".join(p.read_text(encoding="utf-8") for p in (ROOT / "docs").glob("*.md"))
+    files = sorted(p.name for p in (ROOT / "docs" / "samples").iterdir())
+    assert files == [tool.SAMPLE.name] and all(f"](samples/{name})" in pages for name in files)
+
+
 def test_the_changelog_starts_at_the_manifests_version():
     """docs/changelog.md's newest heading is the version the manifest gives the extension, so a release cannot ship
     without saying what changed."""

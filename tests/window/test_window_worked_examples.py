@@ -29,16 +29,15 @@ def worked_example(page):
 
 
 def pictures(example):
-    """The pictures the scenario takes of ``example``: its result, and what Blender made before the tool (when a
-    Blender step adds something before it)."""
-    _, steps = EXAMPLES[example]
-    first_tool = next(k for k, step in enumerate(steps) if step[1].startswith("tessera."))
-    return [f"{example}_start", example] if first_tool >= 2 else [example]
+    """The pictures the scenario takes of ``example``: the view after its first steps (when it names a number of
+    them), and its result."""
+    _, _, start = EXAMPLES[example]
+    return [f"{example}_start", example] if start else [example]
 
 
 @pytest.mark.parametrize("example", sorted(EXAMPLES))
 def test_the_page_names_the_steps_in_order_and_shows_their_pictures(example):
-    page, steps = EXAMPLES[example]
+    page, steps, _ = EXAMPLES[example]
     section = worked_example(page)
     assert_steps_in_order(section, steps, f"{page}'s worked example")
     shown = re.findall(r"\]\(shots/([\w-]+)\.png\)", section)
@@ -53,8 +52,11 @@ def examples(run_scenario):  # noqa: F811
 @pytest.mark.parametrize("example", sorted(EXAMPLES))
 def test_the_steps_give_the_pages_pictures(examples, example):
     r, log, out = examples
-    assert r[f"{example}_tab"] == "Tessera", "the sidebar should be open on the Tessera tab"
-    assert r[f"{example}_faces"] > 0 and r[f"{example}_pixels"] > 2000, f"{example}: nothing made or shown ({out})"
+    if f"{example}_image_spread" in r:  # an image, shown in the Image Editor: streaks, not one flat grey
+        assert r[f"{example}_image_spread"] > 0.05, f"{example}: the image is flat ({out})"
+    else:
+        assert r[f"{example}_tab"] == "Tessera", "the sidebar should be open on the Tessera tab"
+        assert r[f"{example}_faces"] > 0 and r[f"{example}_pixels"] > 2000, f"{example}: nothing made or shown ({out})"
     for name in pictures(example):
         assert_picture_current(out, name)
     assert_no_traceback(log)
@@ -62,6 +64,29 @@ def test_the_steps_give_the_pages_pictures(examples, example):
 
 def test_each_menu_path_ends_in_the_label_of_the_operator_it_runs(examples):
     assert_menu_labels(examples[0])
+
+
+def test_each_tool_step_picks_the_toolbar_button_it_names(examples):
+    """A step that picks a tool names the label of its toolbar button, and that tool is the active one after it."""
+    named = {words: what.removeprefix("tool:") for _, steps, _ in EXAMPLES.values() for words, what, _ in steps
+             if what.startswith("tool:")}
+    assert named and examples[0]["tools"] == {words: [idname, words] for words, idname in named.items()}
+
+
+def test_the_brush_stroke_paints_the_map(examples):
+    assert examples[0]["displacement_map_texels_changed"] > 1000  # a ridge of radius 80 texels, not a few dabs
+
+
+def test_the_triangle_counts_a_page_gives_are_what_its_steps_make(examples):
+    """Each "about N triangles" of a worked example is within 2 % of the triangles its steps make in the window (the
+    terrain's are the scene camera's: a renamed default or a changed level rule changes them)."""
+    counted = set()
+    for example, (page, _, _) in EXAMPLES.items():
+        for figure in re.findall(r"about ([\d,]+) triangles", worked_example(page)):
+            made = examples[0][f"{example}_triangles"]
+            assert abs(int(figure.replace(",", "")) - made) <= 0.02 * made, f"{page}: about {figure}, made {made:,}"
+            counted.add(example)
+    assert "terrain" in counted
 
 
 def test_the_picture_command_lists_the_scenario():

@@ -1,13 +1,22 @@
-"""The manual's worked examples in a real Blender window: each starts from Blender's default scene and runs the menu
-entries its page names, in order (`EXAMPLES`), with the sidebar open on its Tessera tab. The pictures go to the manual
-through ``tools/manual_shots.sh``: ``shot_<example>_start.png`` before the tool (when a Blender step adds something
-first) and ``shot_<example>.png`` after it. ``test_window_worked_examples.py`` holds each page to its steps.
+"""The manual's worked examples in a real Blender window: each starts from Blender's default scene and runs the steps its
+page names, in order (`EXAMPLES`), with the sidebar open on its Tessera tab. The pictures go to the manual through
+``tools/manual_shots.sh``: ``shot_<example>_start.png`` after the first ``start`` steps (when the example names one)
+and ``shot_<example>.png`` after the last. ``test_window_worked_examples.py`` holds each page to its steps.
+
+A step is (the page's words, what it runs, arguments). What it runs is an operator (``"mesh.primitive_monkey_add"``,
+invoked in the 3D viewport as its menu entry runs it; a ``filepath`` is named from the repository's root),
+``"tool:<id>"`` (a tool picked in the toolbar, arguments set in its header: the displacement brush's), ``"drag"`` (a
+left-button drag across the middle of the viewport, as injected mouse events) or ``"editor:<type>"`` (the viewport's
+editor type changed, arguments set on the new editor: ``{"image": "Vector Field"}``; changed back after the picture).
 """
 
+from pathlib import Path
+
 import bpy
+import numpy as np
 from common import menu_step, silhouette
 
-#: example -> (the page in docs/, ((the page's words, operator, arguments), ...)); the last step is Tessera's
+#: example -> (the page in docs/, ((the page's words, what it runs, arguments), ...), steps before the start picture or 0)
 EXAMPLES = {
     "tessellation": ("tessellation.md", (
         ("Delete", "object.delete", {"confirm": False}),
@@ -15,31 +24,48 @@ EXAMPLES = {
         ("Object › Shade Smooth", "object.shade_smooth", {}),
         ("Object › Tessera › Tessellate", "tessera.tessellate",
          {"level_mode": "ADAPTIVE", "camera_source": "VIEWPORT", "edge_pixels": 30.0}),
-    )),
+    ), 3),
     "tubes": ("tubes.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Curve › Bézier", "curve.primitive_bezier_curve_add", {}),
         ("Object › Tessera › Tubes", "tessera.tubes", {}),
-    )),
+    ), 2),
     "loop": ("subdivision.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Mesh › Ico Sphere", "mesh.primitive_ico_sphere_add", {}),
         ("Object › Shade Smooth", "object.shade_smooth", {}),
         ("Object › Tessera › Loop Subdivide", "tessera.loop_subdivide", {}),
-    )),
+    ), 3),
     "node_groups": ("node_groups.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Mesh › Monkey", "mesh.primitive_monkey_add", {}),
         ("Object › Shade Smooth", "object.shade_smooth", {}),
         ("Object › Tessera › Add Tessera Node Group", "tessera.node_group_add", {"group": "Tessera PN Triangles"}),
-    )),
+    ), 3),
     "surface": ("surfaces.md", (
         ("Delete", "object.delete", {"confirm": False}),
         ("Add › Tessera › Parametric Surface", "tessera.parametric_surface_add", {}),
-    )),
+    ), 0),
+    "displacement": ("displacement.md", (
+        ("Delete", "object.delete", {"confirm": False}),
+        ("Add › Mesh › Grid", "mesh.primitive_grid_add", {"x_subdivisions": 100, "y_subdivisions": 100, "size": 4.0}),
+        ("Object › Tessera › Add Displacement Map", "tessera.displacement_add", {}),
+        ("Displacement Brush", "tool:tessera.displacement_brush", {"radius": 80.0}),
+        ("drag", "drag", {}),
+    ), 4),
+    "terrain": ("terrain.md", (
+        ("Delete", "object.delete", {"confirm": False}),
+        ("Add › Tessera › Terrain from Height Map", "tessera.terrain_add",
+         {"filepath": "docs/samples/ridged_height_map.png", "texel_size": 0.01, "height_scale": 1.0}),
+    ), 0),
+    "vector_field": ("vector_field.md", (
+        ("Add › Tessera › Vector Field Texture", "tessera.vector_field_texture", {}),
+        ("Image Editor", "editor:IMAGE_EDITOR", {"image": "Vector Field"}),
+    ), 0),
 }
 SETTLE = 0.5
-DISTANCE = {"tubes": 3.5}  # how far the view stands from the origin, where 7 leaves the result small
+ROOT = Path(__file__).resolve().parents[3]  # the working tree, where a step's file lies
+DISTANCE = {"tubes": 3.5, "terrain": 9.0}  # how far the view stands from the origin, where 7 leaves the result small
 WIREFRAME = {"tessellation"}  # examples shown with the wireframe overlay: their point is where the triangles go
 
 
@@ -61,6 +87,51 @@ def _open_tessera_tab(w):
     w.click(ui.x + ui.width - 8, w.area.y + w.area.height - 300)
 
 
+def _drag(w):
+    """Drag with the left button across the middle of the viewport, from left to right, as a hand does it."""
+    region = w.region
+    y = region.y + region.height // 2
+    x0, x1 = region.x + region.width // 2 - 220, region.x + region.width // 2 + 220
+    w.event("MOUSEMOVE", "NOTHING", x=x0, y=y)
+    yield SETTLE
+    w.event("LEFTMOUSE", "PRESS", x=x0, y=y)
+    yield 0.1
+    for k in range(1, 25):
+        w.event("MOUSEMOVE", "NOTHING", x=x0 + (x1 - x0) * k // 24, y=y)
+        yield 0.05
+    w.event("LEFTMOUSE", "RELEASE", x=x1, y=y)
+    yield SETTLE
+    w.event("MOUSEMOVE", "NOTHING", x=x1, y=region.y + 40)  # the cursor off the stroke: its ring out of the way
+
+
+def _step(w, words, what, props):
+    """Run one step of an example; a generator where the step takes events (yield from it)."""
+    if what.startswith("tool:"):
+        with bpy.context.temp_override(**w.context()):
+            bpy.ops.wm.tool_set_by_id(name=what[len("tool:"):])
+        for name, value in props.items():
+            setattr(bpy.context.scene.tessera.brush, name, value)
+        from bl_ui.space_toolsystem_common import ToolSelectPanelHelper
+
+        helper = ToolSelectPanelHelper._tool_class_from_space_type("VIEW_3D")
+        item, tool, _ = helper._tool_get_active(bpy.context, "VIEW_3D", "OBJECT")
+        w.results.setdefault("tools", {})[words] = [tool.idname, item.label]  # the active tool and its button's label
+        return ()
+    if what == "drag":
+        return _drag(w)
+    if what.startswith("editor:"):
+        area = w.area
+        area.ui_type = what[len("editor:"):]
+        for name, value in props.items():
+            setattr(area.spaces.active, name, bpy.data.images[value] if name == "image" else value)
+        w.results.setdefault("editors", {})[words] = area.type
+        return ()
+    if "filepath" in props:  # a file of this repository, named from its root
+        props = dict(props, filepath=str(ROOT / props["filepath"]))
+    menu_step(w, words, what, props)
+    return ()
+
+
 def run(w):
     from mathutils import Euler
 
@@ -69,7 +140,7 @@ def run(w):
     rv3d = w.space.region_3d
     _open_tessera_tab(w)
     yield SETTLE
-    for example, (_, steps) in EXAMPLES.items():
+    for example, (_, steps, start) in EXAMPLES.items():
         _default_scene(w)
         rv3d.view_rotation = Euler((1.1, 0.0, 0.7)).to_quaternion()
         rv3d.view_perspective = "PERSP"
@@ -77,22 +148,53 @@ def run(w):
         rv3d.view_location = (0.0, 0.0, 0.0)
         w.space.overlay.show_wireframes = example in WIREFRAME
         yield SETTLE
-        for k, (words, idname, props) in enumerate(steps):
+        area = w.area
+        for k, (words, what, props) in enumerate(steps):
             print(f"@@ {example}: {words}", flush=True)
-            menu_step(w, words, idname, props)
+            yield from _step(w, words, what, props)
             yield SETTLE
             if k == 0:
                 empty = w.screenshot()
-            if k + 1 < len(steps) and k > 0 and steps[k + 1][1].startswith("tessera."):  # before the tool
-                w.redraw(2)
-                w.screenshot(f"shot_{example}_start", w.area)
+            if k + 1 == start:
+                _redraw(w, area)
+                w.screenshot(f"shot_{example}_start", area)
+            if what == "drag":
+                r[f"{example}_map_texels_changed"] = _map_changed(bpy.context.active_object)
         made = bpy.context.active_object
         if example in WIREFRAME:
             made.select_set(False)  # its wires grey, not the selection's orange (it stays active: its panels show)
-        r[f"{example}_made"] = made.name
-        evaluated = made.evaluated_get(bpy.context.evaluated_depsgraph_get())
-        r[f"{example}_faces"] = len(evaluated.data.polygons) if made.type == "MESH" else 0  # with its modifiers
-        r[f"{example}_pixels"] = int(silhouette(w.screenshot(), empty).sum())
-        w.redraw(2)
-        w.screenshot(f"shot_{example}", w.area)
-        r[f"{example}_tab"] = next(reg for reg in w.area.regions if reg.type == "UI").active_panel_category
+        if area.type == "VIEW_3D":
+            r[f"{example}_made"] = made.name
+            evaluated = made.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            r[f"{example}_faces"] = len(evaluated.data.polygons) if made.type == "MESH" else 0  # with modifiers
+            if made.type == "MESH":
+                evaluated.data.calc_loop_triangles()
+                r[f"{example}_triangles"] = len(evaluated.data.loop_triangles)
+            r[f"{example}_pixels"] = int(silhouette(w.screenshot(), empty).sum())
+        else:  # an image shown in its editor
+            image = area.spaces.active.image
+            pixels = np.array(image.pixels[:], np.float32).reshape(image.size[1], image.size[0], 4)
+            r[f"{example}_made"] = image.name
+            r[f"{example}_image_spread"] = float(pixels[..., :3].std())
+        _redraw(w, area)
+        w.screenshot(f"shot_{example}", area)
+        if area.type == "VIEW_3D":
+            r[f"{example}_tab"] = next(reg for reg in area.regions if reg.type == "UI").active_panel_category
+        else:
+            area.ui_type = "VIEW_3D"
+        with bpy.context.temp_override(**w.context()):
+            bpy.ops.wm.tool_set_by_id(name="builtin.select_box")  # Blender's default tool for the next example
+        yield SETTLE
+
+
+def _redraw(w, area):
+    """Draw the whole window now, whatever editor ``area`` shows, so the next screenshot shows the current state."""
+    region = next(reg for reg in area.regions if reg.type == "WINDOW")
+    with bpy.context.temp_override(window=w.window, screen=w.window.screen, area=area, region=region):
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+
+
+def _map_changed(ob):
+    """How many texels of ``ob``'s displacement map are away from zero height."""
+    image = ob.tessera.displacement.image
+    return int((np.abs(np.array(image.pixels[:], np.float32).reshape(-1, 4)[:, 0]) > 1e-6).sum())
