@@ -21,7 +21,7 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
         preview_notice(layout, context, s.enabled, "bake an impostor card (Bake Impostor)")
         layout.use_property_split = True
         layout.use_property_decorate = False
-        layout.prop(s, "enabled", text="Live Nailboard")
+        layout.prop(s, "enabled")
         col = layout.column()
         col.active = s.enabled
         for name in ("relief", "tolerance", "samples", "progressive", "lead"):

@@ -11,7 +11,7 @@ _changed = invalidator(TOPIC)
 
 class TESSERA_PG_impostors(bpy.types.PropertyGroup):
     enabled: bpy.props.BoolProperty(
-        name="Nailboard", default=False, update=_changed,
+        name="Live Nailboard", default=False, update=_changed,
         description="Draw this object in the viewport from a board rendered by Cycles in a background process "
                     "(colour, depth and normals) instead of its geometry, regenerated when the view makes it invalid")
     relief: bpy.props.BoolProperty(name="Relief Mapping", default=True, update=_changed,

@@ -6,10 +6,14 @@ and ``shot_<example>.png`` after the last. ``test_window_worked_examples.py`` ho
 A step is (the page's words, what it runs, arguments). What it runs is an operator (``"mesh.primitive_monkey_add"``,
 invoked in the 3D viewport as its menu entry runs it; a ``filepath`` is named from the repository's root),
 ``"tool:<id>"`` (a tool picked in the toolbar, arguments set in its header: the displacement brush's), ``"drag"`` (a
-left-button drag across the middle of the viewport, as injected mouse events) or ``"editor:<type>"`` (the viewport's
-editor type changed, arguments set on the new editor: ``{"image": "Vector Field"}``; changed back after the picture).
+left-button drag across the middle of the viewport, as injected mouse events), ``"panel:<idname>"`` (a sidebar panel
+opened by a Ctrl+click on its header, which closes the others), ``"check:<path>"`` (a checkbox of the
+sidebar ticked: the active object's property at that path; the step ends when its live board is drawn) or
+``"editor:<type>"`` (the viewport's editor type changed, arguments set on the new editor: ``{"image": "Vector
+Field"}``; changed back after the picture).
 """
 
+import time
 from pathlib import Path
 
 import bpy
@@ -58,12 +62,20 @@ EXAMPLES = {
         ("Add › Tessera › Terrain from Height Map", "tessera.terrain_add",
          {"filepath": "docs/samples/ridged_height_map.png", "texel_size": 0.01, "height_scale": 1.0}),
     ), 0),
+    "impostors": ("impostors.md", (
+        ("Delete", "object.delete", {"confirm": False}),
+        ("Add › Mesh › Monkey", "mesh.primitive_monkey_add", {}),
+        ("Object › Shade Smooth", "object.shade_smooth", {}),
+        ("Impostors", "panel:TESSERA_PT_impostors", {}),
+        ("Live Nailboard", "check:tessera.nailboard.enabled", {}),
+    ), 3),
     "vector_field": ("vector_field.md", (
         ("Add › Tessera › Vector Field Texture", "tessera.vector_field_texture", {}),
         ("Image Editor", "editor:IMAGE_EDITOR", {"image": "Vector Field"}),
     ), 0),
 }
 SETTLE = 0.5
+BOARD_S = 120.0  # the longest wait for a live board's first render (about 8 s on two cores)
 ROOT = Path(__file__).resolve().parents[3]  # the working tree, where a step's file lies
 DISTANCE = {"tubes": 3.5, "terrain": 9.0}  # how far the view stands from the origin, where 7 leaves the result small
 WIREFRAME = {"tessellation"}  # examples shown with the wireframe overlay: their point is where the triangles go
@@ -104,6 +116,49 @@ def _drag(w):
     w.event("MOUSEMOVE", "NOTHING", x=x1, y=region.y + 40)  # the cursor off the stroke: its ring out of the way
 
 
+def _boards_drawn(w, limit=BOARD_S):
+    """Wait (redrawing) until every live nailboard has its first board drawn, ``limit`` seconds at most."""
+    preview = w.module("addon.impostors.preview")
+    start = time.monotonic()
+    while time.monotonic() - start < limit:
+        w.redraw()
+        boards = list(preview.MANAGER.boards.values())
+        if all(live.images is not None and live.pending is None for live in boards):
+            break
+        yield 0.5
+    w.results["boards_drawn_s"] = round(time.monotonic() - start, 1)
+    w.results["boards_ready"] = sum(live.images is not None for live in preview.MANAGER.boards.values())
+
+
+def _open_panel(w, words, idname):
+    """Ctrl+click the header of the sidebar panel ``idname``, as an artist opens it: it opens and the others close.
+    The header is found in a screenshot of the sidebar: Tessera's panels shown for the active object, in their
+    order, each after the dark gap Blender draws between two panels."""
+    ui = next(reg for reg in w.area.regions if reg.type == "UI")
+    ctx = dict(w.context(), region=ui)
+    with bpy.context.temp_override(**ctx):
+        shown = sorted((cls for cls in bpy.types.Panel.__subclasses__() if getattr(cls, "bl_category", "") ==
+                        "Tessera" and cls.bl_region_type == "UI" and not getattr(cls, "bl_parent_id", "") and
+                        (not hasattr(cls, "poll") or cls.poll(bpy.context))), key=lambda cls: cls.bl_order)
+    index = [cls.bl_idname for cls in shown].index(idname)
+    w.results.setdefault("panels", {})[words] = shown[index].bl_label
+    w.redraw(2)
+    # the darkest of a few columns just inside the panels' left edge (the viewport shows through the sidebar)
+    column = w.screenshot(region=ui)[:, 14:21].astype(np.int16).max(axis=2).min(axis=1)
+    gaps = [y for y in range(1, len(column) - 3) if column[y - 1] - column[y] > 10 and column[y + 2] - column[y] > 10]
+    top = 0 if index == 0 else gaps[index - 1] + 3
+    if index == 0:
+        top = next(y for y in range(len(column)) if column[y] > 55)  # the first panel's top edge
+    x, y = ui.x + 60, ui.y + ui.height - (top + 12)
+    w.event("MOUSEMOVE", "NOTHING", x=x, y=y)
+    w.event("LEFT_CTRL", "PRESS", x=x, y=y)
+    w.event("LEFTMOUSE", "PRESS", x=x, y=y, ctrl=True)
+    w.event("LEFTMOUSE", "RELEASE", x=x, y=y, ctrl=True)
+    w.event("LEFT_CTRL", "RELEASE", x=x, y=y)
+    yield SETTLE
+    w.event("MOUSEMOVE", "NOTHING", x=w.region.x + 40, y=w.region.y + 40)  # off the sidebar: no highlight
+
+
 def _step(w, words, what, props):
     """Run one step of an example; a generator where the step takes events (yield from it)."""
     if what.startswith("tool:"):
@@ -119,6 +174,15 @@ def _step(w, words, what, props):
         return ()
     if what == "drag":
         return _drag(w)
+    if what.startswith("panel:"):
+        return _open_panel(w, words, what[len("panel:"):])
+    if what.startswith("check:"):
+        owner, _, name = what[len("check:"):].rpartition(".")
+        ob = bpy.context.active_object
+        target = ob.path_resolve(owner) if owner else ob
+        setattr(target, name, True)
+        w.results.setdefault("checks", {})[words] = target.bl_rna.properties[name].name
+        return _boards_drawn(w)
     if what.startswith("editor:"):
         area = w.area
         area.ui_type = what[len("editor:"):]
