@@ -35,6 +35,14 @@ def pictures(example):
     return [f"{example}_start", example] if start else [example]
 
 
+def test_every_capability_page_has_a_worked_example_run_in_the_window():
+    """Each capability (a package of kernels/, its page in docs/) and the node groups' page: a worked example that the
+    scenario runs."""
+    capabilities = {p.name for p in (ROOT / "kernels").iterdir() if p.is_dir() and (p / "__init__.py").exists()}
+    pages = {f"{name}.md" for name in capabilities - {"common"}} | {"node_groups.md"}
+    assert len(pages) >= 9 and pages <= {page for page, _, _ in EXAMPLES.values()}, pages
+
+
 def steps_run(example):
     """What each step of ``example`` runs."""
     return [what for _, what, _ in EXAMPLES[example][1]]

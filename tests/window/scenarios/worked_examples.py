@@ -3,8 +3,11 @@ page names, in order (`EXAMPLES`), with the sidebar open on its Tessera tab. The
 ``tools/manual_shots.sh``: ``shot_<example>_start.png`` after the first ``start`` steps (when the example names one)
 and ``shot_<example>.png`` after the last. ``test_window_worked_examples.py`` holds each page to its steps.
 
-A step is (the page's words, what it runs, arguments). What it runs is an operator (``"mesh.primitive_monkey_add"``,
-invoked in the 3D viewport as its menu entry runs it; a ``filepath`` is named from the repository's root),
+A step is (the page's words, what it runs, arguments). What it runs is an operator (``"mesh.primitive_monkey_add"``),
+run from Blender's menu search (F3, its label, Enter) as a click on its menu entry runs it, its arguments the settings
+it remembers, so that its redo panel opens as after a click (the pictures show it); ``object.delete`` is X then Enter;
+an operator given a ``filepath`` (named from the repository's root) is invoked from Python instead, as its file
+browser would run it;
 ``"tool:<id>"`` (a tool picked in the toolbar, arguments set in its header: the displacement brush's), ``"drag"`` (a
 left-button drag across the middle of the viewport, as injected mouse events), ``"panel:<idname>"`` (a sidebar panel
 opened by a Ctrl+click on its header, which closes the others), ``"check:<path>"`` (a checkbox of the
@@ -14,6 +17,7 @@ Field"}``; changed back after the picture).
 """
 
 import time
+import unicodedata
 from pathlib import Path
 
 import bpy
@@ -159,6 +163,63 @@ def _open_panel(w, words, idname):
     w.event("MOUSEMOVE", "NOTHING", x=w.region.x + 40, y=w.region.y + 40)  # off the sidebar: no highlight
 
 
+def _keys(w, key, x, y):
+    """Press and release ``key`` at window point (x, y)."""
+    w.event(key, "PRESS", x=x, y=y)
+    w.event(key, "RELEASE", x=x, y=y)
+
+
+def _typed(w, text, x, y):
+    """Type ``text`` (letters, accented too, and spaces) with injected key events at window point (x, y)."""
+    for char in text:
+        plain = unicodedata.normalize("NFKD", char)[0].upper()  # é: the E key, typing é
+        key = "SPACE" if char == " " else plain
+        w.event(key, "PRESS", x=x, y=y, unicode=char)
+        w.event(key, "RELEASE", x=x, y=y)
+
+
+def _searched(w, words, idname, props):
+    """Run operator ``idname`` from Blender's menu search (F3, its label, Enter), as a click on its menu entry runs it:
+    its redo panel opens (opened further when collapsed). ``props`` become the settings the operator remembers, which
+    a run from a menu starts from. Fails when the search ran another operator."""
+    module, name = idname.split(".")
+    op = getattr(getattr(bpy.ops, module), name)
+    label = op.get_rna_type().name
+    w.results.setdefault("labels", {})[words] = label
+    wm = bpy.context.window_manager
+    last = wm.operator_properties_last(idname)
+    for key, value in props.items():
+        setattr(last, key, value)
+    x, y = w.region.x + w.region.width // 2, w.region.y + w.region.height // 2
+    w.event("MOUSEMOVE", "NOTHING", x=x, y=y)
+    if idname == "object.delete":  # X asks to confirm; Enter confirms
+        props = {}
+        _keys(w, "X", x, y)
+    else:
+        _keys(w, "F3", x, y)
+        yield SETTLE
+        submenu = w.module("addon.menus").ENUM_MENUS.get(idname)  # a menu entry per item: type the item's name too
+        _typed(w, f"{label} {props[submenu]}" if submenu in props else label, x, y)
+    yield SETTLE
+    _keys(w, "RET", x, y)
+    yield SETTLE
+    ran = wm.operators[-1].bl_idname if len(wm.operators) else None
+    if ran != op.idname():
+        raise RuntimeError(f"the menu search for {label!r} ran {ran}, not {op.idname()}")
+    used = wm.operators[-1].properties
+    wrong = {key: getattr(used, key) for key, value in props.items()
+             if (abs(getattr(used, key) - value) > 1e-6 if isinstance(value, float) else getattr(used, key) != value)}
+    if wrong:
+        raise RuntimeError(f"the menu search ran {label} with {wrong}, not {props}")
+    hud = next((reg for reg in w.area.regions if reg.type == "HUD"), None)
+    if hud is None:
+        raise RuntimeError(f"no redo panel after {label}")
+    if hud.height < 40:  # collapsed to its header: open it, as the artist's click on the header does
+        w.click(hud.x + 20, hud.y + hud.height - 10)
+        yield SETTLE
+    w.event("MOUSEMOVE", "NOTHING", x=w.region.x + w.region.width - 60, y=y)  # off the panel: no highlight
+
+
 def _step(w, words, what, props):
     """Run one step of an example; a generator where the step takes events (yield from it)."""
     if what.startswith("tool:"):
@@ -190,10 +251,10 @@ def _step(w, words, what, props):
             setattr(area.spaces.active, name, bpy.data.images[value] if name == "image" else value)
         w.results.setdefault("editors", {})[words] = area.type
         return ()
-    if "filepath" in props:  # a file of this repository, named from its root
-        props = dict(props, filepath=str(ROOT / props["filepath"]))
-    menu_step(w, words, what, props)
-    return ()
+    if "filepath" in props:  # a file of this repository, named from its root: as the file browser runs it
+        menu_step(w, words, what, dict(props, filepath=str(ROOT / props["filepath"])))
+        return ()
+    return _searched(w, words, what, props)
 
 
 def run(w):
@@ -218,7 +279,7 @@ def run(w):
             yield from _step(w, words, what, props)
             yield SETTLE
             if k == 0:
-                empty = w.screenshot()
+                empty, empty_hud = w.screenshot(), _hud(w)
             if k + 1 == start:
                 _redraw(w, area)
                 w.screenshot(f"shot_{example}_start", area)
@@ -234,7 +295,7 @@ def run(w):
             if made.type == "MESH":
                 evaluated.data.calc_loop_triangles()
                 r[f"{example}_triangles"] = len(evaluated.data.loop_triangles)
-            r[f"{example}_pixels"] = int(silhouette(w.screenshot(), empty).sum())
+            r[f"{example}_pixels"] = _scene_pixels(w.screenshot(), empty, (empty_hud, _hud(w)))
         else:  # an image shown in its editor
             image = area.spaces.active.image
             pixels = np.array(image.pixels[:], np.float32).reshape(image.size[1], image.size[0], 4)
@@ -249,6 +310,24 @@ def run(w):
         with bpy.context.temp_override(**w.context()):
             bpy.ops.wm.tool_set_by_id(name="builtin.select_box")  # Blender's default tool for the next example
         yield SETTLE
+
+
+def _hud(w):
+    """The redo panel's rectangle in viewport screenshots as (rows, columns) slices, or None when none is shown."""
+    region = w.region
+    for hud in (reg for reg in w.area.regions if reg.type == "HUD" and reg.width > 1):
+        top = max(0, region.y + region.height - (hud.y + hud.height))
+        left = max(0, hud.x - region.x)
+        return slice(top, top + hud.height), slice(left, left + hud.width)
+    return None
+
+
+def _scene_pixels(image, empty, huds):
+    """Pixels where ``image`` shows something ``empty`` does not, outside the redo panels ``huds`` of either."""
+    image, empty = image.copy(), empty.copy()
+    for hud in filter(None, huds):
+        image[hud] = empty[hud] = 0
+    return int(silhouette(image, empty).sum())
 
 
 def _redraw(w, area):
