@@ -43,7 +43,7 @@ import bpy
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "out"
+OUT = Path(os.environ.get("TESSERA_DEMO_OUT", ROOT / "out"))  # where the pictures and files go
 LEVEL = 4
 
 
@@ -720,6 +720,19 @@ def render(name, color_type="MATERIAL", light="STUDIO"):
     scene.world.color = (0.9, 0.9, 0.92)
     scene.render.filepath = str(OUT / name)
     bpy.ops.render.render(write_still=True)
+
+
+def caption_figures():
+    """The figures the manual's captions of these pictures give, from the scenes built as `main` builds them, without
+    rendering (``tests/common/test_blender_demo_figures.py`` holds the captions to them)."""
+    source, results = build_methods_scene()
+    figures = {"methods_triangles": {method: len(ob.data.polygons) for method, (ob, _) in results.items()},
+               "adaptive_triangles": build_adaptive_scene()}
+    figures["terrain_triangles"], figures["terrain_full_grid"] = build_terrain_scene()
+    rows = build_loop_scene()
+    figures["loop_triangles"] = {name: tris for name, tris, _ in rows}
+    figures["node_groups_faces"] = build_node_groups_scene()
+    return figures
 
 
 def main():
