@@ -60,14 +60,14 @@ def test_terrain_caption(figures):
 
 
 def test_loop_caption(figures):
-    coarse, level2 = caption("subdivision.md", r"Suzanne \(([\d,]+) triangles after its quads are split\), Loop level 2 "
-                                               r"\(([\d,]+) triangles\)")
+    coarse, level2 = caption("subdivision.md", r"Suzanne \(([\d,]+) triangles after its quads are split\), "
+                                               r"Loop level 2 \(([\d,]+) triangles\)")
     assert number(level2) == figures["loop_triangles"]["Suzanne"] == 16 * number(coarse)
 
 
 def test_node_groups_caption(figures):
-    pn, terrain = caption("node_groups.md", r"(?s)Subdivisions 2, ([\d,]+)\s+faces\).*?([\d,]+) faces, a quarter of the "
-                                            r"full grid")
+    pn, terrain = caption("node_groups.md", r"(?s)Subdivisions 2, ([\d,]+)\s+faces\).*?([\d,]+) faces, a quarter "
+                                            r"of the full grid")
     pn_faces, _, _, terrain_faces = figures["node_groups_faces"]
     assert (number(pn), number(terrain)) == (pn_faces, terrain_faces)
     assert terrain_faces == 128 ** 2 // 4  # the 129² image: 128² quads in the full grid

@@ -1,5 +1,5 @@
-"""The manual's worked examples in a real Blender window: each starts from Blender's default scene and runs the steps its
-page names, in order (`EXAMPLES`), with the sidebar open on its Tessera tab. The pictures go to the manual through
+"""The manual's worked examples in a real Blender window: each starts from Blender's default scene and runs the steps
+its page names, in order (`EXAMPLES`), with the sidebar open on its Tessera tab. The pictures go to the manual through
 ``tools/manual_shots.sh``: ``shot_<example>_start.png`` after the first ``start`` steps (when the example names one)
 and ``shot_<example>.png`` after the last. ``test_window_worked_examples.py`` holds each page to its steps.
 
@@ -7,13 +7,12 @@ A step is (the page's words, what it runs, arguments). What it runs is an operat
 run from Blender's menu search (F3, its label, Enter) as a click on its menu entry runs it, its arguments the settings
 it remembers, so that its redo panel opens as after a click (the pictures show it); ``object.delete`` is X then Enter;
 an operator given a ``filepath`` (named from the repository's root) is invoked from Python instead, as its file
-browser would run it;
-``"tool:<id>"`` (a tool picked in the toolbar, arguments set in its header: the displacement brush's), ``"drag"`` (a
-left-button drag across the middle of the viewport, as injected mouse events), ``"panel:<idname>"`` (a sidebar panel
-opened by a Ctrl+click on its header, which closes the others), ``"check:<path>"`` (a checkbox of the
-sidebar ticked: the active object's property at that path; the step ends when its live board is drawn) or
-``"editor:<type>"`` (the viewport's editor type changed, arguments set on the new editor: ``{"image": "Vector
-Field"}``; changed back after the picture).
+browser would run it; ``"tool:<id>"`` (a tool picked in the toolbar, arguments set in its header: the displacement
+brush's), ``"drag"`` (a left-button drag across the middle of the viewport, as injected mouse events),
+``"panel:<idname>"`` (a sidebar panel opened by a Ctrl+click on its header, which closes the others),
+``"check:<path>"`` (a checkbox of the sidebar ticked: the active object's property at that path; the step ends when
+its live board is drawn) or ``"editor:<type>"`` (the viewport's editor type changed, arguments set on the new editor:
+``{"image": "Vector Field"}``; changed back after the picture).
 """
 
 import time
@@ -24,7 +23,8 @@ import bpy
 import numpy as np
 from common import menu_step, silhouette
 
-#: example -> (the page in docs/, ((the page's words, what it runs, arguments), ...), steps before the start picture or 0)
+#: example -> (its page in docs/, ((the page's words, what it runs, arguments), ...), steps before the start picture
+#: or 0 for none)
 EXAMPLES = {
     "tessellation": ("tessellation.md", (
         ("Delete", "object.delete", {"confirm": False}),
