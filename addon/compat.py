@@ -121,6 +121,16 @@ def menu_input_value(tree, item, label):
         item.default_value = old
 
 
+def has_denoiser():
+    """True when this Blender's Cycles has OpenImageDenoise (official builds do; some distributions' builds do not):
+    without it Cycles renders keep their grain whatever the scene's denoising setting."""
+    try:
+        import _cycles
+    except ImportError:
+        return False
+    return bool(getattr(_cycles, "with_openimagedenoise", False))
+
+
 def has_uv_tangent_node():
     """True when this Blender has the UV Tangent geometry node (5.0 and newer)."""
     return hasattr(bpy.types, "GeometryNodeUVTangent")

@@ -4,8 +4,9 @@ background) and the baked impostor card."""
 import bpy
 
 from ...kernels.common.errors import InvalidInputError
+from .. import compat
 from ..guarded import check_numbers
-from ..sidebar import Sidebar, active_object, panel_order, preview_notice
+from ..sidebar import Sidebar, active_object, panel_order, preview_notice, wrapped_label
 from .preview import MANAGER
 
 
@@ -34,9 +35,17 @@ class TESSERA_PT_impostors(Sidebar, bpy.types.Panel):
             live = MANAGER.boards.get(active_object(context).session_uid)
             state = live.state if live is not None else "Waiting for the first render"
             col.label(text=state, icon="ERROR" if state.startswith("Failed") else "INFO")
+        denoiser_notice(layout, context)
         row = layout.row()
         row.scale_y = 1.4
         row.operator("tessera.impostor_bake", icon="IMAGE_PLANE")
+
+
+def denoiser_notice(layout, context):
+    """Where this Blender's Cycles has no denoiser: boards and cards keep their grain, and more samples is the cure."""
+    if not compat.has_denoiser():
+        wrapped_label(layout.box(), context, "This Blender has no denoiser (OpenImageDenoise), so boards and cards "
+                      "keep Cycles' grain: raise Samples (64 or more) for smoother ones.", icon="INFO")
 
 
 classes = (TESSERA_PT_impostors,)

@@ -7,6 +7,22 @@ import pytest
 pytestmark = pytest.mark.blender
 
 
+class LabelLayout:
+    """A stand-in for a panel's layout that keeps the text of each label drawn into it (boxes and columns: itself)."""
+
+    def __init__(self):
+        self.labels = []
+
+    def box(self):
+        return self
+
+    def column(self, align=False):
+        return self
+
+    def label(self, text="", icon="NONE"):
+        self.labels.append(text)
+
+
 def shown(bpy, addon_module):
     """The bl_labels of the Tessera panels the active object gets, top first."""
     sidebar = addon_module("addon.sidebar")
@@ -58,21 +74,8 @@ def test_material_preview_and_rendered_say_how_to_render_the_result(clean_scene,
 
     sidebar = addon_module("addon.sidebar")
 
-    class Layout:
-        def __init__(self):
-            self.labels = []
-
-        def box(self):
-            return self
-
-        def column(self, align=False):
-            return self
-
-        def label(self, text="", icon="NONE"):
-            self.labels.append(text)
-
     def said(shading, on):
-        layout = Layout()
+        layout = LabelLayout()
         context = SimpleNamespace(space_data=SimpleNamespace(shading=SimpleNamespace(type=shading)),
                                   region=SimpleNamespace(width=320), preferences=bpy_module.context.preferences)
         sidebar.preview_notice(layout, context, on, "apply it (Tessellate)")
@@ -80,3 +83,24 @@ def test_material_preview_and_rendered_say_how_to_render_the_result(clean_scene,
 
     assert "apply it (Tessellate)" in said("MATERIAL", True) and "Solid" in said("RENDERED", True)
     assert said("SOLID", True) == "" and said("RENDERED", False) == ""
+
+
+def test_the_impostors_panel_says_when_this_blender_has_no_denoiser(bpy_module, addon_module, monkeypatch):
+    """A Blender whose Cycles lacks OpenImageDenoise (some distributions' builds) renders grainy boards and cards: the
+    Impostors panel says so and what to raise; with the denoiser it says nothing."""
+    from types import SimpleNamespace
+
+    compat, panel = addon_module("addon.compat"), addon_module("addon.impostors.panel")
+    import _cycles
+
+    assert compat.has_denoiser() == bool(getattr(_cycles, "with_openimagedenoise", False))
+
+    def said(has):
+        monkeypatch.setattr(compat, "has_denoiser", lambda: has)
+        layout = LabelLayout()
+        panel.denoiser_notice(layout, SimpleNamespace(region=SimpleNamespace(width=320),
+                                                      preferences=bpy_module.context.preferences))
+        return " ".join(layout.labels)
+
+    assert "no denoiser" in said(False) and "Samples" in said(False)
+    assert said(True) == ""
