@@ -112,3 +112,43 @@ def test_a_progressive_board_writes_its_preview_first(clean_scene, bpy_module, a
     few.result(timeout=240)
     few.poll()
     assert few.preview() is None  # one sample: nothing to preview
+
+
+def _shrunk(mask, steps):
+    """``mask`` (H, W) bool less ``steps`` texels along its outline (4-neighbour erosion)."""
+    for _ in range(steps):
+        pad = np.pad(mask, 1)
+        mask = pad[1:-1, 1:-1] & pad[:-2, 1:-1] & pad[2:, 1:-1] & pad[1:-1, :-2] & pad[1:-1, 2:]
+    return mask
+
+
+def _grown(mask, steps):
+    """``mask`` (H, W) bool plus ``steps`` texels around its outline (4-neighbour dilation)."""
+    return ~_shrunk(~mask, steps)
+
+
+def test_a_monkey_board_prewarped_for_a_moved_eye_has_no_holes_inside_its_outline(clean_scene, bpy_module,
+                                                                                   addon_module):
+    """A real Cycles board of a smooth Suzanne (ears in front of the head, edge texels whose one depth sample hit the
+    background), pre-warped as the viewport does it for the board's own eye and for eyes moved a little sideways and
+    up: the splat alone opens thousands of gaps (texels in front of the board's plane spread apart), and
+    `fill_holes` with the preview's gap closes every one inside the object's outline (the depth-buffered splat's,
+    small gaps closed, two texels in), so nothing of the viewport shows through the object."""
+    bpy = bpy_module
+    worker, pw = addon_module("addon.impostors.worker"), addon_module("kernels.impostors.prewarp")
+    gap = addon_module("addon.impostors.preview").HOLE_GAP
+    bpy.ops.mesh.primitive_monkey_add()
+    monkey = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    eye = np.array([4.5, -5.0, 3.5])
+    board = worker.request_board(monkey, eye, res_screen=500, fov=np.radians(40), samples=2).result(timeout=240)
+    assert board.present.sum() > 10000
+    for moved in ([0.0, 0.0, 0.0], [0.4, 0.0, 0.0], [0.0, 0.3, 0.4]):
+        target = eye + np.array(moved)
+        splat = pw.forward_splat(board.displacement, board.setup.frame, target, board.present)
+        drawn = pw.fill_holes(splat, gap)
+        oracle = pw.zbuffer_splat(board.displacement, board.setup.frame, target, board.present)
+        inside = _shrunk(_grown(oracle.source >= 0, 3), 5)  # its outline, small gaps closed, two texels in
+        holes = (drawn.source < 0) & inside
+        raw = (splat.source < 0) & inside
+        assert raw.sum() > 1000 and holes.sum() == 0, (moved, int(raw.sum()), int(holes.sum()))  # the fill closes all
