@@ -1,6 +1,7 @@
 """The figures the manual's demo captions give are what the demo's scenes make (tier: blender): the scenes built as
 ``make demo`` builds them (`samples/demo.py`'s ``caption_figures``, no rendering), in a Blender process of their own,
-then each caption read from its page. A changed default, level rule or scene changes the figure, and this fails until
+then each caption read from its page (the captions give ``make demo``'s figures: the newest supported Blender's where
+Blender's own nodes make them). A changed default, level rule or scene changes the figure, and this fails until
 the caption says the new one."""
 
 import json
@@ -65,9 +66,21 @@ def test_loop_caption(figures):
     assert number(level2) == figures["loop_triangles"]["Suzanne"] == 16 * number(coarse)
 
 
+def docs_blender():
+    """(major, minor) of the Blender ``make demo`` runs, the newest supported (requirements/blender-X.Y.txt)."""
+    return max(tuple(int(n) for n in p.stem.removeprefix("blender-").split("."))
+               for p in (ROOT / "requirements").glob("blender-*.txt"))
+
+
 def test_node_groups_caption(figures):
     pn, terrain = caption("node_groups.md", r"(?s)Subdivisions 2, ([\d,]+)\s+faces\).*?([\d,]+) faces, a quarter "
                                             r"of the full grid")
     pn_faces, _, _, terrain_faces = figures["node_groups_faces"]
-    assert (number(pn), number(terrain)) == (pn_faces, terrain_faces)
+    assert number(terrain) == terrain_faces
+    import bpy
+
+    if bpy.app.version[:2] == docs_blender():
+        assert number(pn) == pn_faces
+    else:  # Blender's own Subdivide Mesh node, which the group runs, differs a little by version (4.5: 12 more quads)
+        assert abs(number(pn) - pn_faces) <= 0.005 * pn_faces, (number(pn), pn_faces)
     assert terrain_faces == 128 ** 2 // 4  # the 129² image: 128² quads in the full grid
