@@ -73,9 +73,13 @@ class Window:
 
         return importlib.import_module(f"{ADDON}.{name}")
 
-    def redraw(self, iterations=1):
-        """Draw the whole window now (Blender's own redraw timer), so the next screenshot shows the current state."""
-        with bpy.context.temp_override(**self.context()):
+    def redraw(self, iterations=1, area=None):
+        """Draw the whole window now (Blender's own redraw timer), so the next screenshot shows the current state;
+        ``area``: the area whose context runs it when the 3D viewport is not there (it shows another editor)."""
+        context = self.context() if area is None else {
+            "window": self.window, "screen": self.window.screen, "area": area,
+            "region": next(r for r in area.regions if r.type == "WINDOW")}
+        with bpy.context.temp_override(**context):
             bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=iterations)
 
     def screenshot(self, name=None, region=None):
@@ -97,8 +101,13 @@ class Window:
 
     def click(self, x, y, button="LEFTMOUSE"):
         self.event("MOUSEMOVE", "NOTHING", x=x, y=y)
-        self.event(button, "PRESS", x=x, y=y)
-        self.event(button, "RELEASE", x=x, y=y)
+        self.key(button, x, y)
+
+    def key(self, key, x, y, **kw):
+        """Press and release ``key`` (or a mouse button) at window point (x, y); ``kw``: ``ctrl=True``, ``unicode``."""
+        self.event(key, "PRESS", x=x, y=y, **kw)
+        kw.pop("unicode", None)
+        self.event(key, "RELEASE", x=x, y=y, **kw)
 
 
 def main():

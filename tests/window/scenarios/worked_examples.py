@@ -139,34 +139,24 @@ def _open_panel(w, words, idname):
     The header is found in a screenshot of the sidebar: Tessera's panels shown for the active object, in their
     order, each after the dark gap Blender draws between two panels."""
     ui = next(reg for reg in w.area.regions if reg.type == "UI")
-    ctx = dict(w.context(), region=ui)
-    with bpy.context.temp_override(**ctx):
-        shown = sorted((cls for cls in bpy.types.Panel.__subclasses__() if getattr(cls, "bl_category", "") ==
-                        "Tessera" and cls.bl_region_type == "UI" and not getattr(cls, "bl_parent_id", "") and
-                        (not hasattr(cls, "poll") or cls.poll(bpy.context))), key=lambda cls: cls.bl_order)
-    index = [cls.bl_idname for cls in shown].index(idname)
+    with bpy.context.temp_override(**dict(w.context(), region=ui)):
+        shown = [panel for panel in (getattr(bpy.types, name, None) for name in w.module("addon.sidebar").PANEL_ORDER)
+                 if panel is not None and panel.poll(bpy.context)]
+    index = [panel.bl_idname for panel in shown].index(idname)
     w.results.setdefault("panels", {})[words] = shown[index].bl_label
     w.redraw(2)
     # the darkest of a few columns just inside the panels' left edge (the viewport shows through the sidebar)
     column = w.screenshot(region=ui)[:, 14:21].astype(np.int16).max(axis=2).min(axis=1)
     gaps = [y for y in range(1, len(column) - 3) if column[y - 1] - column[y] > 10 and column[y + 2] - column[y] > 10]
-    top = 0 if index == 0 else gaps[index - 1] + 3
-    if index == 0:
-        top = next(y for y in range(len(column)) if column[y] > 55)  # the first panel's top edge
+    # a panel's top edge: the first panel's where the sidebar starts, each other's just after the gap before it
+    top = gaps[index - 1] + 3 if index else next(y for y in range(len(column)) if column[y] > 55)
     x, y = ui.x + 60, ui.y + ui.height - (top + 12)
     w.event("MOUSEMOVE", "NOTHING", x=x, y=y)
     w.event("LEFT_CTRL", "PRESS", x=x, y=y)
-    w.event("LEFTMOUSE", "PRESS", x=x, y=y, ctrl=True)
-    w.event("LEFTMOUSE", "RELEASE", x=x, y=y, ctrl=True)
+    w.key("LEFTMOUSE", x, y, ctrl=True)
     w.event("LEFT_CTRL", "RELEASE", x=x, y=y)
     yield SETTLE
     w.event("MOUSEMOVE", "NOTHING", x=w.region.x + 40, y=w.region.y + 40)  # off the sidebar: no highlight
-
-
-def _keys(w, key, x, y):
-    """Press and release ``key`` at window point (x, y)."""
-    w.event(key, "PRESS", x=x, y=y)
-    w.event(key, "RELEASE", x=x, y=y)
 
 
 def _typed(w, text, x, y):
@@ -174,8 +164,7 @@ def _typed(w, text, x, y):
     for char in text:
         plain = unicodedata.normalize("NFKD", char)[0].upper()  # é: the E key, typing é
         key = "SPACE" if char == " " else plain
-        w.event(key, "PRESS", x=x, y=y, unicode=char)
-        w.event(key, "RELEASE", x=x, y=y)
+        w.key(key, x, y, unicode=char)
 
 
 def _searched(w, words, idname, props):
@@ -194,14 +183,14 @@ def _searched(w, words, idname, props):
     w.event("MOUSEMOVE", "NOTHING", x=x, y=y)
     if idname == "object.delete":  # X asks to confirm; Enter confirms
         props = {}
-        _keys(w, "X", x, y)
+        w.key("X", x, y)
     else:
-        _keys(w, "F3", x, y)
+        w.key("F3", x, y)
         yield SETTLE
         submenu = w.module("addon.menus").ENUM_MENUS.get(idname)  # a menu entry per item: type the item's name too
         _typed(w, f"{label} {props[submenu]}" if submenu in props else label, x, y)
     yield SETTLE
-    _keys(w, "RET", x, y)
+    w.key("RET", x, y)
     yield SETTLE
     ran = wm.operators[-1].bl_idname if len(wm.operators) else None
     if ran != op.idname():
@@ -281,7 +270,7 @@ def run(w):
             if k == 0:
                 empty, empty_hud = w.screenshot(), _hud(w)
             if k + 1 == start:
-                _redraw(w, area)
+                w.redraw(2, area)
                 w.screenshot(f"shot_{example}_start", area)
             if what == "drag":
                 r[f"{example}_map_texels_changed"] = _map_changed(bpy.context.active_object)
@@ -301,7 +290,7 @@ def run(w):
             pixels = np.array(image.pixels[:], np.float32).reshape(image.size[1], image.size[0], 4)
             r[f"{example}_made"] = image.name
             r[f"{example}_image_spread"] = float(pixels[..., :3].std())
-        _redraw(w, area)
+        w.redraw(2, area)
         w.screenshot(f"shot_{example}", area)
         if area.type == "VIEW_3D":
             r[f"{example}_tab"] = next(reg for reg in area.regions if reg.type == "UI").active_panel_category
@@ -328,13 +317,6 @@ def _scene_pixels(image, empty, huds):
     for hud in filter(None, huds):
         image[hud] = empty[hud] = 0
     return int(silhouette(image, empty).sum())
-
-
-def _redraw(w, area):
-    """Draw the whole window now, whatever editor ``area`` shows, so the next screenshot shows the current state."""
-    region = next(reg for reg in area.regions if reg.type == "WINDOW")
-    with bpy.context.temp_override(window=w.window, screen=w.window.screen, area=area, region=region):
-        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
 
 
 def _map_changed(ob):
