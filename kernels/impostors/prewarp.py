@@ -203,10 +203,18 @@ def _fill_rows(source, max_gap=None):
     return np.where(painted, source, np.where(ok, filled, -1))
 
 
-def fill_holes(splat, max_gap=None):
+def fill_holes(splat, max_gap=None, passes=4):
     """Two 1-D passes ([Clua et al., correction 7]: the paper leaves the method open): holes take the nearest
     painted texel of their row, then what is left the nearest of its column. ``max_gap`` (texels): fill only runs of
     holes enclosed on both sides and at most that long, so an object's outline stays where it is (None: every hole
-    of a row or column with something painted). A new `Splat`."""
-    rows = _fill_rows(splat.source, max_gap)
-    return Splat(_fill_rows(rows.T, max_gap).T)
+    of a row or column with something painted). With ``max_gap`` the two passes repeat while they fill anything, at
+    most ``passes`` times: where the eye magnifies the relief (its front seen off the board's axis) the gaps run
+    longer than ``max_gap`` both ways, and only the column pass shortens a row's run enough for the next row pass.
+    A new `Splat`."""
+    source = splat.source
+    for _ in range(max(1, passes) if max_gap is not None else 1):
+        filled = _fill_rows(_fill_rows(source, max_gap).T, max_gap).T
+        if np.array_equal(filled, source):
+            break
+        source = filled
+    return Splat(source)

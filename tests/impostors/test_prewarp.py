@@ -114,3 +114,37 @@ def test_no_holes_left_for_a_smooth_height_field_under_moderate_view_changes():
         painted = raw.source >= 0
         assert np.array_equal(filled.source[painted], raw.source[painted])  # painted texels are kept
     assert fractions[-1] > fractions[0]  # the raw holes grow with the view change; filled, there are none
+
+
+def _along_rows(painted):
+    """Texels with something painted on both sides along their row (or painted): (H, W) bool."""
+    return np.maximum.accumulate(painted, axis=1) & np.maximum.accumulate(painted[:, ::-1], axis=1)[:, ::-1]
+
+
+def _enclosed(painted):
+    """Texels enclosed along their row and along their column: (H, W) bool."""
+    return _along_rows(painted) & _along_rows(painted.T).T
+
+
+@pytest.mark.parametrize("eye", ([0.3, 0.2, 5.4], [0.6, 0.0, 5.0]))
+def test_a_sphere_seen_off_its_boards_axis_keeps_no_hole_inside_its_outline(eye):
+    """The live board of a sphere, its plane behind it (displacements 1.75 to 2.75) and the eye moved off the axis
+    it was rendered along: the front's texels spread into gaps longer than the preview's gap both ways, which one row
+    and column pass leaves (the viewport showed them as specks through the board); the passes repeat until none is
+    left inside the outline, and nothing is painted outside the outline (of the depth-buffered splat, closed along rows and columns)."""
+    n = 200
+    y, x = (np.mgrid[0:n, 0:n] + 0.5) / n * 2.6 - 1.3
+    present = x * x + y * y < 1.0
+    d = np.where(present, 1.75 + np.sqrt(np.clip(1.0 - x * x - y * y, 0.0, None)), 0.0)
+    size = 2.6 / n
+    frame = pw.ReliefFrame(np.array([-1.3, -1.3, 0.0]), np.array([size, 0, 0]), np.array([0, size, 0]),
+                           np.array([0, 0, 1.0]))
+    raw = pw.forward_splat(d, frame, np.array(eye), present)
+    once = pw.fill_holes(raw, 4, passes=1)
+    filled = pw.fill_holes(raw, 4)
+    assert (_enclosed(once.source >= 0) & (once.source < 0)).sum() > 10  # what one pass left
+    assert (_enclosed(filled.source >= 0) & (filled.source < 0)).sum() == 0
+    oracle = pw.zbuffer_splat(d, frame, np.array(eye), present).source >= 0
+    columns_then_rows = _along_rows(_along_rows(oracle.T).T)
+    outside = ~(columns_then_rows | _along_rows(_along_rows(oracle).T).T)  # the sphere's outline is convex
+    assert outside.sum() > 2000 and (filled.source[outside] < 0).all()  # nothing painted outside the outline
