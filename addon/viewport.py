@@ -272,6 +272,40 @@ def preview_style(context, ob):
     return style
 
 
+_outlined = []  # (draw(color), outline id) of the previews the current draw handler drew for selected objects
+
+
+def outline(context, ob, draw):
+    """Outline ``ob``'s preview as Blender outlines a selected object (its overlay outlines the object's own
+    geometry, which the preview hides): when ``ob`` is selected and the viewport draws outlines (overlays on, Outline
+    Selected on, not Wireframe shading), ``draw(color)`` (the preview drawn flat, unlit, in ``color``) is kept for
+    the outline the draw handler adds once its preview has drawn (`gpu_shaders.outline`)."""
+    space = context.space_data
+    overlay = space.overlay
+    if not ob.select_get() or space.shading.type == "WIREFRAME" or not overlay.show_overlays \
+            or not overlay.show_outline_selected:
+        return
+    from ..gpu_shaders.outline import ACTIVE_ID, SELECTED_ID
+
+    _outlined.append((draw, ACTIVE_ID if ob == context.view_layer.objects.active else SELECTED_ID))
+
+
+def _draw_outlines(context, region):
+    """The outline of what `outline` kept, over the viewport: in the theme's selected and active colours, two pixels
+    a side at a resolution scale above 1.5, as bright behind other objects as in front in X-ray."""
+    from ..gpu_shaders import outline as gpu_outline
+
+    try:
+        shader = gpu_outline.shader()
+    except GPUShaderError:
+        return  # told once by the loader: previews draw on, without outlines
+    theme = context.preferences.themes[0].view_3d
+    mask = gpu_outline.mask_for((region.width, region.height))
+    mask.draw(_outlined)
+    gpu_outline.resolve(shader, mask, (*_linear(theme.object_selected), 1.0), (*_linear(theme.object_active), 1.0),
+                        thick=context.preferences.system.pixel_size > 1.5, xray=context.space_data.shading.show_xray)
+
+
 @bpy.app.handlers.persistent
 def _sync_all(*_args):
     """After a file loads: the modifier where previews are on. Before a save: none (a file never holds one)."""
@@ -305,7 +339,10 @@ def _view_draw(preview):
         gpu.state.depth_mask_set(True)
         try:
             preview.run(context, region, np.array(rv3d.view_matrix), np.array(rv3d.window_matrix))
+            if _outlined:
+                _draw_outlines(context, region)
         finally:
+            _outlined.clear()
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
 
@@ -411,9 +448,12 @@ def stopped_previews():
 
 def clear_previews():
     """Forget every preview's uploads, compiled shaders and pattern batches (rebuilt on the next draw)."""
+    from ..gpu_shaders import outline as gpu_outline
+
     for preview in _previews:
         preview.cache.clear()
     loader.clear()
+    gpu_outline.clear()
 
 
 def register():

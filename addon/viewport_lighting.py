@@ -10,7 +10,7 @@ import numpy as np
 
 from ..gpu_shaders import loader
 from ..gpu_shaders.offscreen import ViewLighting
-from .viewport import preview_style
+from .viewport import outline, preview_style
 
 #: Blender's default surface when an object has no material (grey 0.8, roughness 0.4, not metallic).
 DEFAULT_SURFACE = ((0.8, 0.8, 0.8, 1.0), 0.4, 0.0)
@@ -128,7 +128,8 @@ def draw_as_object(context, ob, view, draw, *args, wire=False, **kwargs):
     preview has one (``wire``), the wire by ``draw(*args, color=, lit=False, wireframe=True, **kwargs)``.
 
     In X-ray the surface is see-through as Blender's objects are: its nearest layer only (a depth pass first, then
-    the colour blended where the depth is equal), so overlapping layers never blotch; its wire shows through."""
+    the colour blended where the depth is equal), so overlapping layers never blotch; its wire shows through. A
+    selected object gets Blender's outline (`viewport.outline`)."""
     import gpu
 
     style = preview_style(context, ob)
@@ -146,6 +147,7 @@ def draw_as_object(context, ob, view, draw, *args, wire=False, **kwargs):
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_mask_set(True)
+        outline(context, ob, lambda mask_color: draw(*args, color=mask_color, lit=False, **kwargs))
     if style.wire_color is not None and wire:
         if style.xray:
             gpu.state.depth_test_set("ALWAYS")

@@ -14,6 +14,7 @@ SHADERS = (
     ("tube_preview", "tubes.draw", "_describe"),
     ("patch_preview", "tessellation.draw", "_describe_preview"),
     ("patch_compute", "tessellation.draw", "_describe_compute"),
+    ("selection_outline", "outline", "_describe"),
     ("terrain_preview", "terrain.draw", "_describe"),
     ("texture_copy", "textures", "_describe_copy"),
     ("vector_field_advect", "vector_field.streaks", "_describe_advect"),

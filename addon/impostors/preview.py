@@ -16,7 +16,7 @@ from ...kernels.common.errors import InvalidInputError
 from ...kernels.impostors.board import board_setup
 from ...kernels.impostors.prewarp import fill_holes, forward_splat
 from ..guarded import check_numbers
-from ..viewport import Preview, previewed_objects, tag_view3d_redraw
+from ..viewport import Preview, outline, previewed_objects, tag_view3d_redraw
 from . import worker
 from .live import NailboardManager
 from .settings import TOPIC
@@ -182,6 +182,7 @@ def _draw(context, region, view, proj):
         elif p.draw.splat is not splat:
             p.draw.set_splat(splat, rows)
         p.draw.draw(proj @ view)
+        outline(context, ob, lambda mask_color, d=p.draw, vp=proj @ view: d.draw(vp, mask_color=mask_color))
 
 
 def previewing(ob):

@@ -64,8 +64,9 @@ class BoardDrawData:
         self.splat = splat
         self.offsets = image_texture(offset_rows(splat) if rows is None else rows, "RG32F")
 
-    def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81)):
-        """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major."""
+    def draw(self, view_projection, lit=False, light_dir=(0.3, -0.5, 0.81), mask_color=None):
+        """Draw into the bound framebuffer (depth test as the caller set it); view_projection (4, 4) row-major;
+        mask_color: rgba every texel of the board is drawn in instead of its colour (a selection outline's mask)."""
         from gpu_extras.batch import batch_for_shader
 
         shader = loader.shader("nailboard", _describe)
@@ -78,11 +79,12 @@ class BoardDrawData:
 
         batch = loader.batch(("nailboard", w, h), build)
         shader.bind()
-        shader.uniform_block("shading", view_block(view_projection, light_dir=tuple(light_dir)))
+        shader.uniform_block("shading", view_block(view_projection, color=tuple(mask_color or (1.0, 1.0, 1.0, 1.0)),
+                                                   light_dir=tuple(light_dir)))
         f = self.frame
         for name, value in (("origin", f.origin), ("axis_a", f.a), ("axis_b", f.b), ("normal_f", f.f)):
             shader.uniform_float(name, tuple(float(x) for x in value))
-        shader.uniform_int("lit", 1 if lit else 0)
+        shader.uniform_int("lit", 2 if mask_color is not None else 1 if lit else 0)
         shader.uniform_sampler("offsets", self.offsets)
         shader.uniform_sampler("colours", self.colours)
         shader.uniform_sampler("displacement", self.displacement)
