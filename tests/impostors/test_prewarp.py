@@ -131,7 +131,8 @@ def test_a_sphere_seen_off_its_boards_axis_keeps_no_hole_inside_its_outline(eye)
     """The live board of a sphere, its plane behind it (displacements 1.75 to 2.75) and the eye moved off the axis
     it was rendered along: the front's texels spread into gaps longer than the preview's gap both ways, which one row
     and column pass leaves (the viewport showed them as specks through the board); the passes repeat until none is
-    left inside the outline, and nothing is painted outside the outline (of the depth-buffered splat, closed along rows and columns)."""
+    left inside the outline, and nothing is painted outside the outline (of the depth-buffered splat, closed along
+    rows and columns)."""
     n = 200
     y, x = (np.mgrid[0:n, 0:n] + 0.5) / n * 2.6 - 1.3
     present = x * x + y * y < 1.0
