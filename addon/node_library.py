@@ -7,8 +7,9 @@ machine without the add-on.
 The .blend is named by a hash of the groups' names and versions and of the Blender that builds them: a new version
 writes a new file and removes the old one. ``make build`` ships one in the zip (``node_library/``, built by the
 build's Blender, see tools/build_extension.py); the entry points there when it was built for this Blender, and
-otherwise the add-on writes its own into the user folder. Nothing is written while Blender is starting (data is
-read-only then): a one-shot timer does it.
+otherwise the add-on writes its own into the user folder: with a window, a worker Blender writes it (building the
+groups takes a second or two, which would hold the window) and the entry is added when it is done; in background mode,
+the add-on itself. Nothing is started while Blender is starting (data is read-only then): a one-shot timer does it.
 """
 
 import hashlib
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import bpy
 
+from ..kernels.common.errors import TesseraError
 from . import node_groups
 from .displacement import nodes as _displace_nodes  # noqa: F401 (registers its group)
 from .manifest import license_id, manifest
@@ -107,14 +109,8 @@ def _complete(directory):
     return library_file(directory).exists() and (directory / CATALOG_FILE).exists()
 
 
-def register_library():
-    """Add (or repoint) the one "Tessera" asset library: the shipped library where it was built for this Blender,
-    else the user folder's, written if it is missing or outdated."""
-    directory = SHIPPED_DIR if _complete(SHIPPED_DIR) else library_dir()
-    if directory is None:
-        return None
-    if not _complete(directory):
-        write_library(directory)
+def _point_entry(directory):
+    """The one "Tessera" asset library entry, pointing at ``directory``."""
     libraries = bpy.context.preferences.filepaths.asset_libraries
     entries = _entries()
     for extra in entries[1:]:
@@ -123,7 +119,75 @@ def register_library():
         entries[0].path = str(directory)
     else:
         libraries.new(name=LIBRARY_NAME, directory=str(directory))
+
+
+def register_library():
+    """Add (or repoint) the one "Tessera" asset library: the shipped library where it was built for this Blender,
+    else the user folder's, written if it is missing or outdated: with a window, by a worker Blender
+    (`node_library_worker.py`; the entry is added when it is done, `_poll_writer`), so the window is never held;
+    in background mode, here."""
+    directory = SHIPPED_DIR if _complete(SHIPPED_DIR) else library_dir()
+    if directory is None:
+        return None
+    if not _complete(directory):
+        if not bpy.app.background and _start_writer(directory):
+            return directory
+        write_library(directory)
+    _point_entry(directory)
     return directory
+
+
+_writer = {}  # "job": the RenderJob writing the library, "directory": where
+
+
+def _start_writer(directory):
+    """Start a worker Blender writing the library into ``directory``; False when it cannot start (then the caller
+    writes it here)."""
+    import json
+
+    from . import render_jobs
+
+    folder = render_jobs.job_folder("library")
+    try:
+        job_file = Path(folder) / "job.json"
+        job_file.write_text(json.dumps({"package": str(Path(__file__).resolve().parents[1]),
+                                        "directory": str(directory)}), encoding="utf-8")
+        log = Path(folder) / "worker.log"
+        process = render_jobs.start_worker(Path(__file__).with_name("node_library_worker.py"), job_file, log)
+    except OSError as err:
+        render_jobs.remove_folder(folder)
+        print(f"Tessera: could not start a Blender to write the node-group library ({err}); writing it here")
+        return False
+    _writer.update(job=render_jobs.RenderJob(process, folder, 1, str(log)), directory=directory)
+    if not bpy.app.timers.is_registered(_poll_writer):
+        bpy.app.timers.register(_poll_writer, first_interval=0.25, persistent=True)
+    return True
+
+
+def _poll_writer():
+    """While the worker writes the library: wait; once it ends, add the entry (or, when it failed, say why once and
+    write the library here: the groups are then in Add Modifier as before)."""
+    job = _writer.get("job")
+    if job is None:
+        return None
+    if job.running():
+        return 0.25
+    directory = _writer.pop("directory")
+    _writer.pop("job")
+    try:
+        job.check("Writing the node-group library")
+    except TesseraError as err:  # the worker's failure, in its words
+        print(f"Tessera: {err}; writing it here")
+    finally:
+        job.close()
+    try:
+        if not _complete(directory):
+            write_library(directory)
+        _point_entry(directory)
+    except (OSError, RuntimeError) as err:
+        print(f"Tessera: the node-group library could not be written to {directory} ({err}); the groups are in "
+              "Object › Tessera › Add Tessera Node Group")
+    return None
 
 
 def _deferred():
@@ -139,8 +203,13 @@ def register():
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_deferred):
-        bpy.app.timers.unregister(_deferred)
+    for timer in (_deferred, _poll_writer):
+        if bpy.app.timers.is_registered(timer):
+            bpy.app.timers.unregister(timer)
+    job = _writer.pop("job", None)
+    _writer.clear()
+    if job is not None:
+        job.cancel()
     libraries = bpy.context.preferences.filepaths.asset_libraries
     for entry in _entries():
         libraries.remove(entry)

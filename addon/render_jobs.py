@@ -32,7 +32,7 @@ import numpy as np
 from ..kernels.common.errors import TesseraError
 
 #: The kinds of job folders; only these are ever removed as stale.
-KINDS = ("impostor", "board", "bake")
+KINDS = ("impostor", "board", "bake", "library")
 #: A folder of a process that is gone is stale after this many seconds; any folder of ours after `STALE_AGE_S`.
 ORPHAN_AGE_S = 60.0
 STALE_AGE_S = 24 * 3600.0

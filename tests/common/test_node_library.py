@@ -49,6 +49,34 @@ def test_library_registered_once_and_removed_on_disable(clean_scene, bpy_module,
     assert len(entries(bpy)) == 1 and entries(bpy)[0].path == directory
 
 
+def test_a_worker_blender_writes_the_library_and_the_entry_follows(clean_scene, bpy_module, addon, addon_module,
+                                                                   tmp_path, capsys):
+    """With a window the library is written by a worker Blender (`node_library_worker.py`), polled by a timer: the
+    files it writes are the library the add-on itself writes (the same groups), and the entry points there when it is
+    done; nothing of the job is left."""
+    import time
+
+    bpy = bpy_module
+    lib = addon_module("addon.node_library")
+    directory = entries(bpy)[0].path
+    try:
+        assert lib._start_writer(tmp_path)
+        job = lib._writer["job"]
+        deadline = time.monotonic() + 240
+        while lib._poll_writer() is not None and time.monotonic() < deadline:
+            time.sleep(0.25)
+        assert not lib._writer and not job.running()
+        assert "writing it here" not in capsys.readouterr().out  # the worker wrote it, not the fallback
+        assert lib._complete(tmp_path) and entries(bpy)[0].path == str(tmp_path)
+        with bpy.data.libraries.load(str(lib.library_file(tmp_path)), assets_only=True) as (src, _):
+            written = set(src.node_groups)
+        with bpy.data.libraries.load(str(lib.library_file(directory)), assets_only=True) as (src, _):
+            assert written == set(src.node_groups) and len(written) >= 5
+        assert not (tmp_path / "job.json").exists() and not lib.Path(job.folder).exists()
+    finally:
+        lib._point_entry(directory)
+
+
 def test_the_assets_describe_themselves(clean_scene, bpy_module, addon, addon_module):
     """Every group in the library: a one-sentence description (its tooltip and its asset's), the asset's author,
     license and copyright from the manifest, a catalog under Tessera, flagged for Add Modifier; every socket with a
