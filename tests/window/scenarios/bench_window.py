@@ -6,7 +6,7 @@ one redraw. Writes its rows into ``results["rows"]``."""
 import time
 
 import bpy
-from common import REDRAWS, clean_scene, frame, operate, region_ms
+from common import REDRAWS, after_startup, clean_scene, frame, operate, region_ms
 from mathutils import Euler
 from previews import _copy_of, height_image, setter
 
@@ -18,16 +18,27 @@ def triangles(ob):
     return len(ob.data.loop_triangles)
 
 
-def cost(w, name, source, preview, applied):
-    """One row: the viewport with ``preview(True)`` against the object ``applied()`` makes (``source`` hidden)."""
+def cost(w, name, source, preview, applied, selected=False):
+    """One row: the viewport with ``preview(True)`` against the object ``applied()`` makes (``source`` hidden);
+    ``selected``: each object selected and active, so both draw their selection outline."""
+    layer = bpy.context.view_layer
+
+    def select(ob):
+        ob.select_set(selected)
+        layer.objects.active = ob if selected else None
+
+    select(source)
     preview(True)
     with_preview = region_ms(w)
     preview(False)
+    source.select_set(False)
     made = applied()
+    select(made)
     source.hide_set(True)
     blender = region_ms(w)
-    row = {"case": f"redraw, {name} preview", "triangles": triangles(made), "preview_ms": round(with_preview, 2),
-           "blender_ms": round(blender, 2), "ratio": round(with_preview / blender, 2)}
+    row = {"case": f"redraw, {name} preview{', selected' if selected else ''}", "triangles": triangles(made),
+           "preview_ms": round(with_preview, 2), "blender_ms": round(blender, 2),
+           "ratio": round(with_preview / blender, 2)}
     bpy.data.objects.remove(made)
     source.hide_set(False)
     return row
@@ -48,6 +59,7 @@ def hold(w, started, done):
 
 def run(w):
     rows = w.results.setdefault("rows", [])
+    yield from after_startup(w)
     clean_scene(w)
     bpy.ops.mesh.primitive_monkey_add()
     ob = bpy.context.active_object
@@ -55,8 +67,9 @@ def run(w):
     frame(w, [ob])
     yield 0.3
     ob.tessera.tessellate.level = 3
-    rows.append(cost(w, "tessellation (PN, level 3)", ob, setter(ob, "tessellate"),
-                     lambda: operate(w, bpy.ops.tessera.tessellate, ob, method="PN", level=3)))
+    for selected in (False, True):
+        rows.append(cost(w, "tessellation (PN, level 3)", ob, setter(ob, "tessellate"),
+                         lambda: operate(w, bpy.ops.tessera.tessellate, ob, method="PN", level=3), selected))
     ob.tessera.loop.levels = 2
     rows.append(cost(w, "Loop (2 levels)", ob, setter(ob, "loop"),
                      lambda: operate(w, bpy.ops.tessera.loop_subdivide, ob, levels=2)))
@@ -94,13 +107,14 @@ def run(w):
         with bpy.context.temp_override(**w.context(), active_object=ob, object=ob, selected_objects=[ob]):
             bpy.ops.tessera.impostor_bake("INVOKE_DEFAULT", grid=4, tile=128, samples=8)
 
-    longest, took = yield from hold(w, bake, lambda: len(set(bpy.data.objects) - before) > 0)
-    rows.append({"case": "impostor bake (4 x 4 views of 128 px, 8 samples)", "seconds": round(took, 1),
-                 "longest_hold_ms": round(longest, 1), "redraw_ms": round(redraw, 1),
-                 "beyond_redraw_ms": round(max(longest - redraw, 0.0), 1)})
-    for made in set(bpy.data.objects) - before:
-        bpy.data.objects.remove(made)
-    yield 0.3
+    for which in ("first of the session", "again"):  # the first start of a modal job pays Blender's one-time costs
+        longest, took = yield from hold(w, bake, lambda: len(set(bpy.data.objects) - before) > 0)
+        rows.append({"case": f"impostor bake (4 x 4 views of 128 px, 8 samples), {which}", "seconds": round(took, 1),
+                     "longest_hold_ms": round(longest, 1), "redraw_ms": round(redraw, 1),
+                     "beyond_redraw_ms": round(max(longest - redraw, 0.0), 1)})
+        for made in set(bpy.data.objects) - before:
+            bpy.data.objects.remove(made)
+        yield 0.3
 
     preview = w.module("addon.impostors.preview")
     s = ob.tessera.nailboard

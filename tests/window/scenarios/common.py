@@ -120,6 +120,15 @@ def oracle(w, name, empty, preview, applied, source=None, masks=False):
     return share
 
 
+def after_startup(w, timeout=120.0):
+    """Yield until the add-on's start-up work is done (its node-group library written by a worker Blender), so that
+    timings do not share the CPU with it. A generator."""
+    library = w.module("addon.node_library")
+    start = time.perf_counter()
+    while library._writer and time.perf_counter() - start < timeout:
+        yield 0.25
+
+
 def region_ms(w, iterations=REDRAWS, warm=True):
     """Milliseconds of main-thread time per redraw of the 3D viewport region; ``warm``: after two redraws that are
     not counted (uploads and level selections happen there), else counting the first redraw of what changed."""
