@@ -109,6 +109,8 @@ class Prewarp:
     draw: object = None
     draw_images: object = None
     pending: tuple = None
+    building: object = None  # the `BoardDrawData.steps` of a new board, one upload per redraw
+    building_images: object = None
 
 
 _prewarps = {}  # object session_uid -> Prewarp
@@ -155,6 +157,17 @@ def _poll_prewarps():
     return 0.02 if pending else None
 
 
+def _redraw_soon():
+    """Redraw the viewports once this draw is over (a redraw asked for while drawing may be dropped)."""
+    if not bpy.app.timers.is_registered(_redraw_now):
+        bpy.app.timers.register(_redraw_now, first_interval=0.0)
+
+
+def _redraw_now():
+    tag_view3d_redraw()
+    return None
+
+
 def _draw(context, region, view, proj):
     from ...gpu_shaders.impostors.draw import BoardDrawData
 
@@ -175,14 +188,31 @@ def _draw(context, region, view, proj):
             continue
         shown_images, _, (splat, rows) = shown
         p = _prewarps[ob.session_uid]
-        if p.draw is None or p.draw_images is not shown_images:
-            p.draw = BoardDrawData(shown_images.setup.frame, shown_images.colours, shown_images.displacement, splat,
-                                   shown_images.normals, rows)
-            p.draw_images = shown_images
+        if p.draw is None or p.draw_images is not shown_images:  # a new board: its uploads one per redraw
+            if p.building is None or p.building_images is not shown_images:
+                p.building = BoardDrawData.steps(shown_images.setup.frame, shown_images.colours,
+                                                 shown_images.displacement, splat, shown_images.normals, rows)
+                p.building_images = shown_images
+            try:
+                next(p.building)
+                _redraw_soon()
+            except StopIteration as built:
+                p.draw, p.draw_images, p.building, p.building_images = built.value, shown_images, None, None
         elif p.draw.splat is not splat:
             p.draw.set_splat(splat, rows)
+        if p.draw is None:  # the first board of this object is still being uploaded
+            continue
         p.draw.draw(proj @ view)
         outline(context, ob, lambda mask_color, d=p.draw, vp=proj @ view: d.draw(vp, mask_color=mask_color))
+
+
+def board_drawn(ob):
+    """Whether ``ob``'s live board is rendered, pre-warped and uploaded, so that the viewport draws it (its uploads
+    take a redraw each: the window tier waits on this before it looks)."""
+    live = MANAGER.boards.get(ob.session_uid)
+    p = _prewarps.get(ob.session_uid)
+    return live is not None and live.images is not None and live.pending is None and p is not None \
+        and p.draw is not None and p.building is None and p.draw_images is live.images
 
 
 def previewing(ob):
@@ -205,4 +235,6 @@ register = PREVIEW.register
 def unregister():
     """Undo `register`; the boards' GPU data goes with it (its GPU context may not outlive the add-on)."""
     PREVIEW.unregister()
+    if bpy.app.timers.is_registered(_redraw_now):
+        bpy.app.timers.unregister(_redraw_now)
     _prewarps.clear()

@@ -48,14 +48,31 @@ class BoardDrawData:
     displacement (H, W) and normals (H, W, 3) of its source images; splat: the `Splat` of the current pre-warp."""
 
     def __init__(self, frame, colours, displacement, splat, normals=None, rows=None):
+        for _ in self._steps(frame, colours, displacement, splat, normals, rows):
+            pass
+
+    @classmethod
+    def steps(cls, frame, colours, displacement, splat, normals=None, rows=None):
+        """The same, made one upload at a time (a generator returning the `BoardDrawData`; its shader compiled
+        first): a viewport that takes one step per redraw is never held by all of them at once."""
+        data = cls.__new__(cls)
+        yield from data._steps(frame, colours, displacement, splat, normals, rows)
+        return data
+
+    def _steps(self, frame, colours, displacement, splat, normals, rows):
         h, w = np.asarray(displacement).shape
         self.frame, self.size = frame, (w, h)
+        loader.shader("nailboard", _describe)
+        yield
         self.colours = image_texture(colours, "RGBA32F")
+        yield
         self.displacement = image_texture(displacement, "R32F")
+        yield
         n = np.zeros((h, w, 4), np.float32)
         if normals is not None:
             n[..., :3] = normals
         self.normals = image_texture(n, "RGBA32F")
+        yield
         self.set_splat(splat, rows)
 
     def set_splat(self, splat, rows=None):

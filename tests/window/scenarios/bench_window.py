@@ -121,8 +121,7 @@ def run(w):
     s.samples, s.progressive = 8, True
 
     def board_ready():
-        live = preview.MANAGER.boards.get(ob.session_uid)
-        return live is not None and live.images is not None and live.pending is None
+        return preview.board_drawn(ob)
 
     def enable():
         s.enabled = True

@@ -39,8 +39,7 @@ def run(w):
     start = time.monotonic()
     while time.monotonic() - start < FIRST_BOARD_S:
         w.redraw()
-        live = preview.MANAGER.boards.get(ob.session_uid)
-        if live is not None and live.images is not None and live.pending is None:
+        if preview.board_drawn(ob):
             break
         yield 0.5
     r["first_board_s"] = time.monotonic() - start

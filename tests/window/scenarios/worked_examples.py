@@ -126,8 +126,7 @@ def _boards_drawn(w, limit=BOARD_S):
     start = time.monotonic()
     while time.monotonic() - start < limit:
         w.redraw()
-        boards = list(preview.MANAGER.boards.values())
-        if all(live.images is not None and live.pending is None for live in boards):
+        if all(preview.board_drawn(ob) for ob in bpy.data.objects if ob.session_uid in preview.MANAGER.boards):
             break
         yield 0.5
     w.results["boards_drawn_s"] = round(time.monotonic() - start, 1)
