@@ -290,9 +290,16 @@ def outline(context, ob, draw):
     _outlined.append((draw, ACTIVE_ID if ob == context.view_layer.objects.active else SELECTED_ID))
 
 
+def thick_outline(preferences):
+    """Whether Blender draws its selection outline two pixels a side (instead of one): at a resolution scale above 1,
+    or with the theme's Outline Width above 2."""
+    return preferences.system.pixel_size > 1.0 or preferences.themes[0].view_3d.outline_width > 2
+
+
 def _draw_outlines(context, region):
     """The outline of what `outline` kept, over the viewport: in the theme's selected and active colours, two pixels
-    a side at a resolution scale above 1.5, as bright behind other objects as in front in X-ray."""
+    a side where Blender's is (a resolution scale above 1, or the theme's Outline Width above 2), as bright behind
+    other objects as in front in X-ray."""
     from ..gpu_shaders import outline as gpu_outline
 
     try:
@@ -303,7 +310,7 @@ def _draw_outlines(context, region):
     mask = gpu_outline.mask_for((region.width, region.height))
     mask.draw(_outlined)
     gpu_outline.resolve(shader, mask, (*_linear(theme.object_selected), 1.0), (*_linear(theme.object_active), 1.0),
-                        thick=context.preferences.system.pixel_size > 1.5, xray=context.space_data.shading.show_xray)
+                        thick=thick_outline(context.preferences), xray=context.space_data.shading.show_xray)
 
 
 @bpy.app.handlers.persistent

@@ -63,16 +63,19 @@ class OutlineMask:
                 draw((0.0, 0.0, 0.0, outline_id))
 
 
-_masks = {}
+_masks = {}  # size -> OutlineMask, the most recently used last
+#: Masks kept: one per viewport size in use (a few viewports of different sizes each keep theirs).
+KEEP_MASKS = 4
 
 
 def mask_for(size):
-    """The `OutlineMask` of this ``size`` (the last one made is kept)."""
+    """The `OutlineMask` of this ``size``, made once and kept while viewports of this size draw outlines."""
     key = tuple(int(v) for v in size)
-    if key not in _masks:
-        _masks.clear()
-        _masks[key] = OutlineMask(key)
-    return _masks[key]
+    mask = _masks.pop(key, None) or OutlineMask(key)
+    _masks[key] = mask
+    while len(_masks) > KEEP_MASKS:
+        del _masks[next(iter(_masks))]
+    return mask
 
 
 def clear():
@@ -87,8 +90,8 @@ def shader():
 
 def resolve(shader, mask, selected_color, active_color, thick=False, xray=False):
     """Draw with ``shader`` (`shader()`) the outline of ``mask`` over the bound framebuffer (the viewport's, whose
-    depth holds the scene): colours linear rgba; thick: two pixels a side (Blender's at a resolution scale above
-    1.5); xray: the occluded part as bright as the rest, as X-ray shows it. Leaves depth test and blending off."""
+    depth holds the scene): colours linear rgba; thick: two pixels a side instead of one; xray: the occluded part as
+    bright as the rest, as X-ray shows it. Leaves depth test and blending off."""
     import gpu
     from gpu_extras.batch import batch_for_shader
 

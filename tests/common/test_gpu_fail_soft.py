@@ -75,6 +75,39 @@ def test_a_preview_stops_once_instead_of_raising_every_frame(failing, addon_modu
     assert "tessera_test" not in viewport.stopped_previews()
 
 
+def test_a_failed_outline_shader_leaves_previews_drawing_without_outlines(failing, addon_module, capfd):
+    """The selection outline's shader failing is told once; the draw handler's outline step returns instead of
+    raising, frame after frame (the previews it outlines keep drawing), and keeps nothing of the frame."""
+    loader, names, tried = failing
+    viewport = addon_module("addon.viewport")
+    names.add("selection_outline")
+    capfd.readouterr()
+    for _ in range(5):
+        viewport._outlined.append((lambda color: None, 1.0))
+        viewport._draw_outlines(None, None)  # returns before it reads the context: the shader is not there
+        viewport._outlined.clear()  # as the draw handler does after every frame
+    out = capfd.readouterr()
+    assert tried.count("selection_outline") == 1 and (out.out + out.err).count("'selection_outline'") == 1
+
+
+def test_the_outline_is_as_thick_as_blenders(bpy_module, addon_module):
+    """Two pixels a side where Blender's is: a resolution scale above 1, or the theme's Outline Width above 2 (read
+    from the preferences of every supported Blender)."""
+    bpy = bpy_module
+    viewport = addon_module("addon.viewport")
+    prefs = bpy.context.preferences
+    theme = prefs.themes[0].view_3d
+    width = theme.outline_width
+    try:
+        theme.outline_width = 1
+        thin = viewport.thick_outline(prefs)
+        theme.outline_width = 3
+        wide = viewport.thick_outline(prefs)
+    finally:
+        theme.outline_width = width
+    assert thin == (prefs.system.pixel_size > 1.0) and wide
+
+
 def _pixels(image):
     px = np.empty(image.size[0] * image.size[1] * 4, np.float32)
     image.pixels.foreach_get(px)
