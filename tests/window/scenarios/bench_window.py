@@ -6,7 +6,7 @@ one redraw. Writes its rows into ``results["rows"]``."""
 import time
 
 import bpy
-from common import REDRAWS, after_startup, clean_scene, frame, operate, region_ms
+from common import REDRAWS, after_startup, clean_scene, frame, operate, region_ms, sun_light, tube_circle
 from mathutils import Euler
 from previews import _copy_of, height_image, setter
 
@@ -76,13 +76,9 @@ def run(w):
     yield 0.3
 
     clean_scene(w)
-    bpy.ops.curve.primitive_bezier_circle_add()
-    ob = bpy.context.active_object
-    t = ob.tessera.tubes
-    t.radius_source, t.radius, t.sides = "CONSTANT", 0.15, 16
-    frame(w, [ob], (0.9, 0.0, 0.5))
-    rows.append(cost(w, "tubes (16 sides)", ob, setter(ob, "tubes"), lambda: operate(
-        w, bpy.ops.tessera.tubes, ob, radius_source="CONSTANT", radius=0.15, sides=16)))
+    ob, tubes = tube_circle(w)
+    rows.append(cost(w, "tubes (16 sides)", ob, setter(ob, "tubes"),
+                     lambda: operate(w, bpy.ops.tessera.tubes, ob, **tubes)))
     yield 0.3
 
     clean_scene(w)
@@ -93,9 +89,7 @@ def run(w):
 
     # The main thread during background work: an impostor bake, then a live board's first render
     clean_scene(w)
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    sun.location = (0.0, 0.0, 100.0)
-    bpy.context.collection.objects.link(sun)
+    sun_light()
     bpy.ops.mesh.primitive_monkey_add()
     ob = bpy.context.active_object
     frame(w, [ob], (1.1, 0.0, 0.7))

@@ -120,6 +120,41 @@ def oracle(w, name, empty, preview, applied, source=None, masks=False):
     return share
 
 
+def sun_light():
+    """A sun out of view (its gizmo is not what a scenario looks at), for the renders of boards and cards."""
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 4.0
+    sun.location = (0.0, 0.0, 100.0)
+    sun.rotation_euler = (0.6, 0.2, 0.3)
+    bpy.context.collection.objects.link(sun)
+    return sun
+
+
+def tube_circle(w):
+    """A Bézier circle with constant tubes of radius 0.15 and 16 sides, framed from above at an angle: the
+    object, its tubes' settings as *Tubes* takes them."""
+    bpy.ops.curve.primitive_bezier_circle_add()
+    ob = bpy.context.active_object
+    settings = {"radius_source": "CONSTANT", "radius": 0.15, "sides": 16}
+    for name, value in settings.items():
+        setattr(ob.tessera.tubes, name, value)
+    frame(w, [ob], (0.9, 0.0, 0.5))
+    return ob, settings
+
+
+def board_drawn_within(w, ob, limit):
+    """Redraw until ``ob``'s live board is drawn (`addon.impostors.preview.board_drawn`), ``limit`` seconds at most.
+    A generator returning the seconds it took."""
+    preview = w.module("addon.impostors.preview")
+    start = time.monotonic()
+    while time.monotonic() - start < limit:
+        w.redraw()
+        if preview.board_drawn(ob):
+            break
+        yield 0.5
+    return time.monotonic() - start
+
+
 def after_startup(w, timeout=120.0):
     """Yield until the add-on's start-up work is done (its node-group library written by a worker Blender), so that
     timings do not share the CPU with it. A generator."""

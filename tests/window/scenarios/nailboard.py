@@ -3,10 +3,8 @@ board takes, where the board is drawn against where Blender draws the object (ma
 its board, the pre-warps made per redraw of an unchanged view (none expected), and what a redraw costs the main
 thread with the view unchanged and just after the view moved (the moved eye's pre-warp runs on a worker thread)."""
 
-import time
-
 import bpy
-from common import clean_scene, frame, mask_mismatch, region_ms, shot, silhouette
+from common import board_drawn_within, clean_scene, frame, mask_mismatch, region_ms, shot, silhouette, sun_light
 from mathutils import Euler
 
 SETTLE = 0.3
@@ -17,11 +15,7 @@ def run(w):
     r = w.results
     preview = w.module("addon.impostors.preview")
     clean_scene(w)
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))  # the board's render needs a light
-    sun.data.energy = 4.0
-    sun.location = (0.0, 0.0, 100.0)  # out of view: its gizmo is not the board
-    sun.rotation_euler = (0.6, 0.2, 0.3)
-    bpy.context.collection.objects.link(sun)
+    sun_light()  # the board's render needs a light
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24)
     ob = bpy.context.active_object
     bpy.ops.object.shade_smooth()
@@ -36,13 +30,7 @@ def run(w):
     s = ob.tessera.nailboard
     s.samples, s.progressive = 4, False
     s.enabled = True
-    start = time.monotonic()
-    while time.monotonic() - start < FIRST_BOARD_S:
-        w.redraw()
-        if preview.board_drawn(ob):
-            break
-        yield 0.5
-    r["first_board_s"] = time.monotonic() - start
+    r["first_board_s"] = yield from board_drawn_within(w, ob, FIRST_BOARD_S)
     live = preview.MANAGER.boards.get(ob.session_uid)
     r["board_ready"] = bool(live is not None and live.images is not None)
     yield SETTLE

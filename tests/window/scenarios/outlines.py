@@ -6,12 +6,10 @@ origins off (the origin dot is not the outline). Recorded per case: ``<name>_out
 Cases: tessellation (active; selected but not active; half behind a cube, where Blender fades the outline), Loop,
 tubes, terrain and the live nailboard."""
 
-import time
-
 import bpy
 import numpy as np
-from common import THRESHOLD, block_mask, clean_scene, frame, operate, shot
-from previews import height_image
+from common import THRESHOLD, block_mask, board_drawn_within, clean_scene, frame, operate, shot, sun_light, tube_circle
+from previews import _copy_of, height_image
 
 SETTLE = 0.3
 FIRST_BOARD_S = 120.0
@@ -93,14 +91,9 @@ def run(w):
 
     # Tubes on a Bézier circle
     clean_scene(w)
-    bpy.ops.curve.primitive_bezier_circle_add()
-    ob = bpy.context.active_object
-    t = ob.tessera.tubes
-    t.radius_source, t.radius, t.sides = "CONSTANT", 0.15, 16
-    frame(w, [ob], (0.9, 0.0, 0.5))
+    ob, tubes = tube_circle(w)
     yield SETTLE
-    compare(w, "tubes", ob, setter(ob, "tubes"), lambda: operate(
-        w, bpy.ops.tessera.tubes, ob, radius_source="CONSTANT", radius=0.15, sides=16))
+    compare(w, "tubes", ob, setter(ob, "tubes"), lambda: operate(w, bpy.ops.tessera.tubes, ob, **tubes))
     yield SETTLE
 
     # A terrain from an image
@@ -109,24 +102,12 @@ def run(w):
     ob = operate(w, bpy.ops.tessera.terrain_add, source="IMAGE", image_name=image.name)
     frame(w, [ob], (1.0, 0.0, 0.6))
     yield SETTLE
-
-    def baked():
-        copy = bpy.data.objects.new(f"{ob.name} baked", ob.data)
-        copy.matrix_world = ob.matrix_world.copy()
-        bpy.context.collection.objects.link(copy)
-        return copy
-
-    compare(w, "terrain", ob, setter(ob, "terrain"), baked)
+    compare(w, "terrain", ob, setter(ob, "terrain"), lambda: _copy_of(ob))
     yield SETTLE
 
     # The live nailboard of a smooth sphere, against the sphere itself (the board stands for it)
     clean_scene(w)
-    preview = w.module("addon.impostors.preview")
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))  # the board's render needs a light
-    sun.data.energy = 4.0
-    sun.location = (0.0, 0.0, 100.0)  # out of view: its gizmo is not the board
-    sun.rotation_euler = (0.6, 0.2, 0.3)
-    bpy.context.collection.objects.link(sun)
+    sun_light()
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24)
     ob = bpy.context.active_object
     bpy.ops.object.shade_smooth()
@@ -134,12 +115,7 @@ def run(w):
     s = ob.tessera.nailboard
     s.samples, s.progressive = 4, False
     s.enabled = True
-    start = time.monotonic()
-    while time.monotonic() - start < FIRST_BOARD_S:
-        w.redraw()
-        if preview.board_drawn(ob):
-            break
-        yield 0.5
+    yield from board_drawn_within(w, ob, FIRST_BOARD_S)
     yield SETTLE
     with_board = outline_mask(w, "board_preview", ob)
     s.enabled = False

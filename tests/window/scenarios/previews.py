@@ -5,7 +5,7 @@ source is hidden with its preview on."""
 
 import bpy
 import numpy as np
-from common import clean_scene, frame, operate, oracle, shot, silhouette
+from common import clean_scene, frame, operate, oracle, shot, silhouette, tube_circle
 
 SETTLE = 0.3
 
@@ -76,15 +76,11 @@ def run(w):
 
     # Tubes on a Bézier circle
     clean_scene(w)
-    bpy.ops.curve.primitive_bezier_circle_add()
-    ob = bpy.context.active_object
-    t = ob.tessera.tubes
-    t.radius_source, t.radius, t.sides = "CONSTANT", 0.15, 16
+    ob, tubes = tube_circle(w)
     empty = staged(w, ob, "tubes", (0.9, 0.0, 0.5))
     yield SETTLE
-    yield from lit_both_ways(
-        w, "tubes", empty, setter(ob, "tubes"),
-        lambda: operate(w, bpy.ops.tessera.tubes, ob, radius_source="CONSTANT", radius=0.15, sides=16), source=ob)
+    yield from lit_both_ways(w, "tubes", empty, setter(ob, "tubes"),
+                             lambda: operate(w, bpy.ops.tessera.tubes, ob, **tubes), source=ob)
     hidden_pixels(w, ob, "tubes", empty, "tubes")
 
     # A terrain from an image, seen from above at an angle
