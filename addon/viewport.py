@@ -281,10 +281,9 @@ def outline(context, ob, draw):
     Selected on, not Wireframe shading), ``draw(color)`` (the preview drawn flat, unlit, in ``color``) is kept for
     the outline the draw handler adds once its preview has drawn (`gpu_shaders.outline`)."""
     space = context.space_data
-    overlay = space.overlay
-    if not ob.select_get() or space.shading.type == "WIREFRAME" or not overlay.show_overlays \
-            or not overlay.show_outline_selected:
-        return
+    if space is None or not ob.select_get() or space.shading.type == "WIREFRAME" \
+            or not space.overlay.show_overlays or not space.overlay.show_outline_selected:
+        return  # no 3D view (an offscreen drawing), or no outline to draw
     from ..gpu_shaders.outline import ACTIVE_ID, SELECTED_ID
 
     _outlined.append((draw, ACTIVE_ID if ob == context.view_layer.objects.active else SELECTED_ID))

@@ -135,7 +135,8 @@ def test_a_board_from_the_cycles_worker_stands_in_for_the_object(clean_scene, gp
 
 def test_the_viewport_draws_a_live_nailboard_without_waiting(clean_scene, gpu_renderer, bpy_module, addon_module):
     """The viewport side: the first frame asks for a board (queued for a timer, nothing drawn, nothing waited for);
-    once the worker is done the next frame draws the object from it, pre-warped for that frame's eye."""
+    once the worker is done and the board pre-warped, the next frames upload it a step each (its shader, then each
+    texture: no frame holds them all) and then draw the object from it, pre-warped for that frame's eye."""
     import time
     from types import SimpleNamespace
 
@@ -167,6 +168,11 @@ def test_the_viewport_draws_a_live_nailboard_without_waiting(clean_scene, gpu_re
     assert live.images is not None and live.pending is None
     assert swapped[..., :3].max() == 0 and preview.PREWARP_COUNT[0] >= 1
     preview._prewarps[ball.session_uid].pending[2].result(timeout=60)
+    frames = 0
+    while not preview.board_drawn(ball) and frames < 10:
+        offscreen.render(draw, size=(160, 160))
+        frames += 1
+    assert preview.board_drawn(ball) and frames == 5  # its shader, colours, depths, normals; then offsets and drawn
     second = offscreen.render(draw, size=(160, 160))
     count = preview.PREWARP_COUNT[0]
     again = offscreen.render(draw, size=(160, 160))

@@ -4,7 +4,8 @@
 
 Enables the add-on from the working tree (a dev extension repository, as the ``blender`` tier does), then drives
 ``tests/window/scenarios/SCENARIO.py``: its ``run(w)`` is a generator that yields the seconds to wait before its next
-step, so the window draws between steps. ``w`` is a `Window`: the 3D viewport, screenshots of it, injected events,
+step, so the window draws between steps. It starts once the add-on's start-up work is done, unless the scenario sets
+``AFTER_STARTUP = False``. ``w`` is a `Window`: the 3D viewport, screenshots of it, injected events,
 and ``w.results``, written to ``OUT_DIR/results.json`` with ``"finished": true`` when the scenario ends (or the error
 that stopped it). Blender quits afterwards; the test that started it reads the results and ``blender.log``.
 
@@ -110,6 +111,15 @@ class Window:
         self.event(key, "RELEASE", x=x, y=y, **kw)
 
 
+def _after_startup(w, steps):
+    """``steps`` once the add-on's start-up work is done (its node-group library, written by a worker Blender), so
+    that no scenario's events and timings share the CPU with that Blender's start."""
+    from common import after_startup
+
+    yield from after_startup(w)
+    return (yield from steps)
+
+
 def main():
     prefs = bpy.context.preferences
     prefs.view.show_splash = False
@@ -136,7 +146,10 @@ def main():
                 enable_addon()
                 sys.path.insert(0, str(SRC / "tests" / "window" / "scenarios"))
                 started = time.perf_counter()
-                steps = __import__(SCENARIO).run(w)
+                scenario = __import__(SCENARIO)
+                steps = scenario.run(w)
+                if getattr(scenario, "AFTER_STARTUP", True):  # the add-on's start-up work done first
+                    steps = _after_startup(w, steps)
                 w.results["setup_s"] = time.perf_counter() - started
             delay = next(steps)
             return max(float(delay), 0.01)

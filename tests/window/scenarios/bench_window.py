@@ -6,7 +6,7 @@ one redraw. Writes its rows into ``results["rows"]``."""
 import time
 
 import bpy
-from common import REDRAWS, after_startup, clean_scene, frame, operate, region_ms, sun_light, tube_circle
+from common import REDRAWS, clean_scene, frame, operate, region_ms, sun_light, tube_circle
 from mathutils import Euler
 from previews import _copy_of, height_image, setter
 
@@ -59,7 +59,6 @@ def hold(w, started, done):
 
 def run(w):
     rows = w.results.setdefault("rows", [])
-    yield from after_startup(w)
     clean_scene(w)
     bpy.ops.mesh.primitive_monkey_add()
     ob = bpy.context.active_object

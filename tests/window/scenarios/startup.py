@@ -9,6 +9,7 @@ import bpy
 from common import region_ms
 
 TIMEOUT_S = 120.0
+AFTER_STARTUP = False  # this scenario watches the start-up work itself
 
 
 def run(w):
