@@ -3,9 +3,9 @@ object from its own evaluated geometry, which a preview hides): `OutlineMask` ta
 and depth in a region-sized framebuffer of its own, `resolve` draws the outline from it over the viewport, faint
 where the scene hides it, as Blender's overlay does."""
 
-import numpy as np
 
 from . import loader
+from .textures import FULLSCREEN_VERT, fullscreen_batch
 
 #: The outline's alpha where another object hides it (Blender's overlay fades occluded outlines to this, outside
 #: X-ray), and the depth slack below which a pixel counts as visible (Blender's: 3 units of a 23-bit mantissa).
@@ -13,9 +13,6 @@ OCCLUDED_ALPHA = 0.35
 DEPTH_BIAS = 3.0 / 8388608.0
 #: The alpha channel a previewed object is drawn with into the mask: its outline id.
 SELECTED_ID, ACTIVE_ID = 0.5, 1.0
-
-_CORNER_VERT = "void main()\n{\n  gl_Position = vec4(corner, 0.0, 1.0);\n}\n"
-
 
 def _describe():
     import gpu
@@ -32,7 +29,7 @@ def _describe():
     info.fragment_out(0, "VEC4", "frag_color")
     if hasattr(info, "depth_write"):  # 4.5+ declares it; 4.2's OpenGL takes gl_FragDepth as it is
         info.depth_write("ANY")
-    info.vertex_source(_CORNER_VERT)
+    info.vertex_source(FULLSCREEN_VERT)
     info.fragment_source(loader.source("outline_frag.glsl"))
     return info
 
@@ -93,10 +90,8 @@ def resolve(shader, mask, selected_color, active_color, thick=False, xray=False)
     depth holds the scene): colours linear rgba; thick: two pixels a side instead of one; xray: the occluded part as
     bright as the rest, as X-ray shows it. Leaves depth test and blending off."""
     import gpu
-    from gpu_extras.batch import batch_for_shader
 
-    batch = loader.batch(("selection_outline",), lambda: batch_for_shader(
-        shader, "TRIS", {"corner": np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.float32)}))
+    batch = fullscreen_batch("selection_outline", shader)
     shader.bind()
     shader.uniform_sampler("ids", mask.ids)
     shader.uniform_sampler("depths", mask.depths)

@@ -30,7 +30,9 @@ def image_texture(values, fmt):
     return gpu.types.GPUTexture((w, h), format=fmt, data=gpu.types.Buffer("FLOAT", v.size, v.ravel()))
 
 
-_COPY_VERT = "void main()\n{\n  gl_Position = vec4(corner, 0.0, 1.0);\n}\n"
+#: The vertex stage of a full-screen pass: one triangle covering the viewport, from the ``corner`` input
+#: (`fullscreen_batch`).
+FULLSCREEN_VERT = "void main()\n{\n  gl_Position = vec4(corner, 0.0, 1.0);\n}\n"
 _COPY_FRAG = "void main()\n{\n  frag_color = texelFetch(source, ivec2(gl_FragCoord.xy), 0);\n}\n"
 
 
@@ -41,9 +43,18 @@ def _describe_copy():
     info.vertex_in(0, "VEC2", "corner")
     info.sampler(0, "FLOAT_2D", "source")
     info.fragment_out(0, "VEC4", "frag_color")
-    info.vertex_source(_COPY_VERT)
+    info.vertex_source(FULLSCREEN_VERT)
     info.fragment_source(_COPY_FRAG)
     return info
+
+
+def fullscreen_batch(name, shader):
+    """The one triangle of a full-screen pass for ``shader`` (its vertex stage `FULLSCREEN_VERT`, input ``corner``),
+    cached under ``name``."""
+    from gpu_extras.batch import batch_for_shader
+
+    return loader.batch((name,), lambda: batch_for_shader(
+        shader, "TRIS", {"corner": np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.float32)}))
 
 
 def read_after_compute(texture, n):
@@ -54,12 +65,10 @@ def read_after_compute(texture, n):
     on a GPU that runs asynchronously it may read the texture before the shader's writes land. A draw that fetches
     every texel into an offscreen framebuffer, and the read of that framebuffer, are ordered by the API itself."""
     import gpu
-    from gpu_extras.batch import batch_for_shader
 
     w, h = texture.width, texture.height
     shader = loader.shader("texture_copy", _describe_copy)
-    batch = loader.batch(("texture_copy",), lambda: batch_for_shader(
-        shader, "TRIS", {"corner": np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.float32)}))
+    batch = fullscreen_batch("texture_copy", shader)
     offscreen = gpu.types.GPUOffScreen(w, h, format="RGBA32F")
     try:
         with offscreen.bind():

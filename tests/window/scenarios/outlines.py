@@ -42,6 +42,11 @@ def compare(w, name, source, preview, applied, active=True):
     drawn = outline_mask(w, f"{name}_applied", made, active)
     bpy.data.objects.remove(made)
     source.hide_set(False)
+    record(w, name, with_preview, drawn)
+
+
+def record(w, name, with_preview, drawn):
+    """Record both outlines' pixel counts and the share of 8-pixel tiles covered by one only."""
     a, b = block_mask(with_preview, 8), block_mask(drawn, 8)
     union = int((a | b).sum())
     r = w.results
@@ -120,8 +125,4 @@ def run(w):
     with_board = outline_mask(w, "board_preview", ob)
     s.enabled = False
     yield SETTLE
-    drawn = outline_mask(w, "board_applied", ob)
-    a, b = block_mask(with_board, 8), block_mask(drawn, 8)
-    union = int((a | b).sum())
-    r["board_outline_preview"], r["board_outline_applied"] = int(with_board.sum()), int(drawn.sum())
-    r["board_outline_mismatch"] = float((a ^ b).sum()) / union if union else 0.0
+    record(w, "board", with_board, outline_mask(w, "board_applied", ob))
